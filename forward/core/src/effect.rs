@@ -1,0 +1,89 @@
+//! Canonical names of unmodelled effects (`GAP.md`, "Effect library").
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+/// An effect that a base model leaves out and an enrichment adds.
+///
+/// The `Display`/`FromStr` spelling is the canonical snake-case name used in
+/// JSON, manifests and the CLI.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Effect {
+    MaterialForm,
+    Viscoelasticity,
+    ZeroOffset,
+    Compressibility,
+    Friction,
+    ModellingSpace,
+    BoundaryCondition,
+    ToolCompliance,
+    Inclusion,
+}
+
+impl Effect {
+    /// Every effect, in the order of `GAP.md`.
+    pub const ALL: [Effect; 9] = [
+        Effect::MaterialForm,
+        Effect::Viscoelasticity,
+        Effect::ZeroOffset,
+        Effect::Compressibility,
+        Effect::Friction,
+        Effect::ModellingSpace,
+        Effect::BoundaryCondition,
+        Effect::ToolCompliance,
+        Effect::Inclusion,
+    ];
+
+    /// Canonical snake-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Effect::MaterialForm => "material_form",
+            Effect::Viscoelasticity => "viscoelasticity",
+            Effect::ZeroOffset => "zero_offset",
+            Effect::Compressibility => "compressibility",
+            Effect::Friction => "friction",
+            Effect::ModellingSpace => "modelling_space",
+            Effect::BoundaryCondition => "boundary_condition",
+            Effect::ToolCompliance => "tool_compliance",
+            Effect::Inclusion => "inclusion",
+        }
+    }
+}
+
+impl fmt::Display for Effect {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for Effect {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Effect::ALL
+            .iter()
+            .copied()
+            .find(|e| e.name() == s)
+            .ok_or_else(|| {
+                let names: Vec<_> = Effect::ALL.iter().map(|e| e.name()).collect();
+                format!("unknown effect `{s}`; expected one of {}", names.join(", "))
+            })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    #[test]
+    fn names_round_trip() {
+        for e in Effect::ALL {
+            assert_eq!(e.name().parse::<Effect>().unwrap(), e);
+            assert_eq!(serde_json_like(e), e.name());
+        }
+        assert!("viscosity".parse::<Effect>().is_err());
+    }
+    fn serde_json_like(e: Effect) -> String {
+        format!("{e}")
+    }
+}

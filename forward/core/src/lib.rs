@@ -1,0 +1,30 @@
+//! # palpate-core
+//!
+//! The vocabulary every palpate crate shares, and nothing more:
+//!
+//! * [`ForwardModel`] — a shared, immutable description of an experiment's
+//!   model; [`Evaluator`] — the per-thread object that owns scratch space and
+//!   history and turns parameters plus a [`Loading`] into predictions.
+//! * [`ParamSpace`] — named physical parameters with bounds and the transform
+//!   to the unbounded space that estimators and samplers move in.
+//! * [`Loading`] — the loading history (time and drive samples).
+//! * [`Effect`] — the canonical names of unmodelled effects (see `GAP.md`).
+//! * [`data`] — reading the project's CSV data files with errors naming file,
+//!   line and column.
+//!
+//! Estimators (`palpate-inverse`, `palpate-uq`) depend on this crate only, so
+//! a wrong dependency arrow to the FE code fails to compile.
+
+pub mod data;
+pub mod effect;
+pub mod error;
+pub mod loading;
+pub mod model;
+pub mod param;
+
+pub use data::{Column, DataError, Table};
+pub use effect::Effect;
+pub use error::ForwardError;
+pub use loading::{Drive, Loading, Observable};
+pub use model::{Evaluator, ForwardModel, ModelExt};
+pub use param::{ParamSpace, ParamSpec, Transform};

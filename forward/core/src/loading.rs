@@ -1,0 +1,119 @@
+//! Loading histories: what drives an experiment and what it observes.
+
+use serde::{Deserialize, Serialize};
+
+/// What the drive samples are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Drive {
+    /// Rigid-tool displacement in mm, positive into the body.
+    DisplacementMm,
+    /// Principal stretch of a homogeneous test (dimensionless).
+    Stretch,
+    /// Tool position along a path in mm (rolling), at a fixed depth.
+    PositionMm,
+}
+
+/// What a model predicts at each sample.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Observable {
+    /// Reaction force on the tool in N, positive in compression.
+    ForceN,
+    /// Nominal (first Piola-Kirchhoff) stress in MPa, positive in tension.
+    NominalStressMPa,
+}
+
+impl Observable {
+    /// Column name used in data files and reports.
+    pub fn column(self) -> &'static str {
+        match self {
+            Observable::ForceN => "force_N",
+            Observable::NominalStressMPa => "stress_MPa",
+        }
+    }
+}
+
+impl Drive {
+    /// Column name used in data files and reports.
+    pub fn column(self) -> &'static str {
+        match self {
+            Drive::DisplacementMm => "displacement_mm",
+            Drive::Stretch => "stretch",
+            Drive::PositionMm => "position_mm",
+        }
+    }
+}
+
+/// A loading history: drive samples and, when the response is rate
+/// dependent, the time of each sample (s, non-decreasing).
+///
+/// Models treat the history as piecewise linear between samples.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Loading {
+    pub drive_kind: Drive,
+    pub drive: Vec<f64>,
+    pub time: Option<Vec<f64>>,
+}
+
+impl Loading {
+    /// A rate-independent history of drive samples.
+    pub fn quasi_static(drive_kind: Drive, drive: Vec<f64>) -> Self {
+        Loading {
+            drive_kind,
+            drive,
+            time: None,
+        }
+    }
+
+    /// A timed history; `time` and `drive` must have the same length.
+    pub fn timed(drive_kind: Drive, time: Vec<f64>, drive: Vec<f64>) -> Self {
+        Loading {
+            drive_kind,
+            drive,
+            time: Some(time),
+        }
+    }
+
+    /// Number of samples.
+    pub fn len(&self) -> usize {
+        self.drive.len()
+    }
+
+    /// True when there are no samples.
+    pub fn is_empty(&self) -> bool {
+        self.drive.is_empty()
+    }
+
+    /// Same history with the drive replaced (e.g. shifted by a zero offset).
+    pub fn with_drive(&self, drive: Vec<f64>) -> Self {
+        Loading {
+            drive_kind: self.drive_kind,
+            drive,
+            time: self.time.clone(),
+        }
+    }
+
+    /// Checks lengths, finiteness and monotone time; returns a message naming
+    /// the first bad sample.
+    pub fn validate(&self) -> Result<(), String> {
+        if let Some(t) = &self.time {
+            if t.len() != self.drive.len() {
+                return Err(format!(
+                    "time has {} samples but drive has {}",
+                    t.len(),
+                    self.drive.len()
+                ));
+            }
+            for i in 1..t.len() {
+                if !(t[i] >= t[i - 1]) {
+                    return Err(format!("time decreases at sample {i}: {} -> {}", t[i - 1], t[i]));
+                }
+            }
+        }
+        if let Some(i) = self.drive.iter().position(|d| !d.is_finite()) {
+            return Err(format!("drive sample {i} is not finite"));
+        }
+        Ok(())
+    }
+}

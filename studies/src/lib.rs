@@ -1,0 +1,1 @@
+//! palpate studies: manifests, runner, reports, plots.
