@@ -1,1 +1,9 @@
-//! palpate studies: manifests, runner, reports, plots.
+//! # palpate-studies
+//!
+//! Everything a user touches: study manifests and their runner, reports,
+//! SVG plots, VTK output wiring, and the `palpate` command-line tool (one
+//! module per subcommand under [`cli`]).
+
+pub mod cli;
+pub mod output;
+pub mod plot;

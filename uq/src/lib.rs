@@ -1,1 +1,5 @@
-//! (under construction)
+//! # palpate-uq
+//!
+//! Uncertainty quantification on any forward model (through palpate-core's
+//! trait only): MCMC posteriors and their diagnostics, designed experiments
+//! and ANOVA, and the sim-to-real gap diagnosis.

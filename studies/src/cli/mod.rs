@@ -1,0 +1,57 @@
+//! The `palpate` command line: one module per subcommand, each with its own
+//! clap `Args` and a `run` function.
+
+use clap::{Parser, Subcommand};
+
+pub mod anova;
+pub mod calibrate;
+pub mod diagnose;
+pub mod doe;
+pub mod run;
+pub mod sample;
+pub mod simulate;
+
+/// palpate: calibrate soft-tissue material laws from force curves, quantify
+/// their uncertainty and diagnose the gap between simulation and measurement.
+///
+/// Units throughout: mm, N, MPa, s. Data files are CSV with a header naming
+/// each column with its unit (time_s, displacement_mm, force_N, stretch,
+/// stress_MPa); lines starting with # are comments.
+#[derive(Debug, Parser)]
+#[command(name = "palpate", version, about, long_about)]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+/// The subcommands.
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Fit a hyperelastic law to homogeneous-test data or to a C1 force record.
+    Calibrate(calibrate::Args),
+    /// Run a finite-element forward model (N1 needle, C1 compression) and write its force curve.
+    Simulate(simulate::Args),
+    /// Sample the Bayesian posterior of a model's parameters by MCMC, with diagnostics.
+    Sample(sample::Args),
+    /// ANOVA of a table with one row per run (factor columns hold level names).
+    Anova(anova::Args),
+    /// Generate and run a designed experiment (factorial design) from a manifest.
+    Doe(doe::Args),
+    /// Diagnose the sim-to-real gap: where the misfit lies, which effect causes it, how far it shrinks.
+    Diagnose(diagnose::Args),
+    /// Run a whole study described by one TOML manifest into a run folder.
+    Run(run::Args),
+}
+
+/// Runs the parsed command line.
+pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
+    match cli.command {
+        Command::Calibrate(a) => calibrate::run(a),
+        Command::Simulate(a) => simulate::run(a),
+        Command::Sample(a) => sample::run(a),
+        Command::Anova(a) => anova::run(a),
+        Command::Doe(a) => doe::run(a),
+        Command::Diagnose(a) => diagnose::run(a),
+        Command::Run(a) => run::run(a),
+    }
+}

@@ -1,0 +1,407 @@
+//! Minimal SVG plotting: line/marker/bar series on linear axes, shaded bands
+//! and highlighted x-windows, composed into grids (corner plots).
+//!
+//! Written here rather than with `plotters`: plotters' text layout pulls in a
+//! font backend (font-kit/freetype or ab_glyph with a bundled font) for what
+//! are plain `<text>` elements in SVG; the few hundred lines below give
+//! deterministic, byte-identical SVG with no system dependency.
+
+use std::fmt::Write;
+
+/// How a series is drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Style {
+    Line,
+    Dashed,
+    Markers,
+    /// Vertical bars from y = 0 at each x (width in x units).
+    Bars(f64),
+    /// Horizontal bars from x = 0 at each y (height in y units).
+    HBars(f64),
+}
+
+/// One named data series.
+#[derive(Debug, Clone)]
+pub struct Series {
+    pub label: String,
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub style: Style,
+    /// CSS colour; `None` takes the next colour of the palette.
+    pub color: Option<String>,
+}
+
+impl Series {
+    /// A solid line.
+    pub fn line(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
+        Series { label: label.into(), x: x.to_vec(), y: y.to_vec(), style: Style::Line, color: None }
+    }
+    /// Markers only (measured data).
+    pub fn markers(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
+        Series { label: label.into(), x: x.to_vec(), y: y.to_vec(), style: Style::Markers, color: None }
+    }
+    /// A dashed line.
+    pub fn dashed(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
+        Series { label: label.into(), x: x.to_vec(), y: y.to_vec(), style: Style::Dashed, color: None }
+    }
+    /// Sets the colour.
+    pub fn color(mut self, c: impl Into<String>) -> Self {
+        self.color = Some(c.into());
+        self
+    }
+    /// Sets the style.
+    pub fn style(mut self, s: Style) -> Self {
+        self.style = s;
+        self
+    }
+}
+
+/// A shaded band between `lower` and `upper` over `x` (e.g. a predictive band).
+#[derive(Debug, Clone)]
+pub struct Band {
+    pub label: String,
+    pub x: Vec<f64>,
+    pub lower: Vec<f64>,
+    pub upper: Vec<f64>,
+    pub color: String,
+}
+
+/// A single set of axes.
+#[derive(Debug, Clone, Default)]
+pub struct Plot {
+    pub title: String,
+    pub x_label: String,
+    pub y_label: String,
+    pub series: Vec<Series>,
+    pub bands: Vec<Band>,
+    /// Highlighted x-intervals (e.g. flagged misfit windows), drawn shaded.
+    pub windows: Vec<(f64, f64)>,
+    /// Horizontal reference lines (y values), drawn dotted.
+    pub hlines: Vec<f64>,
+    /// Tick labels for the y axis instead of numbers (for bar charts of named terms).
+    pub y_categories: Option<Vec<String>>,
+    /// Tick labels for the x axis instead of numbers (for level names).
+    pub x_categories: Option<Vec<String>>,
+    pub width: f64,
+    pub height: f64,
+}
+
+const PALETTE: [&str; 8] = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"];
+
+impl Plot {
+    /// Empty axes with a title and axis labels, 640 x 420 px.
+    pub fn new(title: impl Into<String>, x_label: impl Into<String>, y_label: impl Into<String>) -> Self {
+        Plot {
+            title: title.into(),
+            x_label: x_label.into(),
+            y_label: y_label.into(),
+            width: 640.0,
+            height: 420.0,
+            ..Default::default()
+        }
+    }
+
+    /// Adds a series.
+    pub fn with(mut self, s: Series) -> Self {
+        self.series.push(s);
+        self
+    }
+
+    /// Adds a series in place.
+    pub fn push(&mut self, s: Series) {
+        self.series.push(s);
+    }
+
+    /// The complete SVG document.
+    pub fn to_svg(&self) -> String {
+        let mut out = String::new();
+        let _ = writeln!(
+            out,
+            r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="Helvetica,Arial,sans-serif">"#,
+            w = fmt(self.width),
+            h = fmt(self.height)
+        );
+        let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
+        self.draw(&mut out, 0.0, 0.0);
+        out.push_str("</svg>\n");
+        out
+    }
+
+    /// Data range over series, bands and windows, padded, with zero included for bars.
+    fn ranges(&self) -> ((f64, f64), (f64, f64)) {
+        let mut xs = Vec::new();
+        let mut ys = Vec::new();
+        for s in &self.series {
+            for (&x, &y) in s.x.iter().zip(&s.y) {
+                if x.is_finite() && y.is_finite() {
+                    xs.push(x);
+                    ys.push(y);
+                }
+            }
+            match s.style {
+                Style::Bars(_) => ys.push(0.0),
+                Style::HBars(_) => xs.push(0.0),
+                _ => {}
+            }
+        }
+        for b in &self.bands {
+            xs.extend(b.x.iter().copied().filter(|v| v.is_finite()));
+            ys.extend(b.lower.iter().chain(&b.upper).copied().filter(|v| v.is_finite()));
+        }
+        ys.extend(self.hlines.iter().copied());
+        let span = |v: &[f64]| {
+            let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            if !lo.is_finite() {
+                (0.0, 1.0)
+            } else if hi - lo <= 1e-300 {
+                (lo - 0.5 * lo.abs().max(1.0), hi + 0.5 * hi.abs().max(1.0))
+            } else {
+                (lo, hi)
+            }
+        };
+        let (x0, x1) = span(&xs);
+        let (y0, y1) = span(&ys);
+        let py = 0.05 * (y1 - y0);
+        let px = if self.series.iter().any(|s| matches!(s.style, Style::Bars(_) | Style::HBars(_))) {
+            0.05 * (x1 - x0)
+        } else {
+            0.0
+        };
+        ((x0 - px, x1 + px), (y0 - py, y1 + py))
+    }
+
+    /// Draws the axes with their top-left corner at (ox, oy).
+    pub fn draw(&self, out: &mut String, ox: f64, oy: f64) {
+        let (ml, mr, mt, mb) = (if self.y_categories.is_some() { 130.0 } else { 70.0 }, 20.0, 34.0, 50.0);
+        let (pw, ph) = (self.width - ml - mr, self.height - mt - mb);
+        let ((x0, x1), (y0, y1)) = self.ranges();
+        let sx = |x: f64| ox + ml + (x - x0) / (x1 - x0) * pw;
+        let sy = |y: f64| oy + mt + ph - (y - y0) / (y1 - y0) * ph;
+        let _ = writeln!(
+            out,
+            r#"<text x="{}" y="{}" font-size="14" text-anchor="middle">{}</text>"#,
+            fmt(ox + ml + pw / 2.0),
+            fmt(oy + 20.0),
+            esc(&self.title)
+        );
+        for &(a, b) in &self.windows {
+            let (a, b) = (a.max(x0), b.min(x1));
+            if b > a {
+                let _ = writeln!(
+                    out,
+                    r##"<rect x="{}" y="{}" width="{}" height="{}" fill="#ffcc00" fill-opacity="0.25"/>"##,
+                    fmt(sx(a)),
+                    fmt(oy + mt),
+                    fmt(sx(b) - sx(a)),
+                    fmt(ph)
+                );
+            }
+        }
+        // Grid and ticks.
+        let xticks = match &self.x_categories {
+            Some(c) => (0..c.len()).map(|i| (i as f64, c[i].clone())).collect(),
+            None => ticks(x0, x1).into_iter().map(|t| (t, tick_label(t))).collect::<Vec<_>>(),
+        };
+        let yticks = match &self.y_categories {
+            Some(c) => (0..c.len()).map(|i| (i as f64, c[i].clone())).collect(),
+            None => ticks(y0, y1).into_iter().map(|t| (t, tick_label(t))).collect::<Vec<_>>(),
+        };
+        for (t, l) in &xticks {
+            let x = sx(*t);
+            let _ = writeln!(out, r##"<line x1="{x}" y1="{}" x2="{x}" y2="{}" stroke="#e0e0e0"/>"##, fmt(oy + mt), fmt(oy + mt + ph), x = fmt(x));
+            let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="11" text-anchor="middle">{}</text>"#, fmt(x), fmt(oy + mt + ph + 16.0), esc(l));
+        }
+        for (t, l) in &yticks {
+            let y = sy(*t);
+            let _ = writeln!(out, r##"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="#e0e0e0"/>"##, fmt(ox + ml), fmt(ox + ml + pw), y = fmt(y));
+            let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="11" text-anchor="end">{}</text>"#, fmt(ox + ml - 5.0), fmt(y + 4.0), esc(l));
+        }
+        let _ = writeln!(
+            out,
+            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="none" stroke="black"/>"#,
+            fmt(ox + ml),
+            fmt(oy + mt),
+            fmt(pw),
+            fmt(ph)
+        );
+        let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="12" text-anchor="middle">{}</text>"#, fmt(ox + ml + pw / 2.0), fmt(oy + self.height - 10.0), esc(&self.x_label));
+        let (lx, ly) = (ox + 14.0, oy + mt + ph / 2.0);
+        let _ = writeln!(
+            out,
+            r#"<text x="{}" y="{}" font-size="12" text-anchor="middle" transform="rotate(-90 {} {})">{}</text>"#,
+            fmt(lx),
+            fmt(ly),
+            fmt(lx),
+            fmt(ly),
+            esc(&self.y_label)
+        );
+        for &h in &self.hlines {
+            let _ = writeln!(out, r##"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="#555" stroke-dasharray="2,3"/>"##, fmt(ox + ml), fmt(ox + ml + pw), y = fmt(sy(h)));
+        }
+        for b in &self.bands {
+            let mut pts = String::new();
+            for (x, y) in b.x.iter().zip(&b.upper).chain(b.x.iter().zip(&b.lower).rev()) {
+                let _ = write!(pts, "{},{} ", fmt(sx(*x)), fmt(sy(*y)));
+            }
+            let _ = writeln!(out, r#"<polygon points="{}" fill="{}" fill-opacity="0.25" stroke="none"/>"#, pts.trim_end(), b.color);
+        }
+        let mut legend = Vec::new();
+        for (k, s) in self.series.iter().enumerate() {
+            let c = s.color.clone().unwrap_or_else(|| PALETTE[k % PALETTE.len()].to_string());
+            match s.style {
+                Style::Line | Style::Dashed => {
+                    let mut d = String::new();
+                    let mut pen = false;
+                    for (x, y) in s.x.iter().zip(&s.y) {
+                        if x.is_finite() && y.is_finite() {
+                            let _ = write!(d, "{}{},{} ", if pen { "L" } else { "M" }, fmt(sx(*x)), fmt(sy(*y)));
+                            pen = true;
+                        } else {
+                            pen = false;
+                        }
+                    }
+                    let dash = if s.style == Style::Dashed { r#" stroke-dasharray="6,4""# } else { "" };
+                    let _ = writeln!(out, r#"<path d="{}" fill="none" stroke="{c}" stroke-width="1.8"{dash}/>"#, d.trim_end());
+                }
+                Style::Markers => {
+                    for (x, y) in s.x.iter().zip(&s.y) {
+                        if x.is_finite() && y.is_finite() {
+                            let _ = writeln!(out, r#"<circle cx="{}" cy="{}" r="2.6" fill="none" stroke="{c}"/>"#, fmt(sx(*x)), fmt(sy(*y)));
+                        }
+                    }
+                }
+                Style::Bars(w) => {
+                    for (x, y) in s.x.iter().zip(&s.y) {
+                        let (a, b) = (sx(x - w / 2.0), sx(x + w / 2.0));
+                        let (top, bot) = (sy(y.max(0.0)), sy(y.min(0.0)));
+                        let _ = writeln!(out, r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{c}"/>"#, fmt(a), fmt(top), fmt(b - a), fmt(bot - top));
+                    }
+                }
+                Style::HBars(hgt) => {
+                    for (x, y) in s.x.iter().zip(&s.y) {
+                        let (l, r) = (sx(x.min(0.0)), sx(x.max(0.0)));
+                        let (top, bot) = (sy(y + hgt / 2.0), sy(y - hgt / 2.0));
+                        let _ = writeln!(out, r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{c}"/>"#, fmt(l), fmt(top), fmt(r - l), fmt(bot - top));
+                    }
+                }
+            }
+            if !s.label.is_empty() {
+                legend.push((s.label.clone(), c, s.style));
+            }
+        }
+        for b in &self.bands {
+            if !b.label.is_empty() {
+                legend.push((b.label.clone(), b.color.clone(), Style::Bars(0.0)));
+            }
+        }
+        for (i, (label, c, style)) in legend.iter().enumerate() {
+            let y = oy + mt + 14.0 + 16.0 * i as f64;
+            let x = ox + ml + 10.0;
+            match style {
+                Style::Markers => {
+                    let _ = writeln!(out, r#"<circle cx="{}" cy="{}" r="3" fill="none" stroke="{c}"/>"#, fmt(x + 9.0), fmt(y - 4.0));
+                }
+                Style::Line | Style::Dashed => {
+                    let _ = writeln!(out, r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{c}" stroke-width="2"/>"#, fmt(x), fmt(y - 4.0), fmt(x + 18.0), fmt(y - 4.0));
+                }
+                _ => {
+                    let _ = writeln!(out, r#"<rect x="{}" y="{}" width="18" height="8" fill="{c}" fill-opacity="0.6"/>"#, fmt(x), fmt(y - 8.0));
+                }
+            }
+            let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="11">{}</text>"#, fmt(x + 24.0), fmt(y), esc(label));
+        }
+    }
+}
+
+/// Several plots in a grid of `cols` columns (e.g. a corner plot); `None`
+/// leaves a cell empty.
+pub fn grid_svg(cells: &[Option<Plot>], cols: usize, title: &str) -> String {
+    let cols = cols.max(1);
+    let rows = cells.len().div_ceil(cols);
+    let cw = cells.iter().flatten().map(|p| p.width).fold(0.0, f64::max);
+    let ch = cells.iter().flatten().map(|p| p.height).fold(0.0, f64::max);
+    let (w, h) = (cw * cols as f64, ch * rows as f64 + 30.0);
+    let mut out = String::new();
+    let _ = writeln!(
+        out,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="{w}" height="{h}" viewBox="0 0 {w} {h}" font-family="Helvetica,Arial,sans-serif">"#,
+        w = fmt(w),
+        h = fmt(h)
+    );
+    let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
+    let _ = writeln!(out, r#"<text x="{}" y="20" font-size="15" text-anchor="middle">{}</text>"#, fmt(w / 2.0), esc(title));
+    for (i, cell) in cells.iter().enumerate() {
+        if let Some(p) = cell {
+            p.draw(&mut out, (i % cols) as f64 * cw, 30.0 + (i / cols) as f64 * ch);
+        }
+    }
+    out.push_str("</svg>\n");
+    out
+}
+
+/// "Nice" tick positions (1, 2, 5 x 10^k steps) covering [lo, hi].
+pub fn ticks(lo: f64, hi: f64) -> Vec<f64> {
+    let span = hi - lo;
+    if !(span > 0.0) || !span.is_finite() {
+        return vec![lo];
+    }
+    let raw = span / 6.0;
+    let mag = 10f64.powf(raw.log10().floor());
+    let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| span / s <= 7.0).unwrap_or(10.0 * mag);
+    let first = (lo / step).ceil() as i64;
+    let last = (hi / step).floor() as i64;
+    (first..=last).map(|k| k as f64 * step).collect()
+}
+
+fn tick_label(t: f64) -> String {
+    if t == 0.0 {
+        return "0".into();
+    }
+    let a = t.abs();
+    if !(1e-3..1e5).contains(&a) {
+        format!("{t:.1e}")
+    } else {
+        let s = format!("{t:.4}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    }
+}
+
+/// Coordinates with two decimals: enough for the screen, stable across runs.
+fn fmt(v: f64) -> String {
+    if v.is_finite() {
+        let s = format!("{v:.2}");
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        "0".into()
+    }
+}
+
+fn esc(s: &str) -> String {
+    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ticks_are_nice_and_cover_range() {
+        assert_eq!(ticks(0.0, 10.0), vec![0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
+        let t = ticks(0.013, 0.087);
+        assert!(t.len() >= 3 && t[0] >= 0.013 && *t.last().unwrap() <= 0.087, "{t:?}");
+    }
+
+    #[test]
+    fn svg_is_deterministic_and_well_formed() {
+        let x: Vec<f64> = (0..20).map(|i| i as f64 * 0.1).collect();
+        let y: Vec<f64> = x.iter().map(|v| v * v).collect();
+        let mut p = Plot::new("t < 1", "x", "y").with(Series::markers("data", &x, &y)).with(Series::line("fit", &x, &y));
+        p.windows.push((0.5, 1.0));
+        let a = p.to_svg();
+        assert_eq!(a, p.to_svg());
+        assert!(a.starts_with("<svg") && a.trim_end().ends_with("</svg>"));
+        assert!(a.contains("t &lt; 1"));
+        assert_eq!(a.matches("<circle").count(), 20 + 1);
+    }
+}
