@@ -1,0 +1,337 @@
+//! The catalogue of hyperelastic laws: naming, parameters, checks and dispatch.
+
+use std::fmt;
+use std::str::FromStr;
+
+use nalgebra::Matrix3;
+use serde::{Deserialize, Serialize};
+
+use crate::invariants::invariants;
+use crate::{
+    arruda_boyce, kinematics, mooney_rivlin, neo_hookean, ogden, reduced_polynomial, MaterialError,
+    PrincipalDerivs, StressTangent, Volumetric,
+};
+
+/// Highest order of the reduced polynomial law.
+pub const MAX_POLYNOMIAL_ORDER: usize = 6;
+
+/// An isotropic hyperelastic law with an isochoric energy `W` (Abaqus conventions, see each module).
+///
+/// Parameters are a plain slice in the order of [`Law::params`]:
+/// * `NeoHookean`: `[C10]`
+/// * `MooneyRivlin`: `[C10, C01]`
+/// * `ReducedPolynomial(N)`: `[C10, C20, .., CN0]` (Yeoh is `N = 3`)
+/// * `ArrudaBoyce`: `[mu, lambda_m]`
+/// * `Ogden(N)`: `[mu1, alpha1, .., muN, alphaN]`
+///
+/// The evaluation functions ([`Law::isochoric_energy`], [`Law::stress_tangent`], ...) assume the
+/// parameters passed [`Law::check`]; they never panic, a wrong count gives NaN.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Law {
+    /// `W = C10 (I1b - 3)`.
+    NeoHookean,
+    /// `W = C10 (I1b - 3) + C01 (I2b - 3)`.
+    MooneyRivlin,
+    /// `W = sum_{i=1..N} Ci0 (I1b - 3)^i`, `N = 1..=6`.
+    ReducedPolynomial(usize),
+    /// 5-term Arruda-Boyce series.
+    ArrudaBoyce,
+    /// `W = sum_{i=1..N} 2 mu_i / alpha_i^2 (l1^a_i + l2^a_i + l3^a_i - 3)`, `N >= 1`.
+    Ogden(usize),
+}
+
+/// One material parameter with its unit, search bounds and a starting value for soft silicone/tissue.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MaterialParam {
+    /// Name in the commercial convention (`C10`, `C01`, `C20`, `mu`, `lambda_m`, `mu1`, `alpha1`, ...).
+    pub name: String,
+    /// `"MPa"` or `"1"`.
+    pub unit: &'static str,
+    /// Lower bound (may be `-inf`).
+    pub lower: f64,
+    /// Upper bound (may be `+inf`).
+    pub upper: f64,
+    /// Starting value inside the bounds.
+    pub initial: f64,
+}
+
+impl MaterialParam {
+    fn new(
+        name: impl Into<String>,
+        unit: &'static str,
+        lower: f64,
+        upper: f64,
+        initial: f64,
+    ) -> Self {
+        MaterialParam {
+            name: name.into(),
+            unit,
+            lower,
+            upper,
+            initial,
+        }
+    }
+}
+
+/// Starting exponents of the Ogden terms: alternating signs of growing magnitude, so that the terms differ.
+const OGDEN_INITIAL_ALPHA: [f64; 6] = [2.0, -2.0, 4.0, -4.0, 6.0, -6.0];
+
+fn par(p: &[f64], i: usize) -> f64 {
+    p.get(i).copied().unwrap_or(f64::NAN)
+}
+
+fn positive(name: &str, value: f64, requirement: &str) -> Result<(), MaterialError> {
+    if value > 0.0 {
+        Ok(())
+    } else {
+        Err(MaterialError::OutOfRange {
+            name: name.into(),
+            value,
+            requirement: requirement.into(),
+        })
+    }
+}
+
+impl Law {
+    /// The parameters, in the order the evaluation functions expect them.
+    ///
+    /// Moduli that must be positive have lower bound 0; higher-order polynomial coefficients and
+    /// `C01` may be negative; `lambda_m` in (1, 100); Ogden `alpha_i` in (-20, 20), `mu_i` of either sign.
+    pub fn params(&self) -> Vec<MaterialParam> {
+        let inf = f64::INFINITY;
+        match *self {
+            Law::NeoHookean => vec![MaterialParam::new("C10", "MPa", 0.0, inf, 1e-3)],
+            Law::MooneyRivlin => vec![
+                MaterialParam::new("C10", "MPa", 0.0, inf, 1e-3),
+                MaterialParam::new("C01", "MPa", -inf, inf, 1e-4),
+            ],
+            Law::ReducedPolynomial(n) => (1..=n)
+                .map(|i| {
+                    if i == 1 {
+                        MaterialParam::new("C10", "MPa", 0.0, inf, 1e-3)
+                    } else {
+                        MaterialParam::new(format!("C{i}0"), "MPa", -inf, inf, 0.0)
+                    }
+                })
+                .collect(),
+            Law::ArrudaBoyce => vec![
+                MaterialParam::new("mu", "MPa", 0.0, inf, 2e-3),
+                MaterialParam::new("lambda_m", "1", 1.0, 100.0, 3.0),
+            ],
+            Law::Ogden(n) => (1..=n)
+                .flat_map(|i| {
+                    let alpha = OGDEN_INITIAL_ALPHA
+                        .get(i - 1)
+                        .copied()
+                        .unwrap_or(2.0 + i as f64);
+                    [
+                        MaterialParam::new(format!("mu{i}"), "MPa", -inf, inf, 2e-3 / n as f64),
+                        MaterialParam::new(format!("alpha{i}"), "1", -20.0, 20.0, alpha),
+                    ]
+                })
+                .collect(),
+        }
+    }
+
+    /// Number of parameters.
+    pub fn param_count(&self) -> usize {
+        match *self {
+            Law::NeoHookean => 1,
+            Law::MooneyRivlin => 2,
+            Law::ReducedPolynomial(n) => n,
+            Law::ArrudaBoyce => 2,
+            Law::Ogden(n) => 2 * n,
+        }
+    }
+
+    /// Checks the law's order, the parameter count, finiteness and the sign rules, naming the culprit.
+    ///
+    /// Rules: neo-Hookean `C10 > 0`; Mooney-Rivlin `C10 + C01 > 0` (initial shear modulus);
+    /// reduced polynomial `C10 > 0` (higher terms any sign); Arruda-Boyce `mu > 0`, `lambda_m > 1`;
+    /// Ogden `alpha_i != 0` and `mu0 = sum mu_i > 0`.
+    ///
+    /// Ogden note: the classical rule `mu_i alpha_i > 0` belongs to Ogden's own convention
+    /// `W = sum mu_i / alpha_i (...)`. In the Abaqus convention used here (`2 mu_i / alpha_i^2`) each
+    /// term is non-negative exactly when `mu_i > 0` (AM-GM: `sum l_a^alpha >= 3` when `l1 l2 l3 = 1`),
+    /// so Ogden's 1972 Treloar fit becomes `mu_3 > 0, alpha_3 = -2`, which `mu_i alpha_i > 0` would
+    /// wrongly reject. Single negative `mu_i` are allowed (common in fits); use
+    /// [`crate::stability::drucker`] to see where such a fit stays stable.
+    pub fn check(&self, p: &[f64]) -> Result<(), MaterialError> {
+        match *self {
+            Law::ReducedPolynomial(n) if !(1..=MAX_POLYNOMIAL_ORDER).contains(&n) => {
+                return Err(MaterialError::BadOrder {
+                    law: "reduced-polynomial".into(),
+                    order: n,
+                    allowed: format!("1..={MAX_POLYNOMIAL_ORDER}"),
+                })
+            }
+            Law::Ogden(0) => {
+                return Err(MaterialError::BadOrder {
+                    law: "ogden".into(),
+                    order: 0,
+                    allowed: ">= 1".into(),
+                })
+            }
+            _ => {}
+        }
+        if p.len() != self.param_count() {
+            return Err(MaterialError::WrongCount {
+                law: self.to_string(),
+                expected: self.param_count(),
+                got: p.len(),
+            });
+        }
+        for (spec, &value) in self.params().iter().zip(p) {
+            if !value.is_finite() {
+                return Err(MaterialError::NotFinite {
+                    name: spec.name.clone(),
+                    value,
+                });
+            }
+        }
+        match *self {
+            Law::NeoHookean | Law::ReducedPolynomial(_) => positive("C10", p[0], "must be > 0"),
+            Law::MooneyRivlin => positive(
+                "C10 + C01",
+                p[0] + p[1],
+                "must be > 0 (initial shear modulus 2 (C10 + C01))",
+            ),
+            Law::ArrudaBoyce => {
+                positive("mu", p[0], "must be > 0")?;
+                positive("lambda_m", p[1] - 1.0, "must be > 1").map_err(|_| {
+                    MaterialError::OutOfRange {
+                        name: "lambda_m".into(),
+                        value: p[1],
+                        requirement: "must be > 1".into(),
+                    }
+                })
+            }
+            Law::Ogden(n) => {
+                for i in 0..n {
+                    if p[2 * i + 1] == 0.0 {
+                        return Err(MaterialError::OutOfRange {
+                            name: format!("alpha{}", i + 1),
+                            value: 0.0,
+                            requirement: "must be != 0".into(),
+                        });
+                    }
+                }
+                let mu0: f64 = p.iter().step_by(2).sum();
+                positive(
+                    &(1..=n)
+                        .map(|i| format!("mu{i}"))
+                        .collect::<Vec<_>>()
+                        .join(" + "),
+                    mu0,
+                    "must be > 0 (initial shear modulus)",
+                )
+            }
+        }
+    }
+
+    /// Initial shear modulus `mu0` (NH: `2 C10`; MR: `2 (C10 + C01)`; RP: `2 C10`; Ogden: `sum mu_i`;
+    /// AB: `mu (1 + 3/(5 lm^2) + 99/(175 lm^4) + 513/(875 lm^6) + 42039/(67375 lm^8))`, which is the
+    /// exact `2 dW/dI1` at rest of the 5-term series and tends to `mu` for large `lambda_m`).
+    pub fn shear_modulus(&self, p: &[f64]) -> f64 {
+        match *self {
+            Law::NeoHookean | Law::ReducedPolynomial(_) => 2.0 * par(p, 0),
+            Law::MooneyRivlin => 2.0 * (par(p, 0) + par(p, 1)),
+            Law::ArrudaBoyce => arruda_boyce::initial_shear_modulus(par(p, 0), par(p, 1)),
+            Law::Ogden(n) => {
+                if p.len() == 2 * n {
+                    p.iter().step_by(2).sum()
+                } else {
+                    f64::NAN
+                }
+            }
+        }
+    }
+
+    /// `W(l1, l2, l3)`, the isochoric energy at principal stretches `lam` (used as given, no projection).
+    pub fn isochoric_energy(&self, p: &[f64], lam: [f64; 3]) -> f64 {
+        self.isochoric_principal(p, lam).w
+    }
+
+    /// `W`, `dW/dl_a` and `d2W/dl_a dl_b` with the stretches `lam` treated as independent.
+    pub fn isochoric_principal(&self, p: &[f64], lam: [f64; 3]) -> PrincipalDerivs {
+        if p.len() != self.param_count() {
+            return PrincipalDerivs::nan();
+        }
+        let (i1, i2) = invariants(lam);
+        let inv = match *self {
+            Law::NeoHookean => neo_hookean::invariant_derivs(p[0], i1),
+            Law::MooneyRivlin => mooney_rivlin::invariant_derivs(p[0], p[1], i1, i2),
+            Law::ReducedPolynomial(_) => reduced_polynomial::invariant_derivs(p, i1),
+            Law::ArrudaBoyce => arruda_boyce::invariant_derivs(p[0], p[1], i1),
+            Law::Ogden(_) => return ogden::principal_derivs(p, lam),
+        };
+        inv.to_principal(lam)
+    }
+
+    /// Energy `Psi(F) = W(J^{-1/3} F) + U(J)`, first Piola stress `P = dPsi/dF` and tangent
+    /// `A = dP/dF` (9x9, index `i*3 + j` for `F_ij`), built from the principal derivatives by
+    /// [`kinematics::stress_tangent`]. NaN when `det F <= 0`.
+    pub fn stress_tangent(&self, p: &[f64], vol: Volumetric, f: &Matrix3<f64>) -> StressTangent {
+        kinematics::stress_tangent(|lam| self.isochoric_principal(p, lam), vol, f)
+    }
+}
+
+impl fmt::Display for Law {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Law::NeoHookean => write!(f, "neo-hookean"),
+            Law::MooneyRivlin => write!(f, "mooney-rivlin"),
+            Law::ReducedPolynomial(n) => write!(f, "reduced-polynomial:{n}"),
+            Law::ArrudaBoyce => write!(f, "arruda-boyce"),
+            Law::Ogden(n) => write!(f, "ogden:{n}"),
+        }
+    }
+}
+
+impl FromStr for Law {
+    type Err = MaterialError;
+
+    /// Parses `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N` (N = 1..=6), `yeoh`
+    /// (= `reduced-polynomial:3`), `arruda-boyce`, `ogden:N` (N >= 1); case and surrounding blanks ignored.
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let text = s.trim().to_ascii_lowercase();
+        let unknown = || MaterialError::UnknownLaw {
+            text: s.to_string(),
+        };
+        let (head, order) = match text.split_once(':') {
+            Some((head, n)) => (
+                head.trim(),
+                Some(n.trim().parse::<usize>().map_err(|_| unknown())?),
+            ),
+            None => (text.as_str(), None),
+        };
+        let law = match (head, order) {
+            ("neo-hookean", None) => Law::NeoHookean,
+            ("mooney-rivlin", None) => Law::MooneyRivlin,
+            ("yeoh", None) => Law::ReducedPolynomial(3),
+            ("arruda-boyce", None) => Law::ArrudaBoyce,
+            ("reduced-polynomial", Some(n)) => {
+                if !(1..=MAX_POLYNOMIAL_ORDER).contains(&n) {
+                    return Err(MaterialError::BadOrder {
+                        law: "reduced-polynomial".into(),
+                        order: n,
+                        allowed: format!("1..={MAX_POLYNOMIAL_ORDER}"),
+                    });
+                }
+                Law::ReducedPolynomial(n)
+            }
+            ("ogden", Some(n)) => {
+                if n == 0 {
+                    return Err(MaterialError::BadOrder {
+                        law: "ogden".into(),
+                        order: 0,
+                        allowed: ">= 1".into(),
+                    });
+                }
+                Law::Ogden(n)
+            }
+            _ => return Err(unknown()),
+        };
+        Ok(law)
+    }
+}
