@@ -1,0 +1,99 @@
+//! Enrichment `material_form`: a richer hyperelastic law that contains the
+//! base law as a special case.
+
+use palpate_core::{
+    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+};
+use palpate_material::Law;
+
+/// A richer law and how a base parameter vector maps into it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RicherLaw {
+    /// The richer law.
+    pub law: Law,
+    /// Values appended to the base law's parameters to give the richer law's
+    /// parameters that reproduce the base law exactly (e.g. C20 = 0).
+    pub embed_law_params: Vec<f64>,
+}
+
+/// The next richer law of the same family, whose parameters are the base
+/// law's followed by extra terms that vanish at the "off" point:
+///
+/// * neo-Hookean (C10) -> reduced polynomial N=2 (C10, C20), C20 = 0;
+/// * reduced polynomial N -> N+1 (N < 6), C(N+1)0 = 0;
+/// * Ogden N -> N+1: mu(N+1) = 0 (alpha(N+1) at its starting value).
+///
+/// Mooney-Rivlin and Arruda-Boyce have no nested richer law here (`None`).
+pub fn richer_law(law: &Law) -> Option<RicherLaw> {
+    let richer = match law {
+        Law::NeoHookean => Law::ReducedPolynomial(2),
+        Law::ReducedPolynomial(n) if *n < 6 => Law::ReducedPolynomial(n + 1),
+        Law::Ogden(n) => Law::Ogden(n + 1),
+        _ => return None,
+    };
+    let base_len = law.params().len();
+    let extra = richer.params();
+    if extra.len() <= base_len {
+        return None;
+    }
+    let embed_law_params = extra[base_len..]
+        .iter()
+        .enumerate()
+        // The first extra parameter is the new modulus (C(N+1)0 or mu(N+1)): zero.
+        .map(|(i, p)| if i == 0 { 0.0 } else { p.initial })
+        .collect();
+    Some(RicherLaw {
+        law: richer,
+        embed_law_params,
+    })
+}
+
+/// A model with a richer law, which knows the "off" point that reproduces
+/// the base law: [`ForwardModel::embed`] appends the vanishing terms. Every
+/// other method delegates to the wrapped model.
+pub struct MaterialForm {
+    inner: Box<dyn ForwardModel>,
+    off_tail: Vec<f64>,
+    base_law: String,
+}
+
+impl MaterialForm {
+    /// `inner` uses the richer law; `off_tail` completes a base parameter
+    /// vector to the richer law's "off" point; `base_law` names the base law.
+    pub fn new(inner: Box<dyn ForwardModel>, off_tail: Vec<f64>, base_law: String) -> Self {
+        MaterialForm {
+            inner,
+            off_tail,
+            base_law,
+        }
+    }
+}
+
+impl ForwardModel for MaterialForm {
+    fn name(&self) -> String {
+        format!("{} (richer than {})", self.inner.name(), self.base_law)
+    }
+    fn space(&self) -> &ParamSpace {
+        self.inner.space()
+    }
+    fn observable(&self) -> Observable {
+        self.inner.observable()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        self.inner.evaluator()
+    }
+    fn effects(&self) -> Vec<Effect> {
+        self.inner.effects()
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        self.inner.enrich(effect)
+    }
+    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
+        let mut v = base_theta.to_vec();
+        v.extend_from_slice(&self.off_tail);
+        v
+    }
+    fn predict(&self, theta: &[f64], loading: &Loading) -> Result<Vec<f64>, ForwardError> {
+        self.inner.predict(theta, loading)
+    }
+}

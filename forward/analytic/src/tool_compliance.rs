@@ -1,0 +1,142 @@
+//! Enrichment `tool_compliance`: a series spring between the recorded
+//! displacement and the tool.
+
+use crate::convert::split;
+use crate::wrap::{enrich_wrapper, wrapper_effects};
+use palpate_core::{
+    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+};
+use std::sync::Arc;
+
+/// Maximum Newton iterations of the compliance solve.
+const MAX_ITERATIONS: usize = 60;
+
+/// The recorded displacement d includes the deflection of the machine:
+/// d = u + c F(u), with u the tool's true travel and c = 1/k the compliance
+/// (mm/N). The prediction is F(u) with u solved at every sample.
+///
+/// Parametrised by `c_mm_per_N` >= 0 rather than the stiffness k so that
+/// "off" (a rigid machine, k = infinity) is the reachable point c = 0 where a
+/// score test can differentiate; k = 1/c.
+///
+/// The solve is a Newton iteration on the whole history at once,
+/// u <- u - (u + c F(u) - d) / (1 + c s), with the diagonal slope s = dF_i/du_i
+/// estimated by shifting the whole history; for a rate-independent model
+/// that slope is exact, for a history-dependent one it is an approximation
+/// that still converges (the residual is checked to 1e-10 mm).
+pub struct ToolCompliance {
+    base: Arc<dyn ForwardModel>,
+    space: ParamSpace,
+}
+
+impl ToolCompliance {
+    /// Tool compliance around `base` (a displacement-driven force model).
+    pub fn new(base: Box<dyn ForwardModel>) -> Self {
+        Self::from_arc(Arc::from(base))
+    }
+
+    /// Same, sharing the base model.
+    pub fn from_arc(base: Arc<dyn ForwardModel>) -> Self {
+        let space = base.space().extended(&[ParamSpec::new(
+            "c_mm_per_N",
+            "mm/N",
+            0.0,
+            f64::INFINITY,
+            1e-3,
+        )]);
+        ToolCompliance { base, space }
+    }
+}
+
+struct ToolComplianceEvaluator<'a> {
+    model: &'a ToolCompliance,
+    base: Box<dyn Evaluator + 'a>,
+    shifted: Vec<f64>,
+}
+
+impl Evaluator for ToolComplianceEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let (base_theta, own) = split(theta, &self.model.space, 1)?;
+        let c = own[0];
+        if c == 0.0 {
+            return self.base.predict_into(base_theta, loading, out);
+        }
+        let n = loading.len();
+        if out.len() != n {
+            return Err(ForwardError::InvalidLoading(format!(
+                "output has {} slots for {n} samples",
+                out.len()
+            )));
+        }
+        let scale = 1.0 + loading.drive.iter().fold(0.0f64, |a, d| a.max(d.abs()));
+        let h = 1e-7 * scale;
+        let tol = 1e-10 * scale;
+        let mut u = loading.drive.clone();
+        self.shifted.resize(n, 0.0);
+        for _ in 0..MAX_ITERATIONS {
+            self.base
+                .predict_into(base_theta, &loading.with_drive(u.clone()), out)?;
+            let worst = (0..n)
+                .map(|i| (u[i] + c * out[i] - loading.drive[i]).abs())
+                .fold(0.0f64, f64::max);
+            if worst <= tol {
+                return Ok(());
+            }
+            let plus: Vec<f64> = u.iter().map(|x| x + h).collect();
+            self.base
+                .predict_into(base_theta, &loading.with_drive(plus), &mut self.shifted)?;
+            for i in 0..n {
+                let slope = (self.shifted[i] - out[i]) / h;
+                let denom = 1.0 + c * slope;
+                let denom = if denom > 0.05 { denom } else { 1.0 };
+                u[i] -= (u[i] + c * out[i] - loading.drive[i]) / denom;
+            }
+        }
+        Err(ForwardError::NotConverged {
+            sample: 0,
+            drive: loading.drive.first().copied().unwrap_or(0.0),
+            cuts: 0,
+            reason: format!(
+                "tool-compliance solve did not converge in {MAX_ITERATIONS} iterations"
+            ),
+            completed: Vec::new(),
+        })
+    }
+}
+
+impl ForwardModel for ToolCompliance {
+    fn name(&self) -> String {
+        format!("{} + tool compliance", self.base.name())
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+    fn observable(&self) -> Observable {
+        self.base.observable()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(ToolComplianceEvaluator {
+            model: self,
+            base: self.base.evaluator(),
+            shifted: Vec::new(),
+        })
+    }
+    fn effects(&self) -> Vec<Effect> {
+        wrapper_effects(self.base.as_ref(), Effect::ToolCompliance)
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        let this = Arc::new(ToolCompliance::from_arc(self.base.clone()));
+        enrich_wrapper(this, self.base.as_ref(), Effect::ToolCompliance, effect)
+    }
+    /// Base parameters, then c = 0 (a rigid machine).
+    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
+        let mut v = base_theta.to_vec();
+        v.push(0.0);
+        v
+    }
+}

@@ -1,0 +1,87 @@
+//! Enrichment `zero_offset`: the true contact point differs from the recorded
+//! zero of displacement.
+
+use crate::convert::split;
+use crate::wrap::{enrich_wrapper, wrapper_effects};
+use palpate_core::{
+    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+};
+use std::sync::Arc;
+
+/// F(d) = base(max(d - d0, 0)): contact starts at recorded displacement `d0`
+/// (positive: the tool travels `d0` before touching; negative: the specimen
+/// was already pre-compressed by `-d0` at the recorded zero). One parameter
+/// `d0_mm` in [-5, 5] mm, off at d0 = 0 (an interior point, so sensitivities
+/// exist there). The wrapped model sees the shifted history, times unchanged.
+pub struct ZeroOffset {
+    base: Arc<dyn ForwardModel>,
+    space: ParamSpace,
+}
+
+impl ZeroOffset {
+    /// Zero offset around `base` (a displacement-driven model).
+    pub fn new(base: Box<dyn ForwardModel>) -> Self {
+        Self::from_arc(Arc::from(base))
+    }
+
+    /// Same, sharing the base model.
+    pub fn from_arc(base: Arc<dyn ForwardModel>) -> Self {
+        let space = base
+            .space()
+            .extended(&[ParamSpec::new("d0_mm", "mm", -5.0, 5.0, 0.0)]);
+        ZeroOffset { base, space }
+    }
+}
+
+struct ZeroOffsetEvaluator<'a> {
+    model: &'a ZeroOffset,
+    base: Box<dyn Evaluator + 'a>,
+}
+
+impl Evaluator for ZeroOffsetEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let (base_theta, own) = split(theta, &self.model.space, 1)?;
+        let d0 = own[0];
+        if d0 == 0.0 {
+            return self.base.predict_into(base_theta, loading, out);
+        }
+        let shifted = loading.with_drive(loading.drive.iter().map(|d| (d - d0).max(0.0)).collect());
+        self.base.predict_into(base_theta, &shifted, out)
+    }
+}
+
+impl ForwardModel for ZeroOffset {
+    fn name(&self) -> String {
+        format!("{} + zero offset", self.base.name())
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+    fn observable(&self) -> Observable {
+        self.base.observable()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(ZeroOffsetEvaluator {
+            model: self,
+            base: self.base.evaluator(),
+        })
+    }
+    fn effects(&self) -> Vec<Effect> {
+        wrapper_effects(self.base.as_ref(), Effect::ZeroOffset)
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        let this = Arc::new(ZeroOffset::from_arc(self.base.clone()));
+        enrich_wrapper(this, self.base.as_ref(), Effect::ZeroOffset, effect)
+    }
+    /// Base parameters, then d0 = 0.
+    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
+        let mut v = base_theta.to_vec();
+        v.push(0.0);
+        v
+    }
+}
