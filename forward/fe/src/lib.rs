@@ -1,1 +1,23 @@
-//! (under construction)
+//! # palpate-fe
+//!
+//! Axisymmetric large-deformation finite elements with frictional rigid-tool
+//! contact, for the N1 needle-indentation and C1 compression benchmarks
+//! (`BENCHMARKS.md`).
+//!
+//! * [`mesh`] — structured graded quadrilateral meshes with named sets.
+//! * [`kinematics`] — the kinematic idealisation (an enum owned by the element).
+//! * [`element`] — the Q1/P0 (Simo-Taylor-Pister) mixed element.
+//! * [`tool`] / [`contact`] — analytic rigid tools and node-to-surface
+//!   augmented-Lagrangian Coulomb contact with trial/commit history.
+//! * [`solver`] — Newton-Raphson with line search and automatic increments
+//!   on a faer sparse LU that keeps its symbolic factorisation.
+//! * [`n1`], [`c1`] — the forward models.
+
+pub mod element;
+pub mod error;
+pub mod kinematics;
+pub mod material;
+pub mod mesh;
+pub mod quadrature;
+
+pub use error::FeError;

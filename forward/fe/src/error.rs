@@ -1,0 +1,53 @@
+//! Errors of the finite element machinery.
+
+use thiserror::Error;
+
+/// Why a finite element operation failed. Converted to
+/// [`palpate_core::ForwardError`] at the forward-model boundary.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum FeError {
+    /// A mesh description is unusable.
+    #[error("mesh `{field}`: {reason}")]
+    InvalidMesh { field: String, reason: String },
+    /// A rigid tool starts inside the body.
+    #[error("tool `{tool}` starts inside the body at node {node} (r = {r} mm, z = {z} mm, gap {gap:.3e} mm)")]
+    ToolStartsInside {
+        tool: String,
+        node: usize,
+        r: f64,
+        z: f64,
+        gap: f64,
+    },
+    /// An element turned inside out (det F <= 0 at a quadrature point).
+    #[error("element {element} inverted (det F = {det_f:.3e})")]
+    InvertedElement { element: usize, det_f: f64 },
+    /// The material law returned a non-finite stress.
+    #[error("element {element}: non-finite stress")]
+    NonFiniteStress { element: usize },
+    /// The sparse factorisation failed (singular tangent).
+    #[error("sparse LU failed: {reason}")]
+    Factorisation { reason: String },
+    /// Newton did not converge within the iteration limit.
+    #[error("Newton did not converge in {iterations} iterations (residual {residual:.3e}, tolerance {tolerance:.3e})")]
+    NewtonFailed {
+        iterations: usize,
+        residual: f64,
+        tolerance: f64,
+    },
+    /// A configuration value is invalid.
+    #[error("configuration `{field}`: {reason}")]
+    InvalidConfig { field: String, reason: String },
+}
+
+impl FeError {
+    /// Whether a smaller load increment might cure the failure.
+    pub fn is_recoverable(&self) -> bool {
+        matches!(
+            self,
+            FeError::InvertedElement { .. }
+                | FeError::NonFiniteStress { .. }
+                | FeError::Factorisation { .. }
+                | FeError::NewtonFailed { .. }
+        )
+    }
+}
