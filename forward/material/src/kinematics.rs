@@ -175,7 +175,6 @@ pub fn stress_tangent(
             tangent += m[a][b] * m[a][b].transpose() * c1 + m[a][b] * m[b][a].transpose() * c2;
         }
     }
-    let tangent = (tangent + tangent.transpose()) * 0.5;
 
     StressTangent {
         psi: d.w + vol.u(j),
