@@ -1,1 +1,50 @@
-//! (under construction)
+//! # palpate-inverse
+//!
+//! Calibration of forward models against data: least-squares objectives over
+//! one or several data sets sharing one parameter vector ([`Objective`]),
+//! Levenberg-Marquardt as an argmin solver ([`LevenbergMarquardt`]), BFGS
+//! and L-BFGS through argmin, finite-difference Jacobians computed in
+//! parallel over columns (bit-identical to serial), covariance and
+//! identifiability at the optimum, all reported in a serialisable
+//! [`FitReport`].
+//!
+//! Depends on `palpate-core` only: estimators see `dyn ForwardModel`.
+//!
+//! ```ignore
+//! let set = DataSet::new("uniaxial", model, loading, observed);
+//! let objective = Objective::new(vec![set], ResidualKind::Absolute, &[])?;
+//! let report = fit(&objective, &FitOptions::default())?;
+//! println!("{}", serde_json::to_string_pretty(&report)?);
+//! ```
+
+pub mod covariance;
+pub mod dataset;
+pub mod error;
+pub mod fit;
+pub mod jacobian;
+pub mod lm;
+pub mod objective;
+pub mod observer;
+pub mod problem;
+pub mod report;
+pub mod residual;
+pub mod run;
+pub mod sensitivities;
+pub mod termination;
+
+pub use covariance::{
+    covariance, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION, MAX_CORRELATION,
+};
+pub use dataset::DataSet;
+pub use error::InverseError;
+pub use fit::{fit, start_points, statistics, FitOptions, MultiStart};
+pub use jacobian::{jacobian_unbounded, FdOptions, JacobianEval};
+pub use lm::{LevenbergMarquardt, LmOptions, LmState};
+pub use objective::{sum_of_squares, Evaluators, Objective, ParamMap};
+pub use observer::{shared_observer, FitObserver, Progress, SharedObserver};
+pub use problem::{EvaluationCount, LeastSquaresProblem};
+pub use report::{BoundSide, FitReport, ParameterEstimate, SetReport};
+pub use residual::ResidualKind;
+pub use run::{Method, QuasiNewtonOptions};
+pub use sensitivities::Sensitivities;
+pub use termination::Termination;

@@ -1,0 +1,306 @@
+//! Levenberg-Marquardt as an argmin [`Solver`] (STYLE.md 10).
+//!
+//! Why not the `levenberg-marquardt` crate (rust-cv, a MINPACK port): it is
+//! built on an older nalgebra than the workspace's 0.34 (two nalgebras in the
+//! build), its residual/Jacobian callbacks return `Option`, so the
+//! [`palpate_core::ForwardError`] of a failed evaluation (which data set,
+//! which sample) is lost, and it has no observer hook for progress or an
+//! evaluation budget that counts finite-difference evaluations. The
+//! algorithm is short; written here on argmin's `Solver` so it shares
+//! argmin's executor, observers and state with BFGS/L-BFGS.
+//!
+//! # Algorithm
+//!
+//! Minimises `SSE(z) = ||r(z)||^2`. Each iteration solves the damped
+//! Gauss-Newton system (Moré 1978, "The Levenberg-Marquardt algorithm:
+//! implementation and theory", LNM 630, eq. 2.2 with scaling `D`):
+//!
+//! `(J^T J + mu D^2) h = -J^T r`
+//!
+//! as the linear least-squares problem `[J; sqrt(mu) D] h ~ [-r; 0]` by SVD
+//! (no normal equations, no explicit inverse). `D = diag(d_j)` with
+//! `d_j = max over iterations of ||J_j||` (Moré's scale invariance; a zero
+//! column gets `d_j = 1`). The gain ratio
+//! `rho = (SSE(z) - SSE(z + h)) / (SSE(z) - ||r + J h||^2)` accepts the step
+//! when `rho > 1e-4`; the damping follows Nielsen's rule (Nielsen 1999,
+//! IMM-REP-1999-05; Madsen, Nielsen & Tingleff 2004, "Methods for non-linear
+//! least squares problems", alg. 3.16): on acceptance
+//! `mu <- mu * max(1/3, 1 - (2 rho - 1)^3)`, `nu <- 2`; on rejection
+//! `mu <- mu * nu`, `nu <- 2 nu`. Initial `mu = tau` (relative to `D^2`).
+//! A failed forward evaluation at a trial point is a rejected step.
+//!
+//! Stopping, as MINPACK's `lmder`:
+//! * `ftol`: `|ared| / SSE <= ftol` and `pred / SSE <= ftol` and `rho <= 2`;
+//! * `xtol`: `||D h|| <= xtol (||D z|| + xtol)`;
+//! * `gtol`: `max_j |J_j . r| / (||J_j|| ||r||) <= gtol`;
+//! * zero residual, evaluation budget, iteration budget (argmin's `max_iters`).
+
+use crate::problem::EvaluationCount;
+use crate::Termination;
+use argmin::core::{
+    Error, IterState, Jacobian, Operator, Problem, Solver, TerminationReason, TerminationStatus, KV,
+};
+use nalgebra::{DMatrix, DVector};
+use serde::{Deserialize, Serialize};
+
+/// The argmin state the solver works on: parameters `z`, gradient `J^T r`,
+/// residuals `r`, cost SSE.
+pub type LmState = IterState<Vec<f64>, Vec<f64>, (), (), Vec<f64>, f64>;
+
+/// Tolerances and budgets.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct LmOptions {
+    pub ftol: f64,
+    pub xtol: f64,
+    pub gtol: f64,
+    /// Objective evaluations, finite-difference ones included.
+    pub max_evaluations: usize,
+    pub max_iterations: u64,
+    /// Initial damping `tau` relative to `D^2`.
+    pub initial_damping: f64,
+}
+
+impl Default for LmOptions {
+    fn default() -> Self {
+        LmOptions {
+            ftol: 1e-12,
+            xtol: 1e-10,
+            gtol: 1e-10,
+            max_evaluations: 5000,
+            max_iterations: 1000,
+            initial_damping: 1e-3,
+        }
+    }
+}
+
+/// The solver. After a run, [`LevenbergMarquardt::termination`] says why it stopped.
+#[derive(Debug, Clone)]
+pub struct LevenbergMarquardt {
+    options: LmOptions,
+    mu: f64,
+    nu: f64,
+    scale: Vec<f64>,
+    jacobian: DMatrix<f64>,
+    termination: Option<Termination>,
+}
+
+impl LevenbergMarquardt {
+    /// A solver with these options.
+    pub fn new(options: LmOptions) -> Self {
+        LevenbergMarquardt {
+            options,
+            mu: options.initial_damping,
+            nu: 2.0,
+            scale: Vec::new(),
+            jacobian: DMatrix::zeros(0, 0),
+            termination: None,
+        }
+    }
+
+    /// Why the solver stopped, when it stopped by its own criteria.
+    pub fn termination(&self) -> Option<&Termination> {
+        self.termination.as_ref()
+    }
+
+    /// The Jacobian at the last accepted point.
+    pub fn last_jacobian(&self) -> &DMatrix<f64> {
+        &self.jacobian
+    }
+
+    fn update_scale(&mut self) {
+        let norms = column_norms(&self.jacobian);
+        if self.scale.is_empty() {
+            self.scale = norms
+                .iter()
+                .map(|&n| if n > 0.0 { n } else { 1.0 })
+                .collect();
+        } else {
+            for (d, n) in self.scale.iter_mut().zip(norms) {
+                *d = d.max(n);
+            }
+        }
+    }
+
+    /// `max_j |J_j . r| / (||J_j|| ||r||)`, MINPACK's `gnorm`.
+    fn gradient_cosine(&self, r: &[f64]) -> f64 {
+        let rnorm = r.iter().map(|v| v * v).sum::<f64>().sqrt();
+        let mut worst: f64 = 0.0;
+        for c in 0..self.jacobian.ncols() {
+            let col = self.jacobian.column(c);
+            let n = col.norm();
+            if n > 0.0 {
+                let dot: f64 = col.iter().zip(r).map(|(a, b)| a * b).sum();
+                worst = worst.max((dot / (n * rnorm)).abs());
+            }
+        }
+        worst
+    }
+
+    /// Solves `[J; sqrt(mu) D] h ~ [-r; 0]` by SVD.
+    fn damped_step(&self, r: &[f64]) -> Option<Vec<f64>> {
+        let (m, q) = self.jacobian.shape();
+        let mut a = DMatrix::zeros(m + q, q);
+        a.view_mut((0, 0), (m, q)).copy_from(&self.jacobian);
+        let root_mu = self.mu.sqrt();
+        for j in 0..q {
+            a[(m + j, j)] = root_mu * self.scale[j];
+        }
+        let mut b = DVector::zeros(m + q);
+        for (bi, ri) in b.iter_mut().zip(r) {
+            *bi = -ri;
+        }
+        let h = a.svd(true, true).solve(&b, f64::MIN_POSITIVE).ok()?;
+        h.iter()
+            .all(|v| v.is_finite())
+            .then(|| h.iter().copied().collect())
+    }
+
+    fn check_converged(&mut self, r: &[f64], sse: f64) {
+        if sse == 0.0 {
+            self.termination = Some(Termination::ZeroResidual);
+        } else if self.gradient_cosine(r) <= self.options.gtol {
+            self.termination = Some(Termination::Gradient);
+        }
+    }
+}
+
+/// Euclidean norm of each column.
+pub fn column_norms(j: &DMatrix<f64>) -> Vec<f64> {
+    (0..j.ncols()).map(|c| j.column(c).norm()).collect()
+}
+
+fn gradient(j: &DMatrix<f64>, r: &[f64]) -> Vec<f64> {
+    (0..j.ncols())
+        .map(|c| j.column(c).iter().zip(r).map(|(a, b)| a * b).sum())
+        .collect()
+}
+
+impl<O> Solver<O, LmState> for LevenbergMarquardt
+where
+    O: Operator<Param = Vec<f64>, Output = Vec<f64>>
+        + Jacobian<Param = Vec<f64>, Jacobian = DMatrix<f64>>
+        + EvaluationCount,
+{
+    fn name(&self) -> &str {
+        "Levenberg-Marquardt"
+    }
+
+    fn init(
+        &mut self,
+        problem: &mut Problem<O>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let z = state
+            .take_param()
+            .ok_or_else(|| Error::msg("Levenberg-Marquardt needs a starting point"))?;
+        let r = problem.apply(&z)?;
+        self.jacobian = problem.jacobian(&z)?;
+        self.update_scale();
+        self.mu = self.options.initial_damping;
+        self.nu = 2.0;
+        self.termination = None;
+        let sse: f64 = r.iter().map(|v| v * v).sum();
+        self.check_converged(&r, sse);
+        let g = gradient(&self.jacobian, &r);
+        Ok((state.param(z).cost(sse).gradient(g).residuals(r), None))
+    }
+
+    fn next_iter(
+        &mut self,
+        problem: &mut Problem<O>,
+        mut state: LmState,
+    ) -> Result<(LmState, Option<KV>), Error> {
+        let z = state
+            .take_param()
+            .ok_or_else(|| Error::msg("Levenberg-Marquardt lost its parameters"))?;
+        let r = state
+            .take_residuals()
+            .ok_or_else(|| Error::msg("Levenberg-Marquardt lost its residuals"))?;
+        let sse = state.get_cost();
+        loop {
+            if problem.problem.as_ref().map_or(0, |p| p.evaluations())
+                >= self.options.max_evaluations
+            {
+                self.termination = Some(Termination::MaxEvaluations);
+                break;
+            }
+            let Some(h) = self.damped_step(&r) else {
+                self.termination = Some(Termination::NoProgress);
+                break;
+            };
+            let dh: f64 = h
+                .iter()
+                .zip(&self.scale)
+                .map(|(a, d)| (a * d).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            let dz: f64 = z
+                .iter()
+                .zip(&self.scale)
+                .map(|(a, d)| (a * d).powi(2))
+                .sum::<f64>()
+                .sqrt();
+            if dh <= self.options.xtol * (dz + self.options.xtol) {
+                self.termination = Some(Termination::RelativeStep);
+                break;
+            }
+            let jh = &self.jacobian * DVector::from_column_slice(&h);
+            let predicted_sse: f64 = r.iter().zip(jh.iter()).map(|(a, b)| (a + b).powi(2)).sum();
+            let pred = sse - predicted_sse;
+            let z_new: Vec<f64> = z.iter().zip(&h).map(|(a, b)| a + b).collect();
+            let trial = problem.apply(&z_new).ok().and_then(|r_new| {
+                let sse_new: f64 = r_new.iter().map(|v| v * v).sum();
+                sse_new.is_finite().then_some((r_new, sse_new))
+            });
+            let (rho, accepted) = match trial {
+                Some((r_new, sse_new)) if pred > 0.0 => {
+                    ((sse - sse_new) / pred, Some((r_new, sse_new)))
+                }
+                _ => (f64::NEG_INFINITY, None),
+            };
+            if rho > 1e-4 {
+                let (r_new, sse_new) = accepted.expect("accepted step has residuals");
+                self.jacobian = problem.jacobian(&z_new)?;
+                self.update_scale();
+                self.mu *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
+                self.nu = 2.0;
+                let ared = sse - sse_new;
+                if ared.abs() <= self.options.ftol * sse
+                    && pred <= self.options.ftol * sse
+                    && rho <= 2.0
+                {
+                    self.termination = Some(Termination::CostReduction);
+                } else {
+                    self.check_converged(&r_new, sse_new);
+                }
+                let g = gradient(&self.jacobian, &r_new);
+                let kv = argmin::kv!("mu" => self.mu; "rho" => rho;);
+                return Ok((
+                    state
+                        .param(z_new)
+                        .cost(sse_new)
+                        .gradient(g)
+                        .residuals(r_new),
+                    Some(kv),
+                ));
+            }
+            self.mu *= self.nu;
+            self.nu *= 2.0;
+            if !(self.mu.is_finite() && self.mu < 1e300) {
+                self.termination = Some(Termination::NoProgress);
+                break;
+            }
+        }
+        Ok((state.param(z).cost(sse).residuals(r), None))
+    }
+
+    fn terminate(&mut self, _state: &LmState) -> TerminationStatus {
+        match &self.termination {
+            None => TerminationStatus::NotTerminated,
+            Some(t) if t.converged() => {
+                TerminationStatus::Terminated(TerminationReason::SolverConverged)
+            }
+            Some(t) => TerminationStatus::Terminated(TerminationReason::SolverExit(t.to_string())),
+        }
+    }
+}
