@@ -14,10 +14,12 @@
 //! * [`n1`], [`c1`] — the forward models.
 
 pub mod element;
+pub mod contact;
 pub mod error;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;
 pub mod quadrature;
+pub mod tool;
 
 pub use error::FeError;
