@@ -14,6 +14,8 @@ use serde::Serialize;
 
 /// Condition number of the scaled `J^T J` above which a fit is not identifiable.
 pub const MAX_CONDITION: f64 = 1e10;
+/// Relative singular value of the scaled Jacobian below which it counts as zero (rank).
+pub const RANK_TOLERANCE: f64 = 1e-9;
 /// |correlation| above which two parameters are not separately identifiable.
 pub const MAX_CORRELATION: f64 = 0.999;
 
@@ -83,7 +85,9 @@ pub fn covariance(jx: &DMatrix<f64>, sse: f64, names: &[String], at_bound: &[boo
         let v_t = svd.v_t.expect("V requested");
         let s = &svd.singular_values;
         let s_max = s.iter().cloned().fold(0.0, f64::max);
-        let tol = s_max * (m.max(qa) as f64) * f64::EPSILON;
+        // Finite-difference Jacobians are accurate to ~1e-10 relative, so
+        // singular values below RANK_TOLERANCE * s_max are taken as zero.
+        let tol = s_max * RANK_TOLERANCE;
         let s_min = if m < qa {
             0.0
         } else {

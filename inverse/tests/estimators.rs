@@ -1,0 +1,579 @@
+//! Estimator tests on small nonlinear models defined here (the crate sees
+//! only `dyn ForwardModel`). Each test can fail: known parameters must be
+//! recovered, standard errors must match closed forms.
+
+use palpate_core::{
+    Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+};
+use palpate_inverse::*;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use rand_xoshiro::Xoshiro256PlusPlus;
+use std::sync::{Arc, Mutex};
+
+type Law = fn(&[f64], f64) -> Result<f64, ForwardError>;
+
+/// A model `y_i = law(theta, drive_i)`.
+struct FnModel {
+    name: &'static str,
+    space: ParamSpace,
+    law: Law,
+}
+
+struct FnEvaluator<'a>(&'a FnModel);
+
+impl Evaluator for FnEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        self.0.space.check(theta)?;
+        for (o, &d) in out.iter_mut().zip(&loading.drive) {
+            *o = (self.0.law)(theta, d)?;
+        }
+        Ok(())
+    }
+}
+
+impl ForwardModel for FnModel {
+    fn name(&self) -> String {
+        self.name.into()
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+    fn observable(&self) -> Observable {
+        Observable::ForceN
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(FnEvaluator(self))
+    }
+}
+
+const INF: f64 = f64::INFINITY;
+
+fn p(name: &str, lower: f64, upper: f64, initial: f64) -> ParamSpec {
+    ParamSpec::new(name, "1", lower, upper, initial)
+}
+
+/// `a exp(-b t) + c`, `b > 0`.
+fn exp_decay() -> Arc<dyn ForwardModel> {
+    Arc::new(FnModel {
+        name: "exp decay",
+        space: ParamSpace::new(vec![
+            p("a", -INF, INF, 1.0),
+            p("b", 0.0, INF, 1.0),
+            p("c", -INF, INF, 0.0),
+        ]),
+        law: |t, x| Ok(t[0] * (-t[1] * x).exp() + t[2]),
+    })
+}
+
+fn times(n: usize, end: f64) -> Vec<f64> {
+    (0..n).map(|i| end * i as f64 / (n - 1) as f64).collect()
+}
+
+fn set(model: Arc<dyn ForwardModel>, drive: Vec<f64>, truth: &[f64]) -> DataSet {
+    let loading = Loading::quasi_static(Drive::DisplacementMm, drive);
+    let observed = model.predict(truth, &loading).unwrap();
+    DataSet::new(model.name(), model, loading, observed)
+}
+
+fn noisy(mut s: DataSet, sd: f64, seed: u64) -> DataSet {
+    let mut rng = Xoshiro256PlusPlus::seed_from_u64(seed);
+    let normal = Normal::new(0.0, sd).unwrap();
+    for y in s.observed.iter_mut() {
+        *y += normal.sample(&mut rng);
+    }
+    s
+}
+
+fn lm() -> FitOptions {
+    FitOptions::default()
+}
+
+#[test]
+fn recovers_exponential_decay_without_noise() {
+    let truth = [2.5, 0.7, -0.3];
+    let obj = Objective::new(
+        vec![set(exp_decay(), times(40, 6.0), &truth)],
+        ResidualKind::Absolute,
+        &[],
+    )
+    .unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    assert!(r.converged, "{:?}", r.termination);
+    for (name, t) in ["a", "b", "c"].iter().zip(truth) {
+        let v = r.value(name).unwrap();
+        assert!((v - t).abs() <= 1e-8 * t.abs(), "{name}: {v} vs {t}");
+    }
+    assert!(r.sse < 1e-20, "{}", r.sse);
+    assert!(r.identifiability.identifiable, "{:?}", r.identifiability);
+    assert!((r.r_squared - 1.0).abs() < 1e-12);
+    // The report serialises (NaN -> null).
+    let json = serde_json::to_string(&r).unwrap();
+    assert!(json.contains("\"termination\""));
+}
+
+#[test]
+fn noisy_exponential_decay_truth_within_three_standard_errors() {
+    let truth = [2.5, 0.7, -0.3];
+    let mut hits = 0;
+    for seed in 0..5 {
+        let s = noisy(set(exp_decay(), times(60, 6.0), &truth), 0.02, seed);
+        let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+        let r = fit(&obj, &lm()).unwrap();
+        assert!(r.converged);
+        for (name, t) in ["a", "b", "c"].iter().zip(truth) {
+            let (v, se) = (r.value(name).unwrap(), r.standard_error(name).unwrap());
+            assert!(se > 0.0 && se < 0.1, "{name}: se {se}");
+            assert!(
+                (v - t).abs() < 4.0 * se,
+                "{name}: {v} +- {se} vs {t} (seed {seed})"
+            );
+            if (v - t).abs() < 2.0 * se {
+                hits += 1;
+            }
+        }
+        // sigma^2 estimates the noise variance.
+        let s2 = r.sigma2.unwrap();
+        assert!((s2.sqrt() / 0.02 - 1.0).abs() < 0.3, "sigma {}", s2.sqrt());
+    }
+    // ~95 % of 15 intervals of 2 SE should cover: at least 11.
+    assert!(hits >= 11, "{hits} of 15 within 2 SE");
+}
+
+#[test]
+fn rosenbrock_residuals_are_solved_from_the_classical_start() {
+    // r = (10 (x2 - x1^2), 1 - x1) written as predictions minus observations.
+    let model: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "rosenbrock",
+        space: ParamSpace::new(vec![p("x1", -INF, INF, -1.2), p("x2", -INF, INF, 1.0)]),
+        law: |t, d| {
+            Ok(if d == 0.0 {
+                10.0 * (t[1] - t[0] * t[0])
+            } else {
+                -t[0]
+            })
+        },
+    });
+    let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.0, 1.0]);
+    let s = DataSet::new("rosenbrock", model, loading, vec![0.0, -1.0]);
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    assert!(r.converged, "{:?}", r.termination);
+    assert!((r.value("x1").unwrap() - 1.0).abs() < 1e-8);
+    assert!((r.value("x2").unwrap() - 1.0).abs() < 1e-8);
+    // n == p: sigma^2 undefined, no standard errors, correlation still defined.
+    assert!(r.sigma2.is_none() && r.standard_error("x1").is_none());
+}
+
+fn line() -> Arc<dyn ForwardModel> {
+    Arc::new(FnModel {
+        name: "line",
+        space: ParamSpace::new(vec![p("a", -INF, INF, 0.0), p("b", -INF, INF, 1.0)]),
+        law: |t, x| Ok(t[0] + t[1] * x),
+    })
+}
+
+#[test]
+fn standard_errors_match_linear_regression_formulas() {
+    let x = times(25, 4.0);
+    let s = noisy(set(line(), x.clone(), &[1.0, 0.5]), 0.1, 7);
+    let y = s.observed.clone();
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    let n = x.len() as f64;
+    let xm = x.iter().sum::<f64>() / n;
+    let ym = y.iter().sum::<f64>() / n;
+    let sxx: f64 = x.iter().map(|v| (v - xm).powi(2)).sum();
+    let sxy: f64 = x.iter().zip(&y).map(|(a, b)| (a - xm) * (b - ym)).sum();
+    let b = sxy / sxx;
+    let a = ym - b * xm;
+    let sse: f64 = x
+        .iter()
+        .zip(&y)
+        .map(|(xi, yi)| (yi - a - b * xi).powi(2))
+        .sum();
+    let s2 = sse / (n - 2.0);
+    let se_b = (s2 / sxx).sqrt();
+    let se_a = (s2 * (1.0 / n + xm * xm / sxx)).sqrt();
+    let corr = -xm / (xm * xm + sxx / n).sqrt();
+    let rel = |u: f64, v: f64| (u - v).abs() / v.abs();
+    assert!(rel(r.value("a").unwrap(), a) < 1e-10);
+    assert!(rel(r.value("b").unwrap(), b) < 1e-10);
+    assert!(rel(r.sse, sse) < 1e-10);
+    assert!(
+        rel(r.standard_error("a").unwrap(), se_a) < 1e-7,
+        "{:?} vs {se_a}",
+        r.standard_error("a")
+    );
+    assert!(rel(r.standard_error("b").unwrap(), se_b) < 1e-7);
+    assert!(
+        rel(r.correlation[0][1], corr) < 1e-7,
+        "{} vs {corr}",
+        r.correlation[0][1]
+    );
+    let ss_tot: f64 = y.iter().map(|v| (v - ym).powi(2)).sum();
+    assert!(rel(r.sets[0].r_squared, 1.0 - sse / ss_tot) < 1e-10);
+}
+
+#[test]
+fn bfgs_and_lbfgs_reach_the_levenberg_marquardt_optimum() {
+    let truth = [2.5, 0.7, -0.3];
+    let s = noisy(set(exp_decay(), times(50, 6.0), &truth), 0.02, 11);
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let reference = fit(&obj, &lm()).unwrap();
+    for method in [
+        Method::Bfgs(QuasiNewtonOptions::default()),
+        Method::Lbfgs {
+            memory: 5,
+            options: QuasiNewtonOptions::default(),
+        },
+    ] {
+        let r = fit(&obj, &FitOptions::with_method(method)).unwrap();
+        assert!(
+            (r.sse / reference.sse - 1.0).abs() < 1e-9,
+            "{}: {} vs {}",
+            r.method,
+            r.sse,
+            reference.sse
+        );
+        for name in ["a", "b", "c"] {
+            let (u, v) = (r.value(name).unwrap(), reference.value(name).unwrap());
+            let se = reference.standard_error(name).unwrap();
+            assert!((u - v).abs() < 1e-4 * se, "{}: {name} {u} vs {v}", r.method);
+        }
+    }
+}
+
+#[test]
+fn collinear_parameters_are_not_identifiable() {
+    let model: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "collinear",
+        space: ParamSpace::new(vec![
+            p("a", -INF, INF, 1.0),
+            p("b", -INF, INF, 0.5),
+            p("c", -INF, INF, 0.0),
+        ]),
+        law: |t, x| Ok((t[0] + t[1]) * x + t[2]),
+    });
+    let s = noisy(set(model, times(20, 2.0), &[1.0, 1.0, 0.2]), 0.01, 3);
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    let id = &r.identifiability;
+    assert!(!id.identifiable, "{id:?}");
+    assert!(
+        id.involved.contains(&"a".to_string()) && id.involved.contains(&"b".to_string()),
+        "{id:?}"
+    );
+    assert!(!id.involved.contains(&"c".to_string()), "{id:?}");
+    assert_eq!(id.rank, 2, "{id:?}");
+    assert!(id.condition_number > MAX_CONDITION, "{id:?}");
+    // No standard error for parameters in the null space; c keeps its own.
+    assert!(r.standard_error("a").is_none() && r.standard_error("b").is_none());
+    assert!(r.standard_error("c").unwrap() < 0.01);
+    // The sum is still determined.
+    assert!((r.value("a").unwrap() + r.value("b").unwrap() - 2.0).abs() < 0.05);
+}
+
+#[test]
+fn relative_residuals_skip_zero_observations() {
+    let truth = [1.5, 0.4];
+    // The line through zero at x = 0 gives a zero observation.
+    let s = set(line(), vec![-2.0, -1.0, 0.0, 1.0, 2.0, 3.0], &[0.0, 0.0]);
+    assert_eq!(s.observed[2], 0.0);
+    let mut s = set(line(), times(6, 5.0), &truth);
+    s.observed[0] = 0.0; // a zero observation that is ignored
+    let obj = Objective::new(vec![s], ResidualKind::Relative, &[]).unwrap();
+    assert_eq!(obj.n_residuals(), 5);
+    let r = fit(&obj, &lm()).unwrap();
+    assert_eq!(r.sets[0].kept, vec![1, 2, 3, 4, 5]);
+    assert!(
+        (r.value("a").unwrap() - truth[0]).abs() < 1e-8
+            && (r.value("b").unwrap() - truth[1]).abs() < 1e-8
+    );
+    // Residuals are relative: predicted/observed - 1.
+    let k = 3;
+    let set = &r.sets[0];
+    let expected = set.predicted[k] / set.observed[k] - 1.0;
+    assert!((set.residuals[k - 1] - expected).abs() < 1e-15);
+}
+
+#[test]
+fn parallel_and_serial_jacobians_are_bit_identical() {
+    let s = noisy(set(exp_decay(), times(30, 6.0), &[2.5, 0.7, -0.3]), 0.02, 5);
+    let obj = Objective::new(vec![s.clone(), s], ResidualKind::Normalised, &[]).unwrap();
+    let z = obj.unbounded_from_theta(&[2.0, 0.9, 0.1]).unwrap();
+    let serial = FdOptions {
+        parallel: false,
+        ..FdOptions::default()
+    };
+    let parallel = FdOptions::default();
+    let js = jacobian_unbounded(&obj, &z, None, &serial).unwrap().matrix;
+    for threads in [1, 2, 4] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        let jp = pool.install(|| {
+            jacobian_unbounded(&obj, &z, None, &parallel)
+                .unwrap()
+                .matrix
+        });
+        assert!(
+            js.iter()
+                .zip(jp.iter())
+                .all(|(a, b)| a.to_bits() == b.to_bits()),
+            "{threads} threads"
+        );
+    }
+    // And the FD Jacobian is a Jacobian: compare with the analytic one.
+    let theta = obj.theta_from_unbounded(&z);
+    let dxdz = obj.dx_dz(&z);
+    let (_, f) = (0, obj.factors(0)[0].1);
+    for (i, &t) in times(30, 6.0).iter().enumerate() {
+        let e = (-theta[1] * t).exp();
+        let exact = [
+            f * e * dxdz[0],
+            -f * theta[0] * t * e * dxdz[1],
+            f * dxdz[2],
+        ];
+        for j in 0..3 {
+            assert!(
+                (js[(i, j)] - exact[j]).abs() < 1e-8 * (1.0 + exact[j].abs()),
+                "({i},{j})"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_parameter_pushed_onto_its_bound_is_reported_there() {
+    // Data from a decreasing line; the slope is constrained to b >= 0.
+    let bounded: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "bounded line",
+        space: ParamSpace::new(vec![p("a", -INF, INF, 0.0), p("b", 0.0, INF, 1.0)]),
+        law: |t, x| Ok(t[0] + t[1] * x),
+    });
+    let x = times(11, 2.0);
+    let y: Vec<f64> = x.iter().map(|v| 3.0 - 0.5 * v).collect();
+    let mean = y.iter().sum::<f64>() / y.len() as f64;
+    let s = DataSet::new(
+        "line",
+        bounded,
+        Loading::quasi_static(Drive::DisplacementMm, x),
+        y,
+    );
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    let b = r.parameter("b").unwrap();
+    assert!(b.value >= 0.0 && b.value < 1e-8, "b = {}", b.value);
+    assert_eq!(b.at_bound, Some(BoundSide::Lower));
+    assert!(b.standard_error.is_none());
+    assert!(
+        (r.value("a").unwrap() - mean).abs() < 1e-8,
+        "{} vs {mean}",
+        r.value("a").unwrap()
+    );
+    assert!(r.standard_error("a").is_some());
+    assert_eq!(r.identifiability.at_bound, vec!["b".to_string()]);
+}
+
+#[test]
+fn fixed_parameters_are_held_and_reported() {
+    let truth = [2.5, 0.7, -0.3];
+    let obj = Objective::new(
+        vec![set(exp_decay(), times(30, 6.0), &truth)],
+        ResidualKind::Absolute,
+        &[("c".to_string(), -0.3)],
+    )
+    .unwrap();
+    assert_eq!(obj.free_names(), vec!["a", "b"]);
+    let r = fit(&obj, &lm()).unwrap();
+    let c = r.parameter("c").unwrap();
+    assert!(c.fixed && c.value == -0.3 && c.standard_error.is_none());
+    assert!((r.value("b").unwrap() - 0.7).abs() < 1e-8);
+    assert_eq!(r.correlation.len(), 2);
+    // Unknown names and out-of-bounds values are named errors.
+    let e = Objective::new(
+        vec![set(exp_decay(), times(5, 1.0), &truth)],
+        ResidualKind::Absolute,
+        &[("D1".to_string(), 0.0)],
+    )
+    .unwrap_err();
+    assert!(
+        matches!(e, InverseError::UnknownParameter { ref name, .. } if name == "D1"),
+        "{e}"
+    );
+    let e = Objective::new(
+        vec![set(exp_decay(), times(5, 1.0), &truth)],
+        ResidualKind::Absolute,
+        &[("b".to_string(), -1.0)],
+    )
+    .unwrap_err();
+    assert!(matches!(e, InverseError::OutOfBounds { .. }), "{e}");
+}
+
+#[test]
+fn joint_fit_of_two_sets_with_different_scales_and_normalised_residuals() {
+    // Same parameters, second set observed in other units (x1000) and longer.
+    let truth = [2.5, 0.7, -0.3];
+    let scaled: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "exp decay x1000",
+        space: exp_decay().space().clone(),
+        law: |t, x| Ok(1000.0 * (t[0] * (-t[1] * x).exp() + t[2])),
+    });
+    let s1 = noisy(set(exp_decay(), times(20, 6.0), &truth), 0.01, 1);
+    let s2 = noisy(set(scaled, times(80, 6.0), &truth), 10.0, 2);
+    let obj = Objective::new(vec![s1, s2], ResidualKind::Normalised, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    assert_eq!(r.sets.len(), 2);
+    for (name, t) in ["a", "b", "c"].iter().zip(truth) {
+        let (v, se) = (r.value(name).unwrap(), r.standard_error(name).unwrap());
+        assert!((v - t).abs() < 4.0 * se, "{name}: {v} +- {se}");
+    }
+    // Each set's normalised SSE is its relative RMS error squared: comparable magnitudes.
+    let ratio = r.sets[0].sse / r.sets[1].sse;
+    assert!(ratio > 0.1 && ratio < 10.0, "{ratio}");
+    // Mismatched parameter names are refused.
+    let other: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "other",
+        space: ParamSpace::new(vec![p("a", -INF, INF, 0.0), p("k", -INF, INF, 1.0)]),
+        law: |t, x| Ok(t[0] + t[1] * x),
+    });
+    let e = Objective::new(
+        vec![
+            set(exp_decay(), times(5, 1.0), &truth),
+            set(other, times(5, 1.0), &[0.0, 1.0]),
+        ],
+        ResidualKind::Absolute,
+        &[],
+    )
+    .unwrap_err();
+    assert!(matches!(e, InverseError::ParameterMismatch { .. }), "{e}");
+}
+
+struct ExpSensitivities;
+impl Sensitivities for ExpSensitivities {
+    fn predict_with_jacobian(
+        &self,
+        t: &[f64],
+        loading: &Loading,
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
+        let e: Vec<f64> = loading.drive.iter().map(|x| (-t[1] * x).exp()).collect();
+        let pred = e.iter().map(|e| t[0] * e + t[2]).collect();
+        let da = e.clone();
+        let db = e
+            .iter()
+            .zip(&loading.drive)
+            .map(|(e, x)| -t[0] * x * e)
+            .collect();
+        Ok((pred, vec![da, db, vec![1.0; e.len()]]))
+    }
+}
+
+#[test]
+fn exact_sensitivities_replace_finite_differences() {
+    let truth = [2.5, 0.7, -0.3];
+    let s = noisy(set(exp_decay(), times(30, 6.0), &truth), 0.02, 9);
+    let fd_obj = Objective::new(vec![s.clone()], ResidualKind::Relative, &[]).unwrap();
+    let ex_obj = Objective::new(
+        vec![s.with_sensitivities(Arc::new(ExpSensitivities))],
+        ResidualKind::Relative,
+        &[],
+    )
+    .unwrap();
+    let z = fd_obj.unbounded_from_theta(&[2.0, 0.9, 0.1]).unwrap();
+    let jf = jacobian_unbounded(&fd_obj, &z, None, &FdOptions::default()).unwrap();
+    let je = jacobian_unbounded(&ex_obj, &z, None, &FdOptions::default()).unwrap();
+    assert_eq!(je.evaluations, 1);
+    for (a, b) in jf.matrix.iter().zip(je.matrix.iter()) {
+        assert!((a - b).abs() < 1e-7 * (1.0 + b.abs()), "{a} vs {b}");
+    }
+    let (rf, re) = (fit(&fd_obj, &lm()).unwrap(), fit(&ex_obj, &lm()).unwrap());
+    assert!((rf.value("b").unwrap() - re.value("b").unwrap()).abs() < 1e-8);
+}
+
+#[test]
+fn a_forward_failure_at_the_start_names_the_set() {
+    let fragile: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "fragile",
+        space: ParamSpace::new(vec![p("a", -INF, INF, 5.0)]),
+        law: |t, x| {
+            if t[0] > 4.0 {
+                Err(ForwardError::Unphysical {
+                    drive: x,
+                    reason: "too stiff".into(),
+                })
+            } else {
+                Ok(t[0] * x)
+            }
+        },
+    });
+    let s = DataSet::new(
+        "stiff test",
+        fragile,
+        Loading::quasi_static(Drive::DisplacementMm, vec![1.0, 2.0]),
+        vec![1.0, 2.0],
+    );
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let e = fit(&obj, &lm()).unwrap_err();
+    assert!(
+        matches!(e, InverseError::Forward { ref set, .. } if set == "stiff test"),
+        "{e}"
+    );
+    assert!(e.to_string().contains("too stiff"), "{e}");
+    // From an admissible start the failing region only rejects trial steps.
+    let r = fit(
+        &obj,
+        &FitOptions {
+            start: Some(vec![0.5]),
+            ..lm()
+        },
+    )
+    .unwrap();
+    assert!((r.value("a").unwrap() - 1.0).abs() < 1e-10);
+}
+
+#[test]
+fn multistart_escapes_a_local_minimum_and_the_observer_sees_progress() {
+    // y = sin(w t): from w0 = 1 the nearest minimum is not the truth w = 3.
+    let model: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "sine",
+        space: ParamSpace::new(vec![p("w", 0.0, INF, 1.0)]),
+        law: |t, x| Ok((t[0] * x).sin()),
+    });
+    let s = set(model, times(60, 6.0), &[3.0]);
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let single = fit(&obj, &lm()).unwrap();
+    assert!(
+        single.sse > 1.0,
+        "single start found {}",
+        single.value("w").unwrap()
+    );
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let log = seen.clone();
+    let options = FitOptions {
+        multistart: MultiStart {
+            starts: 8,
+            spread: 1.5,
+        },
+        observer: Some(shared_observer(move |p: &Progress| {
+            log.lock().unwrap().push((p.start, p.sse))
+        })),
+        ..lm()
+    };
+    let r = fit(&obj, &options).unwrap();
+    assert!(
+        (r.value("w").unwrap() - 3.0).abs() < 1e-8,
+        "w = {}",
+        r.value("w").unwrap()
+    );
+    assert_eq!(r.starts, 8);
+    assert_ne!(r.best_start, 0);
+    let seen = seen.lock().unwrap();
+    assert!(seen.len() >= 8 && seen.iter().any(|&(k, _)| k == 7));
+}
