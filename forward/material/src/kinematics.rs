@@ -158,7 +158,7 @@ pub fn stress_tangent(
     let mut tangent = SMatrix::<f64, 9, 9>::zeros();
     for a in 0..3 {
         for b in 0..3 {
-            tangent += m[a][a] * m[b][b].transpose() * psi_ab[a][b];
+            tangent.ger(psi_ab[a][b], &m[a][a], &m[b][b], 1.0);
         }
     }
     for a in 0..3 {
@@ -172,7 +172,8 @@ pub fn stress_tangent(
                 (gt[a] - gt[b]) / (lam[a] * lam[a] - lam[b] * lam[b])
             };
             let c2 = 0.5 * ((c1 * lam[b] - psi_a[b]) / lam[a] + (c1 * lam[a] - psi_a[a]) / lam[b]);
-            tangent += m[a][b] * m[a][b].transpose() * c1 + m[a][b] * m[b][a].transpose() * c2;
+            tangent.ger(c1, &m[a][b], &m[a][b], 1.0);
+            tangent.ger(c2, &m[a][b], &m[b][a], 1.0);
         }
     }
 

@@ -8,8 +8,8 @@ use serde::{Deserialize, Serialize};
 
 use crate::invariants::invariants;
 use crate::{
-    arruda_boyce, kinematics, mooney_rivlin, neo_hookean, ogden, reduced_polynomial, MaterialError,
-    PrincipalDerivs, StressTangent, Volumetric,
+    arruda_boyce, invariant_kinematics, kinematics, mooney_rivlin, neo_hookean, ogden,
+    reduced_polynomial, InvariantDerivs, MaterialError, PrincipalDerivs, StressTangent, Volumetric,
 };
 
 /// Highest order of the reduced polynomial law.
@@ -258,20 +258,57 @@ impl Law {
             return PrincipalDerivs::nan();
         }
         let (i1, i2) = invariants(lam);
-        let inv = match *self {
-            Law::NeoHookean => neo_hookean::invariant_derivs(p[0], i1),
-            Law::MooneyRivlin => mooney_rivlin::invariant_derivs(p[0], p[1], i1, i2),
-            Law::ReducedPolynomial(_) => reduced_polynomial::invariant_derivs(p, i1),
-            Law::ArrudaBoyce => arruda_boyce::invariant_derivs(p[0], p[1], i1),
-            Law::Ogden(_) => return ogden::principal_derivs(p, lam),
-        };
-        inv.to_principal(lam)
+        match self.invariant_derivs(p, i1, i2) {
+            Some(inv) => inv.to_principal(lam),
+            None => ogden::principal_derivs(p, lam),
+        }
+    }
+
+    /// `W(I1, I2)` and its invariant derivatives for the laws written in invariants; `None` for
+    /// Ogden (principal stretches only). NaN when the parameter count is wrong.
+    pub fn invariant_derivs(&self, p: &[f64], i1: f64, i2: f64) -> Option<InvariantDerivs> {
+        if p.len() != self.param_count() {
+            return Some(InvariantDerivs {
+                w: f64::NAN,
+                w1: f64::NAN,
+                w2: f64::NAN,
+                w11: f64::NAN,
+                w12: f64::NAN,
+                w22: f64::NAN,
+            });
+        }
+        match *self {
+            Law::NeoHookean => Some(neo_hookean::invariant_derivs(p[0], i1)),
+            Law::MooneyRivlin => Some(mooney_rivlin::invariant_derivs(p[0], p[1], i1, i2)),
+            Law::ReducedPolynomial(_) => Some(reduced_polynomial::invariant_derivs(p, i1)),
+            Law::ArrudaBoyce => Some(arruda_boyce::invariant_derivs(p[0], p[1], i1)),
+            Law::Ogden(_) => None,
+        }
     }
 
     /// Energy `Psi(F) = W(J^{-1/3} F) + U(J)`, first Piola stress `P = dPsi/dF` and tangent
-    /// `A = dP/dF` (9x9, index `i*3 + j` for `F_ij`), built from the principal derivatives by
+    /// `A = dP/dF` (9x9, index `i*3 + j` for `F_ij`). Laws written in invariants use the
+    /// eigen-free [`invariant_kinematics::stress_tangent`]; Ogden uses the principal-stretch
     /// [`kinematics::stress_tangent`]. NaN when `det F <= 0`.
     pub fn stress_tangent(&self, p: &[f64], vol: Volumetric, f: &Matrix3<f64>) -> StressTangent {
+        match self {
+            Law::Ogden(_) => self.stress_tangent_principal(p, vol, f),
+            _ => invariant_kinematics::stress_tangent(
+                |i1, i2| self.invariant_derivs(p, i1, i2).unwrap_or_default(),
+                vol,
+                f,
+            ),
+        }
+    }
+
+    /// The same as [`Law::stress_tangent`], always through the principal stretches
+    /// ([`kinematics::stress_tangent`]); kept public as an independent cross-check.
+    pub fn stress_tangent_principal(
+        &self,
+        p: &[f64],
+        vol: Volumetric,
+        f: &Matrix3<f64>,
+    ) -> StressTangent {
         kinematics::stress_tangent(|lam| self.isochoric_principal(p, lam), vol, f)
     }
 }

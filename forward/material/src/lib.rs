@@ -17,6 +17,7 @@
 pub mod arruda_boyce;
 pub mod error;
 pub mod homogeneous;
+pub mod invariant_kinematics;
 pub mod invariants;
 pub mod kinematics;
 pub mod law;

@@ -642,3 +642,33 @@ fn inverted_gradients_give_nan_not_a_panic() {
     let st = Law::NeoHookean.stress_tangent(&[0.1], Volumetric::D1(0.1), &f);
     assert!(st.psi.is_nan() && st.p[(0, 0)].is_nan());
 }
+
+#[test]
+fn invariant_and_principal_paths_agree() {
+    for (law, p) in cases() {
+        if let Law::Ogden(_) = law {
+            continue;
+        }
+        for vol in vols(&law, &p) {
+            for f in gradients() {
+                let (fast, generic) = (
+                    law.stress_tangent(&p, vol, &f),
+                    law.stress_tangent_principal(&p, vol, &f),
+                );
+                let scale = law.shear_modulus(&p) + max_abs(generic.a.iter());
+                assert!((fast.psi - generic.psi).abs() < 1e-12 * scale, "{law}: psi");
+                assert!(
+                    max_abs((fast.p - generic.p).iter()) < 1e-11 * scale,
+                    "{law}: P {} vs {}",
+                    fast.p,
+                    generic.p
+                );
+                let da = max_abs((fast.a - generic.a).iter());
+                assert!(
+                    da < 1e-9 * scale,
+                    "{law} at {f}: A differs by {da} (scale {scale})"
+                );
+            }
+        }
+    }
+}
