@@ -100,10 +100,12 @@ impl ContactSet {
         kin: Kinematics,
         options: ContactOptions,
     ) -> Result<ContactSet, FeError> {
-        tool.shape.check().map_err(|reason| FeError::InvalidConfig {
-            field: format!("tool `{name}`"),
-            reason,
-        })?;
+        tool.shape
+            .check()
+            .map_err(|reason| FeError::InvalidConfig {
+                field: format!("tool `{name}`"),
+                reason,
+            })?;
         let mut area = std::collections::BTreeMap::<usize, f64>::new();
         for &[a, b] in mesh.edge_set(edges)? {
             let (pa, pb) = (mesh.nodes[a], mesh.nodes[b]);
@@ -173,7 +175,10 @@ impl ContactSet {
             };
             if tn <= 0.0 {
                 self.trial[k] = t;
-                out.push(NodeContact { node: n, ..Default::default() });
+                out.push(NodeContact {
+                    node: n,
+                    ..Default::default()
+                });
                 continue;
             }
             t.normal_force = tn;
@@ -272,7 +277,9 @@ mod tests {
     use crate::mesh::Grading;
 
     fn set(friction: f64) -> (Mesh, ContactSet) {
-        let m = Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2)).unwrap();
+        let m =
+            Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2))
+                .unwrap();
         let tool = RigidTool {
             shape: ToolShape::Sphere { radius: 2.5 },
             origin: [0.0, 2.0],
@@ -297,7 +304,9 @@ mod tests {
 
     #[test]
     fn tool_inside_is_an_error_naming_tool_and_node() {
-        let m = Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2)).unwrap();
+        let m =
+            Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2))
+                .unwrap();
         let tool = RigidTool {
             shape: ToolShape::Platen,
             origin: [0.0, 1.5],
@@ -309,7 +318,8 @@ mod tests {
             penalty_tangent: 1.0,
             penetration_tol: 1e-6,
         };
-        let e = ContactSet::new("platen", tool, &m, "top", Kinematics::Axisymmetric, opts).unwrap_err();
+        let e =
+            ContactSet::new("platen", tool, &m, "top", Kinematics::Axisymmetric, opts).unwrap_err();
         let s = e.to_string();
         assert!(s.contains("platen") && s.contains("node"), "{s}");
     }
@@ -341,7 +351,11 @@ mod tests {
                     for i in 0..2 {
                         let fd = (p[k].force[i] - q[k].force[i]) / (2.0 * h);
                         let an = nc.stiffness[i][j];
-                        assert!((fd - an).abs() < 1e-5 * (1.0 + an.abs()), "mu {friction} node {} {i}{j}: {an} vs {fd}", nc.node);
+                        assert!(
+                            (fd - an).abs() < 1e-5 * (1.0 + an.abs()),
+                            "mu {friction} node {} {i}{j}: {an} vs {fd}",
+                            nc.node
+                        );
                     }
                 }
             }

@@ -13,13 +13,20 @@
 //!   on a faer sparse LU that keeps its symbolic factorisation.
 //! * [`n1`], [`c1`] — the forward models.
 
-pub mod element;
+pub mod c1;
 pub mod contact;
+pub mod element;
 pub mod error;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;
+pub mod model;
 pub mod quadrature;
+pub mod solver;
+pub mod sparse;
 pub mod tool;
 
+pub use c1::{C1Fe, Platens};
 pub use error::FeError;
+pub use model::{Bulk, Simulation};
+pub use solver::{Progress, RunStats, SolverOptions};

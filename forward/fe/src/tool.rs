@@ -16,7 +16,10 @@ pub enum ToolShape {
     /// Hemispherical tip of radius `tip_radius` tangent to a cone of
     /// half-angle `half_angle_deg` (BENCHMARKS.md N1: 2.5 mm, 15 degrees; the
     /// cap ends `90 - half_angle` degrees from the pole).
-    Needle { tip_radius: f64, half_angle_deg: f64 },
+    Needle {
+        tip_radius: f64,
+        half_angle_deg: f64,
+    },
     /// A sphere of the given radius (Hertz).
     Sphere { radius: f64 },
     /// A flat-ended cylindrical punch whose edge is rounded with `edge_radius`
@@ -51,7 +54,12 @@ fn arc(p: [f64; 2], c: [f64; 2], radius: f64, xi0: f64) -> Projection {
     let n = [d[0] / rho, d[1] / rho];
     let t = [-n[1], n[0]];
     let phi = d[0].atan2(-d[1]);
-    let outer = |a: [f64; 2], b: [f64; 2], s: f64| [[s * a[0] * b[0], s * a[0] * b[1]], [s * a[1] * b[0], s * a[1] * b[1]]];
+    let outer = |a: [f64; 2], b: [f64; 2], s: f64| {
+        [
+            [s * a[0] * b[0], s * a[0] * b[1]],
+            [s * a[1] * b[0], s * a[1] * b[1]],
+        ]
+    };
     Projection {
         gap: rho - radius,
         normal: n,
@@ -99,8 +107,13 @@ impl ToolShape {
                     return Err("needle needs tip_radius > 0 and 0 < half_angle_deg < 90".into());
                 }
             }
-            ToolShape::Sphere { radius } if !pos(radius) => return Err("sphere radius must be > 0".into()),
-            ToolShape::FlatPunch { radius, edge_radius } => {
+            ToolShape::Sphere { radius } if !pos(radius) => {
+                return Err("sphere radius must be > 0".into())
+            }
+            ToolShape::FlatPunch {
+                radius,
+                edge_radius,
+            } => {
                 if !pos(radius) || !pos(edge_radius) || edge_radius >= radius {
                     return Err("flat punch needs 0 < edge_radius < radius".into());
                 }
@@ -129,7 +142,10 @@ impl ToolShape {
                 }
             }
             ToolShape::Platen => line(p, [0.0, 0.0], [0.0, -1.0], 0.0),
-            ToolShape::FlatPunch { radius, edge_radius } => {
+            ToolShape::FlatPunch {
+                radius,
+                edge_radius,
+            } => {
                 let c = [radius - edge_radius, edge_radius];
                 if p[0] <= c[0] {
                     line(p, [0.0, 0.0], [0.0, -1.0], 0.0)
@@ -182,7 +198,11 @@ mod tests {
         // The cap ends at r = 2.4148 mm, 1.8530 mm above the tip.
         let s = ToolShape::n1_needle();
         let p = s.project([2.4148, 1.8530 - 0.01]);
-        assert!((p.gap - 0.01 * (15f64).to_radians().sin()).abs() < 2e-4, "{}", p.gap);
+        assert!(
+            (p.gap - 0.01 * (15f64).to_radians().sin()).abs() < 2e-4,
+            "{}",
+            p.gap
+        );
         // A point on the cone axis-side far up is inside.
         assert!(s.project([1.0, 5.0]).gap < 0.0);
         assert!((s.project([0.0, -0.3]).gap - 0.3).abs() < 1e-14);
@@ -190,7 +210,14 @@ mod tests {
 
     #[test]
     fn derivatives_match_finite_differences() {
-        let pts = [[0.7, -0.4], [2.6, 1.0], [3.5, 6.0], [1.95, 0.05], [2.1, 0.5], [0.3, -0.01]];
+        let pts = [
+            [0.7, -0.4],
+            [2.6, 1.0],
+            [3.5, 6.0],
+            [1.95, 0.05],
+            [2.1, 0.5],
+            [0.3, -0.01],
+        ];
         let h = 1e-7;
         for s in shapes() {
             for p in pts {
@@ -201,11 +228,16 @@ mod tests {
                     b[j] -= h;
                     let (pa, pb) = (s.project(a), s.project(b));
                     let fd = |x: f64, y: f64| (x - y) / (2.0 * h);
-                    assert!((fd(pa.gap, pb.gap) - pr.normal[j]).abs() < 1e-6, "{s:?} {p:?}");
+                    assert!(
+                        (fd(pa.gap, pb.gap) - pr.normal[j]).abs() < 1e-6,
+                        "{s:?} {p:?}"
+                    );
                     assert!((fd(pa.xi, pb.xi) - pr.dxi[j]).abs() < 1e-6, "{s:?} {p:?}");
                     for i in 0..2 {
                         assert!((fd(pa.normal[i], pb.normal[i]) - pr.dnormal[i][j]).abs() < 1e-6);
-                        assert!((fd(pa.tangent[i], pb.tangent[i]) - pr.dtangent[i][j]).abs() < 1e-6);
+                        assert!(
+                            (fd(pa.tangent[i], pb.tangent[i]) - pr.dtangent[i][j]).abs() < 1e-6
+                        );
                     }
                 }
             }
