@@ -3,3 +3,6 @@
 //! Uncertainty quantification on any forward model (through palpate-core's
 //! trait only): MCMC posteriors and their diagnostics, designed experiments
 //! and ANOVA, and the sim-to-real gap diagnosis.
+
+pub mod likelihood;
+pub mod mcmc;

@@ -1,0 +1,18 @@
+//! Priors, noise models and the posterior of a forward model's parameters.
+//!
+//! * [`Prior`]: flat, uniform, normal, log-normal, half-normal.
+//! * [`NoiseModel`]: Gaussian noise with known or inferred SD, independent or
+//!   AR(1)-correlated (exact likelihood).
+//! * [`Posterior`]: data sets + priors as a [`crate::mcmc::LogDensity`] in the
+//!   unbounded space, with the transforms' log-Jacobian.
+//! * [`predictive_band`]: posterior predictive bands.
+
+pub mod noise;
+pub mod posterior;
+pub mod predictive;
+pub mod prior;
+
+pub use noise::{ar1_log_likelihood, gaussian_log_likelihood, Correlation, NoiseModel, NoiseSd};
+pub use posterior::{DataSet, LikelihoodError, Posterior};
+pub use predictive::{predictive_band, PredictiveBand};
+pub use prior::Prior;

@@ -1,0 +1,315 @@
+//! The posterior of a forward model's parameters given one or more data sets,
+//! as a log-density in the unbounded space of palpate-core's transforms.
+//!
+//! With physical parameters x = x(z) (the model's parameters followed by the
+//! inferred noise parameters of each data set),
+//!
+//!   log p(z | y) = sum_k log p_k(x_k) + log |dx/dz| + sum_s log L_s(y_s | x)  + const,
+//!
+//! where L_s is the Gaussian (independent or AR(1)) likelihood of data set s
+//! ([`super::noise`]) and log |dx/dz| the log-Jacobian of the bound transforms
+//! ([`ParamSpace::log_jacobian`]), so that a sampler moving in z draws from
+//! the posterior of x. A forward-model error (a parameter the model rejects,
+//! a non-converged solve) gives `-inf`: the point is rejected.
+
+use super::noise::{ar1_log_likelihood, gaussian_log_likelihood, Correlation, NoiseModel, NoiseSd};
+use super::prior::Prior;
+use crate::mcmc::{DensityWorker, LogDensity};
+use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec};
+use std::sync::Arc;
+use thiserror::Error;
+
+/// Why a posterior could not be set up.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum LikelihoodError {
+    #[error("no data set")]
+    NoData,
+    #[error("data set `{name}`: {observed} observations for {samples} loading samples")]
+    LengthMismatch {
+        name: String,
+        observed: usize,
+        samples: usize,
+    },
+    #[error("data set `{name}`: its model has parameters {got:?}, the first data set's model has {expected:?}")]
+    ParameterMismatch {
+        name: String,
+        expected: Vec<String>,
+        got: Vec<String>,
+    },
+    #[error("{priors} priors given for {params} model parameters")]
+    PriorCount { priors: usize, params: usize },
+    #[error("prior of `{name}`: {reason}")]
+    InvalidPrior { name: String, reason: String },
+    #[error("data set `{name}`: {reason}")]
+    InvalidNoise { name: String, reason: String },
+}
+
+/// One data set: a model of the experiment, its loading, what was observed
+/// and the noise model.
+#[derive(Clone)]
+pub struct DataSet {
+    /// Short name, used to name its noise parameters (`sigma_<name>`).
+    pub name: String,
+    pub model: Arc<dyn ForwardModel>,
+    pub loading: Loading,
+    pub observed: Vec<f64>,
+    pub noise: NoiseModel,
+}
+
+#[derive(Debug, Clone, Copy)]
+struct NoiseSlots {
+    sigma: Option<usize>,
+    phi: Option<usize>,
+}
+
+/// The posterior of the model parameters (and inferred noise parameters).
+pub struct Posterior {
+    datasets: Vec<DataSet>,
+    space: ParamSpace,
+    priors: Vec<Prior>,
+    n_model: usize,
+    slots: Vec<NoiseSlots>,
+}
+
+impl Posterior {
+    /// A posterior from data sets whose models share one parameter space, and
+    /// one prior per model parameter (noise priors are in the noise models).
+    pub fn new(
+        datasets: Vec<DataSet>,
+        model_priors: Vec<Prior>,
+    ) -> Result<Posterior, LikelihoodError> {
+        let first = datasets.first().ok_or(LikelihoodError::NoData)?;
+        let base = first.model.space().clone();
+        if model_priors.len() != base.len() {
+            return Err(LikelihoodError::PriorCount {
+                priors: model_priors.len(),
+                params: base.len(),
+            });
+        }
+        let mut specs = base.params.clone();
+        let mut priors = model_priors;
+        for (p, spec) in priors.iter().zip(&specs) {
+            p.validate()
+                .map_err(|reason| LikelihoodError::InvalidPrior {
+                    name: spec.name.clone(),
+                    reason,
+                })?;
+        }
+        let single = datasets.len() == 1;
+        let mut slots = Vec::new();
+        for ds in &datasets {
+            if ds.model.space().names() != base.names() {
+                return Err(LikelihoodError::ParameterMismatch {
+                    name: ds.name.clone(),
+                    expected: base.names(),
+                    got: ds.model.space().names(),
+                });
+            }
+            if ds.observed.len() != ds.loading.len() {
+                return Err(LikelihoodError::LengthMismatch {
+                    name: ds.name.clone(),
+                    observed: ds.observed.len(),
+                    samples: ds.loading.len(),
+                });
+            }
+            let suffix = if single {
+                String::new()
+            } else {
+                format!("_{}", ds.name)
+            };
+            let bad = |reason: String| LikelihoodError::InvalidNoise {
+                name: ds.name.clone(),
+                reason,
+            };
+            let unit = match ds.model.observable() {
+                palpate_core::Observable::ForceN => "N",
+                palpate_core::Observable::NominalStressMPa => "MPa",
+            };
+            let scale = ds
+                .observed
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+                .max(1e-300);
+            let sigma = match ds.noise.sd {
+                NoiseSd::Known(s) if s.is_finite() && s > 0.0 => None,
+                NoiseSd::Known(s) => {
+                    return Err(bad(format!("noise SD must be positive, got {s}")))
+                }
+                NoiseSd::Inferred(p) => {
+                    p.validate().map_err(bad)?;
+                    specs.push(ParamSpec::new(
+                        format!("sigma{suffix}"),
+                        unit,
+                        0.0,
+                        f64::INFINITY,
+                        0.02 * scale,
+                    ));
+                    priors.push(p);
+                    Some(specs.len() - 1)
+                }
+            };
+            let phi = match ds.noise.correlation {
+                Correlation::Independent => None,
+                Correlation::Ar1Known(f) if f > -1.0 && f < 1.0 => None,
+                Correlation::Ar1Known(f) => {
+                    return Err(bad(format!(
+                        "AR(1) coefficient must lie in (-1, 1), got {f}"
+                    )))
+                }
+                Correlation::Ar1Inferred(p) => {
+                    p.validate().map_err(bad)?;
+                    specs.push(ParamSpec::new(format!("phi{suffix}"), "1", -1.0, 1.0, 0.0));
+                    priors.push(p);
+                    Some(specs.len() - 1)
+                }
+            };
+            slots.push(NoiseSlots { sigma, phi });
+        }
+        Ok(Posterior {
+            n_model: base.len(),
+            datasets,
+            space: ParamSpace::new(specs),
+            priors,
+            slots,
+        })
+    }
+
+    /// All parameters: the model's, then each data set's inferred sigma and phi.
+    pub fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+
+    /// Number of model parameters (the first entries of a parameter vector).
+    pub fn n_model(&self) -> usize {
+        self.n_model
+    }
+
+    /// Parameter names.
+    pub fn names(&self) -> Vec<String> {
+        self.space.names()
+    }
+
+    /// The data sets.
+    pub fn datasets(&self) -> &[DataSet] {
+        &self.datasets
+    }
+
+    /// Priors of all parameters, in the order of [`Posterior::space`].
+    pub fn priors(&self) -> &[Prior] {
+        &self.priors
+    }
+
+    /// Whether every prior is proper (the evidence is then meaningful).
+    pub fn priors_proper(&self) -> bool {
+        self.priors.iter().all(Prior::is_proper)
+    }
+
+    /// Noise SD and AR(1) coefficient of data set `s` at parameters `x`.
+    pub fn noise_at(&self, s: usize, x: &[f64]) -> (f64, f64) {
+        let ds = &self.datasets[s];
+        let sigma = match (ds.noise.sd, self.slots[s].sigma) {
+            (NoiseSd::Known(v), _) => v,
+            (_, Some(i)) => x[i],
+            _ => f64::NAN,
+        };
+        let phi = match (ds.noise.correlation, self.slots[s].phi) {
+            (Correlation::Ar1Known(f), _) => f,
+            (_, Some(i)) => x[i],
+            _ => 0.0,
+        };
+        (sigma, phi)
+    }
+
+    /// Model predictions of data set `s` at physical parameters `x`.
+    pub fn predict(&self, s: usize, x: &[f64]) -> Result<Vec<f64>, ForwardError> {
+        let ds = &self.datasets[s];
+        ds.model.predict(&x[..self.n_model], &ds.loading)
+    }
+
+    /// Log prior + log-likelihood at physical parameters `x` (no Jacobian):
+    /// the posterior density of x, up to the evidence.
+    pub fn log_posterior_physical(&self, x: &[f64]) -> f64 {
+        let mut w = self.make_worker();
+        w.log_physical(x)
+    }
+
+    fn make_worker(&self) -> PosteriorWorker<'_> {
+        PosteriorWorker {
+            post: self,
+            evaluators: self.datasets.iter().map(|d| d.model.evaluator()).collect(),
+            pred: self
+                .datasets
+                .iter()
+                .map(|d| vec![0.0; d.loading.len()])
+                .collect(),
+            x: vec![0.0; self.space.len()],
+        }
+    }
+}
+
+struct PosteriorWorker<'a> {
+    post: &'a Posterior,
+    evaluators: Vec<Box<dyn Evaluator + 'a>>,
+    pred: Vec<Vec<f64>>,
+    x: Vec<f64>,
+}
+
+impl PosteriorWorker<'_> {
+    fn log_physical(&mut self, x: &[f64]) -> f64 {
+        let post = self.post;
+        let mut lp = 0.0;
+        for (p, &v) in post.priors.iter().zip(x) {
+            lp += p.log_density(v);
+        }
+        if !lp.is_finite() {
+            return f64::NEG_INFINITY;
+        }
+        for s in 0..post.datasets.len() {
+            let ds = &post.datasets[s];
+            let pred = &mut self.pred[s];
+            if self.evaluators[s]
+                .predict_into(&x[..post.n_model], &ds.loading, pred)
+                .is_err()
+            {
+                return f64::NEG_INFINITY;
+            }
+            for (r, o) in pred.iter_mut().zip(&ds.observed) {
+                *r = o - *r;
+            }
+            let (sigma, phi) = post.noise_at(s, x);
+            if sigma.is_nan() || sigma <= 0.0 || phi.is_nan() || phi.abs() >= 1.0 {
+                return f64::NEG_INFINITY;
+            }
+            lp += match ds.noise.correlation {
+                Correlation::Independent => gaussian_log_likelihood(pred, sigma),
+                _ => ar1_log_likelihood(pred, sigma, phi),
+            };
+        }
+        lp
+    }
+}
+
+impl DensityWorker for PosteriorWorker<'_> {
+    fn log_density(&mut self, z: &[f64]) -> f64 {
+        let post = self.post;
+        for (k, (p, &v)) in post.space.params.iter().zip(z).enumerate() {
+            self.x[k] = p.from_unbounded(v);
+            if !p.contains(self.x[k]) {
+                return f64::NEG_INFINITY;
+            }
+        }
+        let x = std::mem::take(&mut self.x);
+        let lp = self.log_physical(&x) + post.space.log_jacobian(z);
+        self.x = x;
+        lp
+    }
+}
+
+impl LogDensity for Posterior {
+    fn dim(&self) -> usize {
+        self.space.len()
+    }
+    fn worker(&self) -> Box<dyn DensityWorker + '_> {
+        Box::new(self.make_worker())
+    }
+}

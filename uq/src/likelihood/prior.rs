@@ -1,0 +1,223 @@
+//! Priors on one physical parameter.
+
+use serde::{Deserialize, Serialize};
+use std::fmt;
+use std::str::FromStr;
+
+const LN_SQRT_2PI: f64 = 0.918_938_533_204_672_8;
+
+/// A prior density on a physical parameter value x.
+///
+/// * `Flat`: p(x) ∝ 1 inside the parameter's bounds (improper when a bound is infinite).
+/// * `Uniform { lower, upper }`: 1 / (upper - lower) on [lower, upper].
+/// * `Normal { mean, sd }`: N(mean, sd^2).
+/// * `LogNormal { mu, sigma }`: ln x ~ N(mu, sigma^2), x > 0.
+/// * `HalfNormal { sd }`: 2 N(x; 0, sd^2) for x >= 0.
+///
+/// Spelled in the CLI and manifests as `flat`, `uniform:L,U`, `normal:M,S`,
+/// `lognormal:MU,SIGMA`, `halfnormal:S`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Prior {
+    Flat,
+    Uniform { lower: f64, upper: f64 },
+    Normal { mean: f64, sd: f64 },
+    LogNormal { mu: f64, sigma: f64 },
+    HalfNormal { sd: f64 },
+}
+
+impl Prior {
+    /// log p(x), normalised (0 for `Flat`); `-inf` outside the support.
+    pub fn log_density(&self, x: f64) -> f64 {
+        match *self {
+            Prior::Flat => 0.0,
+            Prior::Uniform { lower, upper } => {
+                if x >= lower && x <= upper {
+                    -(upper - lower).ln()
+                } else {
+                    f64::NEG_INFINITY
+                }
+            }
+            Prior::Normal { mean, sd } => {
+                let u = (x - mean) / sd;
+                -0.5 * u * u - sd.ln() - LN_SQRT_2PI
+            }
+            Prior::LogNormal { mu, sigma } => {
+                if x <= 0.0 {
+                    return f64::NEG_INFINITY;
+                }
+                let u = (x.ln() - mu) / sigma;
+                -0.5 * u * u - sigma.ln() - LN_SQRT_2PI - x.ln()
+            }
+            Prior::HalfNormal { sd } => {
+                if x < 0.0 {
+                    return f64::NEG_INFINITY;
+                }
+                let u = x / sd;
+                -0.5 * u * u - sd.ln() - LN_SQRT_2PI + std::f64::consts::LN_2
+            }
+        }
+    }
+
+    /// Whether the prior integrates to one (needed for a meaningful evidence).
+    pub fn is_proper(&self) -> bool {
+        !matches!(self, Prior::Flat)
+    }
+
+    /// Checks the prior's own numbers.
+    pub fn validate(&self) -> Result<(), String> {
+        let ok = match *self {
+            Prior::Flat => true,
+            Prior::Uniform { lower, upper } => {
+                lower.is_finite() && upper.is_finite() && upper > lower
+            }
+            Prior::Normal { mean, sd } => mean.is_finite() && sd.is_finite() && sd > 0.0,
+            Prior::LogNormal { mu, sigma } => mu.is_finite() && sigma.is_finite() && sigma > 0.0,
+            Prior::HalfNormal { sd } => sd.is_finite() && sd > 0.0,
+        };
+        if ok {
+            Ok(())
+        } else {
+            Err(format!(
+                "invalid prior {self}: widths must be positive and finite"
+            ))
+        }
+    }
+}
+
+impl fmt::Display for Prior {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Prior::Flat => write!(f, "flat"),
+            Prior::Uniform { lower, upper } => write!(f, "uniform:{lower},{upper}"),
+            Prior::Normal { mean, sd } => write!(f, "normal:{mean},{sd}"),
+            Prior::LogNormal { mu, sigma } => write!(f, "lognormal:{mu},{sigma}"),
+            Prior::HalfNormal { sd } => write!(f, "halfnormal:{sd}"),
+        }
+    }
+}
+
+impl FromStr for Prior {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        let (kind, args) = s.split_once(':').unwrap_or((s, ""));
+        let nums: Vec<f64> = if args.is_empty() {
+            Vec::new()
+        } else {
+            args.split(',')
+                .map(|a| {
+                    a.trim()
+                        .parse::<f64>()
+                        .map_err(|_| format!("prior `{s}`: `{a}` is not a number"))
+                })
+                .collect::<Result<_, _>>()?
+        };
+        let need = |n: usize| {
+            if nums.len() == n {
+                Ok(())
+            } else {
+                Err(format!(
+                    "prior `{s}`: `{kind}` takes {n} numbers, got {}",
+                    nums.len()
+                ))
+            }
+        };
+        let p = match kind.trim().to_ascii_lowercase().as_str() {
+            "flat" => {
+                need(0)?;
+                Prior::Flat
+            }
+            "uniform" => {
+                need(2)?;
+                Prior::Uniform { lower: nums[0], upper: nums[1] }
+            }
+            "normal" => {
+                need(2)?;
+                Prior::Normal { mean: nums[0], sd: nums[1] }
+            }
+            "lognormal" | "log-normal" => {
+                need(2)?;
+                Prior::LogNormal { mu: nums[0], sigma: nums[1] }
+            }
+            "halfnormal" | "half-normal" => {
+                need(1)?;
+                Prior::HalfNormal { sd: nums[0] }
+            }
+            other => {
+                return Err(format!(
+                    "unknown prior `{other}`; expected flat, uniform:L,U, normal:M,S, lognormal:MU,SIGMA or halfnormal:S"
+                ))
+            }
+        };
+        p.validate()?;
+        Ok(p)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Trapezoidal integral of exp(log p) over [a, b].
+    fn integral(p: Prior, a: f64, b: f64) -> f64 {
+        let n = 200_000;
+        let h = (b - a) / n as f64;
+        (0..=n)
+            .map(|i| {
+                let w = if i == 0 || i == n { 0.5 } else { 1.0 };
+                w * p.log_density(a + i as f64 * h).exp()
+            })
+            .sum::<f64>()
+            * h
+    }
+
+    #[test]
+    fn proper_priors_integrate_to_one() {
+        for (p, a, b) in [
+            (
+                Prior::Uniform {
+                    lower: 1.0,
+                    upper: 3.0,
+                },
+                0.0,
+                4.0,
+            ),
+            (Prior::Normal { mean: 1.0, sd: 0.5 }, -5.0, 7.0),
+            (
+                Prior::LogNormal {
+                    mu: 0.2,
+                    sigma: 0.4,
+                },
+                1e-9,
+                20.0,
+            ),
+            (Prior::HalfNormal { sd: 2.0 }, 0.0, 30.0),
+        ] {
+            let i = integral(p, a, b);
+            assert!((i - 1.0).abs() < 2e-4, "{p}: {i}");
+        }
+    }
+
+    #[test]
+    fn parses_and_rejects() {
+        for s in [
+            "flat",
+            "uniform:0,1",
+            "normal:1e-3,2e-4",
+            "lognormal:-7,0.5",
+            "halfnormal:0.1",
+        ] {
+            let p: Prior = s.parse().unwrap();
+            assert_eq!(p.to_string().parse::<Prior>().unwrap(), p);
+        }
+        assert!("normal:1"
+            .parse::<Prior>()
+            .unwrap_err()
+            .contains("2 numbers"));
+        assert!("normal:1,-1".parse::<Prior>().is_err());
+        assert!("gamma:1,1"
+            .parse::<Prior>()
+            .unwrap_err()
+            .contains("unknown prior"));
+    }
+}
