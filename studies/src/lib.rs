@@ -4,6 +4,10 @@
 //! SVG plots, VTK output wiring, and the `palpate` command-line tool (one
 //! module per subcommand under [`cli`]).
 
+pub mod calibration;
 pub mod cli;
+pub mod manifest;
 pub mod output;
 pub mod plot;
+pub mod provenance;
+pub mod runner;

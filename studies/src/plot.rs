@@ -34,15 +34,33 @@ pub struct Series {
 impl Series {
     /// A solid line.
     pub fn line(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
-        Series { label: label.into(), x: x.to_vec(), y: y.to_vec(), style: Style::Line, color: None }
+        Series {
+            label: label.into(),
+            x: x.to_vec(),
+            y: y.to_vec(),
+            style: Style::Line,
+            color: None,
+        }
     }
     /// Markers only (measured data).
     pub fn markers(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
-        Series { label: label.into(), x: x.to_vec(), y: y.to_vec(), style: Style::Markers, color: None }
+        Series {
+            label: label.into(),
+            x: x.to_vec(),
+            y: y.to_vec(),
+            style: Style::Markers,
+            color: None,
+        }
     }
     /// A dashed line.
     pub fn dashed(label: impl Into<String>, x: &[f64], y: &[f64]) -> Self {
-        Series { label: label.into(), x: x.to_vec(), y: y.to_vec(), style: Style::Dashed, color: None }
+        Series {
+            label: label.into(),
+            x: x.to_vec(),
+            y: y.to_vec(),
+            style: Style::Dashed,
+            color: None,
+        }
     }
     /// Sets the colour.
     pub fn color(mut self, c: impl Into<String>) -> Self {
@@ -86,11 +104,17 @@ pub struct Plot {
     pub height: f64,
 }
 
-const PALETTE: [&str; 8] = ["#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf"];
+const PALETTE: [&str; 8] = [
+    "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
+];
 
 impl Plot {
     /// Empty axes with a title and axis labels, 640 x 420 px.
-    pub fn new(title: impl Into<String>, x_label: impl Into<String>, y_label: impl Into<String>) -> Self {
+    pub fn new(
+        title: impl Into<String>,
+        x_label: impl Into<String>,
+        y_label: impl Into<String>,
+    ) -> Self {
         Plot {
             title: title.into(),
             x_label: x_label.into(),
@@ -146,7 +170,13 @@ impl Plot {
         }
         for b in &self.bands {
             xs.extend(b.x.iter().copied().filter(|v| v.is_finite()));
-            ys.extend(b.lower.iter().chain(&b.upper).copied().filter(|v| v.is_finite()));
+            ys.extend(
+                b.lower
+                    .iter()
+                    .chain(&b.upper)
+                    .copied()
+                    .filter(|v| v.is_finite()),
+            );
         }
         ys.extend(self.hlines.iter().copied());
         let span = |v: &[f64]| {
@@ -163,7 +193,11 @@ impl Plot {
         let (x0, x1) = span(&xs);
         let (y0, y1) = span(&ys);
         let py = 0.05 * (y1 - y0);
-        let px = if self.series.iter().any(|s| matches!(s.style, Style::Bars(_) | Style::HBars(_))) {
+        let px = if self
+            .series
+            .iter()
+            .any(|s| matches!(s.style, Style::Bars(_) | Style::HBars(_)))
+        {
             0.05 * (x1 - x0)
         } else {
             0.0
@@ -173,7 +207,16 @@ impl Plot {
 
     /// Draws the axes with their top-left corner at (ox, oy).
     pub fn draw(&self, out: &mut String, ox: f64, oy: f64) {
-        let (ml, mr, mt, mb) = (if self.y_categories.is_some() { 130.0 } else { 70.0 }, 20.0, 34.0, 50.0);
+        let (ml, mr, mt, mb) = (
+            if self.y_categories.is_some() {
+                130.0
+            } else {
+                70.0
+            },
+            20.0,
+            34.0,
+            50.0,
+        );
         let (pw, ph) = (self.width - ml - mr, self.height - mt - mb);
         let ((x0, x1), (y0, y1)) = self.ranges();
         let sx = |x: f64| ox + ml + (x - x0) / (x1 - x0) * pw;
@@ -201,21 +244,51 @@ impl Plot {
         // Grid and ticks.
         let xticks = match &self.x_categories {
             Some(c) => (0..c.len()).map(|i| (i as f64, c[i].clone())).collect(),
-            None => ticks(x0, x1).into_iter().map(|t| (t, tick_label(t))).collect::<Vec<_>>(),
+            None => ticks(x0, x1)
+                .into_iter()
+                .map(|t| (t, tick_label(t)))
+                .collect::<Vec<_>>(),
         };
         let yticks = match &self.y_categories {
             Some(c) => (0..c.len()).map(|i| (i as f64, c[i].clone())).collect(),
-            None => ticks(y0, y1).into_iter().map(|t| (t, tick_label(t))).collect::<Vec<_>>(),
+            None => ticks(y0, y1)
+                .into_iter()
+                .map(|t| (t, tick_label(t)))
+                .collect::<Vec<_>>(),
         };
         for (t, l) in &xticks {
             let x = sx(*t);
-            let _ = writeln!(out, r##"<line x1="{x}" y1="{}" x2="{x}" y2="{}" stroke="#e0e0e0"/>"##, fmt(oy + mt), fmt(oy + mt + ph), x = fmt(x));
-            let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="11" text-anchor="middle">{}</text>"#, fmt(x), fmt(oy + mt + ph + 16.0), esc(l));
+            let _ = writeln!(
+                out,
+                r##"<line x1="{x}" y1="{}" x2="{x}" y2="{}" stroke="#e0e0e0"/>"##,
+                fmt(oy + mt),
+                fmt(oy + mt + ph),
+                x = fmt(x)
+            );
+            let _ = writeln!(
+                out,
+                r#"<text x="{}" y="{}" font-size="11" text-anchor="middle">{}</text>"#,
+                fmt(x),
+                fmt(oy + mt + ph + 16.0),
+                esc(l)
+            );
         }
         for (t, l) in &yticks {
             let y = sy(*t);
-            let _ = writeln!(out, r##"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="#e0e0e0"/>"##, fmt(ox + ml), fmt(ox + ml + pw), y = fmt(y));
-            let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="11" text-anchor="end">{}</text>"#, fmt(ox + ml - 5.0), fmt(y + 4.0), esc(l));
+            let _ = writeln!(
+                out,
+                r##"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="#e0e0e0"/>"##,
+                fmt(ox + ml),
+                fmt(ox + ml + pw),
+                y = fmt(y)
+            );
+            let _ = writeln!(
+                out,
+                r#"<text x="{}" y="{}" font-size="11" text-anchor="end">{}</text>"#,
+                fmt(ox + ml - 5.0),
+                fmt(y + 4.0),
+                esc(l)
+            );
         }
         let _ = writeln!(
             out,
@@ -225,7 +298,13 @@ impl Plot {
             fmt(pw),
             fmt(ph)
         );
-        let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="12" text-anchor="middle">{}</text>"#, fmt(ox + ml + pw / 2.0), fmt(oy + self.height - 10.0), esc(&self.x_label));
+        let _ = writeln!(
+            out,
+            r#"<text x="{}" y="{}" font-size="12" text-anchor="middle">{}</text>"#,
+            fmt(ox + ml + pw / 2.0),
+            fmt(oy + self.height - 10.0),
+            esc(&self.x_label)
+        );
         let (lx, ly) = (ox + 14.0, oy + mt + ph / 2.0);
         let _ = writeln!(
             out,
@@ -237,37 +316,74 @@ impl Plot {
             esc(&self.y_label)
         );
         for &h in &self.hlines {
-            let _ = writeln!(out, r##"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="#555" stroke-dasharray="2,3"/>"##, fmt(ox + ml), fmt(ox + ml + pw), y = fmt(sy(h)));
+            let _ = writeln!(
+                out,
+                r##"<line x1="{}" y1="{y}" x2="{}" y2="{y}" stroke="#555" stroke-dasharray="2,3"/>"##,
+                fmt(ox + ml),
+                fmt(ox + ml + pw),
+                y = fmt(sy(h))
+            );
         }
         for b in &self.bands {
             let mut pts = String::new();
-            for (x, y) in b.x.iter().zip(&b.upper).chain(b.x.iter().zip(&b.lower).rev()) {
+            for (x, y) in
+                b.x.iter()
+                    .zip(&b.upper)
+                    .chain(b.x.iter().zip(&b.lower).rev())
+            {
                 let _ = write!(pts, "{},{} ", fmt(sx(*x)), fmt(sy(*y)));
             }
-            let _ = writeln!(out, r#"<polygon points="{}" fill="{}" fill-opacity="0.25" stroke="none"/>"#, pts.trim_end(), b.color);
+            let _ = writeln!(
+                out,
+                r#"<polygon points="{}" fill="{}" fill-opacity="0.25" stroke="none"/>"#,
+                pts.trim_end(),
+                b.color
+            );
         }
         let mut legend = Vec::new();
         for (k, s) in self.series.iter().enumerate() {
-            let c = s.color.clone().unwrap_or_else(|| PALETTE[k % PALETTE.len()].to_string());
+            let c = s
+                .color
+                .clone()
+                .unwrap_or_else(|| PALETTE[k % PALETTE.len()].to_string());
             match s.style {
                 Style::Line | Style::Dashed => {
                     let mut d = String::new();
                     let mut pen = false;
                     for (x, y) in s.x.iter().zip(&s.y) {
                         if x.is_finite() && y.is_finite() {
-                            let _ = write!(d, "{}{},{} ", if pen { "L" } else { "M" }, fmt(sx(*x)), fmt(sy(*y)));
+                            let _ = write!(
+                                d,
+                                "{}{},{} ",
+                                if pen { "L" } else { "M" },
+                                fmt(sx(*x)),
+                                fmt(sy(*y))
+                            );
                             pen = true;
                         } else {
                             pen = false;
                         }
                     }
-                    let dash = if s.style == Style::Dashed { r#" stroke-dasharray="6,4""# } else { "" };
-                    let _ = writeln!(out, r#"<path d="{}" fill="none" stroke="{c}" stroke-width="1.8"{dash}/>"#, d.trim_end());
+                    let dash = if s.style == Style::Dashed {
+                        r#" stroke-dasharray="6,4""#
+                    } else {
+                        ""
+                    };
+                    let _ = writeln!(
+                        out,
+                        r#"<path d="{}" fill="none" stroke="{c}" stroke-width="1.8"{dash}/>"#,
+                        d.trim_end()
+                    );
                 }
                 Style::Markers => {
                     for (x, y) in s.x.iter().zip(&s.y) {
                         if x.is_finite() && y.is_finite() {
-                            let _ = writeln!(out, r#"<circle cx="{}" cy="{}" r="2.6" fill="none" stroke="{c}"/>"#, fmt(sx(*x)), fmt(sy(*y)));
+                            let _ = writeln!(
+                                out,
+                                r#"<circle cx="{}" cy="{}" r="2.6" fill="none" stroke="{c}"/>"#,
+                                fmt(sx(*x)),
+                                fmt(sy(*y))
+                            );
                         }
                     }
                 }
@@ -275,14 +391,28 @@ impl Plot {
                     for (x, y) in s.x.iter().zip(&s.y) {
                         let (a, b) = (sx(x - w / 2.0), sx(x + w / 2.0));
                         let (top, bot) = (sy(y.max(0.0)), sy(y.min(0.0)));
-                        let _ = writeln!(out, r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{c}"/>"#, fmt(a), fmt(top), fmt(b - a), fmt(bot - top));
+                        let _ = writeln!(
+                            out,
+                            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{c}"/>"#,
+                            fmt(a),
+                            fmt(top),
+                            fmt(b - a),
+                            fmt(bot - top)
+                        );
                     }
                 }
                 Style::HBars(hgt) => {
                     for (x, y) in s.x.iter().zip(&s.y) {
                         let (l, r) = (sx(x.min(0.0)), sx(x.max(0.0)));
                         let (top, bot) = (sy(y + hgt / 2.0), sy(y - hgt / 2.0));
-                        let _ = writeln!(out, r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{c}"/>"#, fmt(l), fmt(top), fmt(r - l), fmt(bot - top));
+                        let _ = writeln!(
+                            out,
+                            r#"<rect x="{}" y="{}" width="{}" height="{}" fill="{c}"/>"#,
+                            fmt(l),
+                            fmt(top),
+                            fmt(r - l),
+                            fmt(bot - top)
+                        );
                     }
                 }
             }
@@ -300,16 +430,39 @@ impl Plot {
             let x = ox + ml + 10.0;
             match style {
                 Style::Markers => {
-                    let _ = writeln!(out, r#"<circle cx="{}" cy="{}" r="3" fill="none" stroke="{c}"/>"#, fmt(x + 9.0), fmt(y - 4.0));
+                    let _ = writeln!(
+                        out,
+                        r#"<circle cx="{}" cy="{}" r="3" fill="none" stroke="{c}"/>"#,
+                        fmt(x + 9.0),
+                        fmt(y - 4.0)
+                    );
                 }
                 Style::Line | Style::Dashed => {
-                    let _ = writeln!(out, r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{c}" stroke-width="2"/>"#, fmt(x), fmt(y - 4.0), fmt(x + 18.0), fmt(y - 4.0));
+                    let _ = writeln!(
+                        out,
+                        r#"<line x1="{}" y1="{}" x2="{}" y2="{}" stroke="{c}" stroke-width="2"/>"#,
+                        fmt(x),
+                        fmt(y - 4.0),
+                        fmt(x + 18.0),
+                        fmt(y - 4.0)
+                    );
                 }
                 _ => {
-                    let _ = writeln!(out, r#"<rect x="{}" y="{}" width="18" height="8" fill="{c}" fill-opacity="0.6"/>"#, fmt(x), fmt(y - 8.0));
+                    let _ = writeln!(
+                        out,
+                        r#"<rect x="{}" y="{}" width="18" height="8" fill="{c}" fill-opacity="0.6"/>"#,
+                        fmt(x),
+                        fmt(y - 8.0)
+                    );
                 }
             }
-            let _ = writeln!(out, r#"<text x="{}" y="{}" font-size="11">{}</text>"#, fmt(x + 24.0), fmt(y), esc(label));
+            let _ = writeln!(
+                out,
+                r#"<text x="{}" y="{}" font-size="11">{}</text>"#,
+                fmt(x + 24.0),
+                fmt(y),
+                esc(label)
+            );
         }
     }
 }
@@ -330,10 +483,19 @@ pub fn grid_svg(cells: &[Option<Plot>], cols: usize, title: &str) -> String {
         h = fmt(h)
     );
     let _ = writeln!(out, r#"<rect width="100%" height="100%" fill="white"/>"#);
-    let _ = writeln!(out, r#"<text x="{}" y="20" font-size="15" text-anchor="middle">{}</text>"#, fmt(w / 2.0), esc(title));
+    let _ = writeln!(
+        out,
+        r#"<text x="{}" y="20" font-size="15" text-anchor="middle">{}</text>"#,
+        fmt(w / 2.0),
+        esc(title)
+    );
     for (i, cell) in cells.iter().enumerate() {
         if let Some(p) = cell {
-            p.draw(&mut out, (i % cols) as f64 * cw, 30.0 + (i / cols) as f64 * ch);
+            p.draw(
+                &mut out,
+                (i % cols) as f64 * cw,
+                30.0 + (i / cols) as f64 * ch,
+            );
         }
     }
     out.push_str("</svg>\n");
@@ -343,12 +505,16 @@ pub fn grid_svg(cells: &[Option<Plot>], cols: usize, title: &str) -> String {
 /// "Nice" tick positions (1, 2, 5 x 10^k steps) covering [lo, hi].
 pub fn ticks(lo: f64, hi: f64) -> Vec<f64> {
     let span = hi - lo;
-    if !(span > 0.0) || !span.is_finite() {
+    if span.is_nan() || span <= 0.0 || !span.is_finite() {
         return vec![lo];
     }
     let raw = span / 6.0;
     let mag = 10f64.powf(raw.log10().floor());
-    let step = [1.0, 2.0, 5.0, 10.0].iter().map(|m| m * mag).find(|s| span / s <= 7.0).unwrap_or(10.0 * mag);
+    let step = [1.0, 2.0, 5.0, 10.0]
+        .iter()
+        .map(|m| m * mag)
+        .find(|s| span / s <= 7.0)
+        .unwrap_or(10.0 * mag);
     let first = (lo / step).ceil() as i64;
     let last = (hi / step).floor() as i64;
     (first..=last).map(|k| k as f64 * step).collect()
@@ -378,7 +544,9 @@ fn fmt(v: f64) -> String {
 }
 
 fn esc(s: &str) -> String {
-    s.replace('&', "&amp;").replace('<', "&lt;").replace('>', "&gt;")
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
 }
 
 #[cfg(test)]
@@ -389,14 +557,19 @@ mod tests {
     fn ticks_are_nice_and_cover_range() {
         assert_eq!(ticks(0.0, 10.0), vec![0.0, 2.0, 4.0, 6.0, 8.0, 10.0]);
         let t = ticks(0.013, 0.087);
-        assert!(t.len() >= 3 && t[0] >= 0.013 && *t.last().unwrap() <= 0.087, "{t:?}");
+        assert!(
+            t.len() >= 3 && t[0] >= 0.013 && *t.last().unwrap() <= 0.087,
+            "{t:?}"
+        );
     }
 
     #[test]
     fn svg_is_deterministic_and_well_formed() {
         let x: Vec<f64> = (0..20).map(|i| i as f64 * 0.1).collect();
         let y: Vec<f64> = x.iter().map(|v| v * v).collect();
-        let mut p = Plot::new("t < 1", "x", "y").with(Series::markers("data", &x, &y)).with(Series::line("fit", &x, &y));
+        let mut p = Plot::new("t < 1", "x", "y")
+            .with(Series::markers("data", &x, &y))
+            .with(Series::line("fit", &x, &y));
         p.windows.push((0.5, 1.0));
         let a = p.to_svg();
         assert_eq!(a, p.to_svg());

@@ -106,8 +106,12 @@ impl Loading {
                 ));
             }
             for i in 1..t.len() {
-                if !(t[i] >= t[i - 1]) {
-                    return Err(format!("time decreases at sample {i}: {} -> {}", t[i - 1], t[i]));
+                if t[i].is_nan() || t[i] < t[i - 1] {
+                    return Err(format!(
+                        "time decreases at sample {i}: {} -> {}",
+                        t[i - 1],
+                        t[i]
+                    ));
                 }
             }
         }

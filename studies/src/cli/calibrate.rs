@@ -1,10 +1,246 @@
-//! `palpate calibrate` (not yet implemented).
+//! `palpate calibrate`: fit a hyperelastic law to homogeneous-test data or a
+//! C1 force record, print a table, optionally write JSON and an SVG plot.
 
-/// Options of `palpate calibrate`.
+use crate::calibration::{calibrate, parse_method, Calibration, Request, TestData, TestKind};
+use crate::output::{write_atomic, write_json};
+use crate::plot::{Plot, Series};
+use anyhow::Context;
+use palpate_inverse::ResidualKind;
+use palpate_material::Law;
+use std::path::PathBuf;
+
+/// Fit a hyperelastic law to measured data.
+///
+/// Homogeneous tests: `--data TEST=FILE` with TEST one of uniaxial, biaxial,
+/// planar and FILE a CSV with columns `stretch,stress_MPa` (nominal stress).
+/// Several --data options are fitted jointly with one parameter set.
+///
+/// Benchmark C1 (38 x 9 mm cylinder between lubricated platens):
+/// `--benchmark C1 --data FILE` with columns `displacement_mm,force_N`.
+///
+/// Example: palpate calibrate --law mooney-rivlin --data uniaxial=u.csv --data biaxial=b.csv --json fit.json
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N (N = 1..6),
+    /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N.
+    #[arg(long)]
+    pub law: String,
+    /// Data to fit: TEST=FILE for homogeneous tests (TEST = uniaxial, biaxial,
+    /// planar), or just FILE with --benchmark C1. Repeat to fit jointly.
+    #[arg(long = "data", required = true, value_name = "TEST=FILE")]
+    pub data: Vec<String>,
+    /// Fit a benchmark's force record instead of homogeneous stress data (C1).
+    #[arg(long, value_name = "ID")]
+    pub benchmark: Option<String>,
+    /// Residual: absolute (default), relative ((f-y)/y; zero-stress points
+    /// are left out) or normalised (each data set weighs equally).
+    #[arg(long, default_value = "absolute")]
+    pub residual: String,
+    /// Estimator: lm (Levenberg-Marquardt, default), bfgs or lbfgs (argmin).
+    #[arg(long, default_value = "lm")]
+    pub estimator: String,
+    /// Hold a parameter fixed, e.g. --fix C01=0 (MPa or dimensionless). Repeatable.
+    #[arg(long = "fix", value_name = "NAME=VALUE")]
+    pub fix: Vec<String>,
+    /// Write the result as JSON: each parameter by name with value and
+    /// standard error, R^2, RMS, iterations, evaluations, Drucker range.
+    #[arg(long, value_name = "OUT.json")]
+    pub json: Option<PathBuf>,
+    /// Draw the data against the fit (SVG).
+    #[arg(long, value_name = "OUT.svg")]
+    pub plot: Option<PathBuf>,
+}
+
+/// Splits `NAME=VALUE` (or `NAME=PATH`).
+pub fn split_pair<'a>(s: &'a str, what: &str) -> anyhow::Result<(&'a str, &'a str)> {
+    s.split_once('=')
+        .filter(|(a, b)| !a.is_empty() && !b.is_empty())
+        .ok_or_else(|| anyhow::anyhow!("`{s}`: expected {what}"))
+}
+
+/// Reads the `--data` options.
+pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec<TestData>> {
+    let mut out = Vec::new();
+    match benchmark {
+        Some(b) if b.eq_ignore_ascii_case("c1") => {
+            for d in data {
+                let path = d
+                    .strip_prefix("C1=")
+                    .or_else(|| d.strip_prefix("c1="))
+                    .unwrap_or(d);
+                out.push(TestData::read(
+                    "C1",
+                    TestKind::C1,
+                    std::path::Path::new(path),
+                )?);
+            }
+        }
+        Some(b) => anyhow::bail!(
+            "--benchmark {b}: calibration supports C1 (FE benchmarks are fitted through manifests)"
+        ),
+        None => {
+            for d in data {
+                let (test, path) = split_pair(
+                    d,
+                    "TEST=FILE, e.g. uniaxial=data.csv (or use --benchmark C1 --data FILE)",
+                )?;
+                let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
+                out.push(TestData::read(test, kind, std::path::Path::new(path))?);
+            }
+        }
+    }
+    Ok(out)
+}
 
 /// Runs `palpate calibrate`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`palpate calibrate` is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let law: Law = args
+        .law
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    let residual: ResidualKind = args
+        .residual
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
+    let method = parse_method(&args.estimator).context("--estimator")?;
+    let mut fixed = Vec::new();
+    for f in &args.fix {
+        let (name, value) = split_pair(f, "NAME=VALUE, e.g. C01=0")?;
+        let v: f64 = value
+            .parse()
+            .map_err(|_| anyhow::anyhow!("--fix {f}: `{value}` is not a number"))?;
+        fixed.push((name.to_string(), v));
+    }
+    let data = read_data(&args.data, args.benchmark.as_deref())?;
+    let result = calibrate(Request {
+        law,
+        fitted: &data,
+        predict: &[],
+        residual,
+        method,
+        fixed,
+        observer: None,
+    })?;
+    print!("{}", table(&result));
+    if let Some(p) = &args.json {
+        write_json(p, &result)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &args.plot {
+        write_atomic(p, fit_plot(&result).to_svg().as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// A readable table of a calibration.
+pub fn table(c: &Calibration) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "law {} fitted to {} ({} residuals, {})",
+        c.law,
+        c.data.join(" + "),
+        c.residual,
+        c.estimator
+    );
+    let _ = writeln!(
+        s,
+        "{:<10} {:>14} {:>14} {:>8}",
+        "parameter", "value", "std. error", "unit"
+    );
+    for (name, p) in c.params.iter() {
+        let se = match (p.fixed, p.standard_error) {
+            (true, _) => "fixed".to_string(),
+            (false, Some(e)) => format!("{e:.6e}"),
+            (false, None) => "n/a".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "{:<10} {:>14.6e} {:>14} {:>8}",
+            name, p.value, se, p.unit
+        );
+    }
+    let _ = writeln!(
+        s,
+        "R^2 {:.6}  RMS {:.4e}  SSE {:.6e}  iterations {}  evaluations {}  converged {}",
+        c.r2, c.rms, c.sse, c.iterations, c.evaluations, c.converged
+    );
+    if !c.identifiable {
+        let _ = writeln!(
+            s,
+            "NOT IDENTIFIABLE from these data: {} (condition number {:.2e}); values above are one of many equally good fits",
+            c.fit.identifiability.involved.join(", "),
+            c.fit.identifiability.condition_number
+        );
+    }
+    let d = &c.drucker;
+    let _ = writeln!(
+        s,
+        "Drucker stable stretch ranges: uniaxial [{:.3}, {:.3}]  biaxial [{:.3}, {:.3}]  planar [{:.3}, {:.3}]",
+        d.uniaxial.lower, d.uniaxial.upper, d.biaxial.lower, d.biaxial.upper, d.planar.lower, d.planar.upper
+    );
+    for p in &c.predictions {
+        let _ = writeln!(
+            s,
+            "  {:<12} {:<10} R^2 {:.5}  RMS {:.4e}",
+            p.data,
+            if p.fitted { "fitted" } else { "predicted" },
+            p.r2,
+            p.rms
+        );
+    }
+    s
+}
+
+/// Data (markers) against the fitted law (lines), one colour per data set.
+pub fn fit_plot(c: &Calibration) -> Plot {
+    let homogeneous = c.predictions.iter().all(|p| p.data != "C1");
+    let (xl, yl) = if homogeneous {
+        ("stretch", "nominal stress (MPa)")
+    } else {
+        ("displacement (mm)", "force (N)")
+    };
+    let mut plot = Plot::new(
+        format!(
+            "{} fitted to {} ({} residuals)",
+            c.law,
+            c.data.join(" + "),
+            c.residual
+        ),
+        xl,
+        yl,
+    );
+    const COLOURS: [&str; 6] = [
+        "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
+    ];
+    for (k, p) in c.predictions.iter().enumerate() {
+        let col = COLOURS[k % COLOURS.len()];
+        plot.push(
+            Series::markers(
+                format!("{} data", p.data),
+                &p.stretch_or_displacement,
+                &p.observed,
+            )
+            .color(col),
+        );
+        let (x, y) = (&p.stretch_or_displacement, &p.predicted);
+        let label = format!(
+            "{} {} (R^2 {:.4})",
+            p.data,
+            if p.fitted { "fit" } else { "prediction" },
+            p.r2
+        );
+        plot.push(
+            if p.fitted {
+                Series::line(label, x, y)
+            } else {
+                Series::dashed(label, x, y)
+            }
+            .color(col),
+        );
+    }
+    plot
 }

@@ -1,0 +1,305 @@
+//! Study manifests: one TOML file describes a whole study.
+//!
+//! Plain serde types with `deny_unknown_fields` (a misspelled field is an
+//! error with its line, reported by the TOML parser), then [`Manifest::validate`]
+//! checks every cross-reference and file and names the offending field.
+//! Steps are an externally tagged enum, so each `[[steps]]` table holds exactly
+//! one of `calibrate`, `diagnose`, `sample`, `anova` or `simulate`.
+//!
+//! ```toml
+//! [study]
+//! name = "treloar-laws"
+//! seed = 1
+//!
+//! [data.uniaxial]
+//! file = "data/treloar/uniaxial.csv"     # relative to the manifest
+//! test = "uniaxial"                      # uniaxial | biaxial | planar | C1
+//!
+//! [models.nh]
+//! law = "neo-hookean"
+//!
+//! [[steps]]
+//! [steps.calibrate]
+//! name = "laws"
+//! models = ["nh"]
+//! fits = { uniaxial = ["uniaxial"] }
+//! residuals = ["absolute", "relative"]
+//! ```
+
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A whole study.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Manifest {
+    pub study: StudyMeta,
+    #[serde(default)]
+    pub data: BTreeMap<String, DataSpec>,
+    #[serde(default)]
+    pub models: BTreeMap<String, ModelSpec>,
+    pub steps: Vec<Step>,
+}
+
+/// Name, description and seed of a study.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct StudyMeta {
+    pub name: String,
+    #[serde(default)]
+    pub description: String,
+    /// Seed for everything random in the study (noise, MCMC, run order).
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// One data file and the test it records.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DataSpec {
+    /// CSV file, relative to the manifest's directory.
+    pub file: PathBuf,
+    /// `uniaxial`, `biaxial`, `planar` (stretch, stress_MPa) or `C1` (displacement_mm, force_N[, time_s]).
+    pub test: String,
+}
+
+/// A material law, with parameters optionally held fixed.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ModelSpec {
+    /// `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N`, `yeoh`, `arruda-boyce`, `ogden:N`.
+    pub law: String,
+    /// Parameters held at a value during fits, by name (MPa or dimensionless).
+    #[serde(default)]
+    pub fixed: BTreeMap<String, f64>,
+}
+
+/// One step of a study.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Step {
+    Calibrate(CalibrateStep),
+    Diagnose(DiagnoseStep),
+}
+
+/// Fit every model to every group of data sets, with every residual kind.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateStep {
+    pub name: String,
+    /// Model names (keys of `[models]`).
+    pub models: Vec<String>,
+    /// Named groups of data sets fitted jointly, e.g. `{ all = ["uniaxial", "biaxial", "planar"] }`.
+    pub fits: BTreeMap<String, Vec<String>>,
+    /// Residual kinds: `absolute`, `relative`, `normalised`.
+    #[serde(default = "default_residuals")]
+    pub residuals: Vec<String>,
+    /// `lm`, `bfgs` or `lbfgs`.
+    #[serde(default = "default_estimator")]
+    pub estimator: String,
+    /// Data sets on which every fit is also evaluated (predictions of other modes).
+    #[serde(default)]
+    pub predict: Vec<String>,
+}
+
+/// Diagnose the sim-to-real gap of a base model on one C1 data set.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiagnoseStep {
+    pub name: String,
+    /// Data set names (each diagnosed separately).
+    pub data: Vec<String>,
+    /// Base law, e.g. `neo-hookean`.
+    pub base: String,
+}
+
+fn default_residuals() -> Vec<String> {
+    vec!["absolute".into()]
+}
+fn default_estimator() -> String {
+    "lm".into()
+}
+
+/// The kinds of test a data set can record.
+pub const TESTS: [&str; 4] = ["uniaxial", "biaxial", "planar", "C1"];
+
+impl Manifest {
+    /// Reads and parses a manifest; TOML and unknown-field errors carry the
+    /// file name and line.
+    pub fn read(path: &Path) -> anyhow::Result<Manifest> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("cannot read manifest {}: {e}", path.display()))?;
+        Manifest::parse(path, &text)
+    }
+
+    /// Parses manifest text (errors name `path`).
+    pub fn parse(path: &Path, text: &str) -> anyhow::Result<Manifest> {
+        toml::from_str(text)
+            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))
+    }
+
+    /// Checks every reference (models, data sets, laws, residual and
+    /// estimator names, files) and names the offending field.
+    pub fn validate(&self, manifest_path: &Path) -> anyhow::Result<()> {
+        let where_ = manifest_path.display();
+        let dir = manifest_path.parent().unwrap_or(Path::new("."));
+        for (name, d) in &self.data {
+            if !TESTS.contains(&d.test.as_str()) {
+                anyhow::bail!(
+                    "{where_}: data.{name}.test = \"{}\": expected one of {}",
+                    d.test,
+                    TESTS.join(", ")
+                );
+            }
+            let f = dir.join(&d.file);
+            if !f.is_file() {
+                anyhow::bail!("{where_}: data.{name}.file: no such file {}", f.display());
+            }
+        }
+        for (name, m) in &self.models {
+            if let Err(e) = m.law.parse::<palpate_material::Law>() {
+                anyhow::bail!("{where_}: models.{name}.law = \"{}\": {e}", m.law);
+            }
+        }
+        for (i, step) in self.steps.iter().enumerate() {
+            match step {
+                Step::Calibrate(c) => {
+                    let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
+                    for m in &c.models {
+                        if !self.models.contains_key(m) {
+                            anyhow::bail!(
+                                "{where_}: {at}.models: unknown model \"{m}\" (defined: {})",
+                                keys(&self.models)
+                            );
+                        }
+                    }
+                    if c.fits.is_empty() {
+                        anyhow::bail!(
+                            "{where_}: {at}.fits: at least one group of data sets is needed"
+                        );
+                    }
+                    for (g, sets) in &c.fits {
+                        if sets.is_empty() {
+                            anyhow::bail!("{where_}: {at}.fits.{g}: empty group");
+                        }
+                        for s in sets {
+                            if !self.data.contains_key(s) {
+                                anyhow::bail!("{where_}: {at}.fits.{g}: unknown data set \"{s}\" (defined: {})", keys(&self.data));
+                            }
+                        }
+                    }
+                    for s in &c.predict {
+                        if !self.data.contains_key(s) {
+                            anyhow::bail!(
+                                "{where_}: {at}.predict: unknown data set \"{s}\" (defined: {})",
+                                keys(&self.data)
+                            );
+                        }
+                    }
+                    for r in &c.residuals {
+                        if !["absolute", "relative", "normalised"].contains(&r.as_str()) {
+                            anyhow::bail!("{where_}: {at}.residuals: \"{r}\" is not one of absolute, relative, normalised");
+                        }
+                    }
+                    if !["lm", "bfgs", "lbfgs"].contains(&c.estimator.as_str()) {
+                        anyhow::bail!(
+                            "{where_}: {at}.estimator: \"{}\" is not one of lm, bfgs, lbfgs",
+                            c.estimator
+                        );
+                    }
+                }
+                Step::Diagnose(d) => {
+                    let at = format!("steps[{i}].diagnose (\"{}\")", d.name);
+                    for s in &d.data {
+                        match self.data.get(s) {
+                            None => anyhow::bail!(
+                                "{where_}: {at}.data: unknown data set \"{s}\" (defined: {})",
+                                keys(&self.data)
+                            ),
+                            Some(spec) if spec.test != "C1" => {
+                                anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 force record", spec.test)
+                            }
+                            _ => {}
+                        }
+                    }
+                    if let Err(e) = d.base.parse::<palpate_material::Law>() {
+                        anyhow::bail!("{where_}: {at}.base = \"{}\": {e}", d.base);
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn keys<V>(m: &BTreeMap<String, V>) -> String {
+    if m.is_empty() {
+        "none".into()
+    } else {
+        m.keys().cloned().collect::<Vec<_>>().join(", ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const GOOD: &str = r#"
+[study]
+name = "t"
+
+[data.uni]
+file = "x.csv"
+test = "uniaxial"
+
+[models.nh]
+law = "neo-hookean"
+
+[[steps]]
+[steps.calibrate]
+name = "fit"
+models = ["nh"]
+fits = { u = ["uni"] }
+"#;
+
+    #[test]
+    fn parses_a_good_manifest() {
+        let m = Manifest::parse(Path::new("s.toml"), GOOD).unwrap();
+        assert_eq!(m.steps.len(), 1);
+        assert!(
+            matches!(&m.steps[0], Step::Calibrate(c) if c.residuals == ["absolute"] && c.estimator == "lm")
+        );
+    }
+
+    #[test]
+    fn misspelled_field_is_an_error_with_its_line() {
+        let bad = GOOD.replace("models = [\"nh\"]", "modles = [\"nh\"]");
+        let e = Manifest::parse(Path::new("s.toml"), &bad)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("s.toml") && e.contains("modles") && e.contains("line 15"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn unknown_references_name_the_field() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("x.csv"), "stretch,stress_MPa\n1,0\n").unwrap();
+        let p = dir.path().join("s.toml");
+        let m =
+            Manifest::parse(&p, &GOOD.replace("models = [\"nh\"]", "models = [\"mr\"]")).unwrap();
+        let e = m.validate(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("steps[0].calibrate") && e.contains("\"mr\""),
+            "{e}"
+        );
+        let m = Manifest::parse(&p, &GOOD.replace("neo-hookean", "neo-hooke")).unwrap();
+        let e = m.validate(&p).unwrap_err().to_string();
+        assert!(e.contains("models.nh.law"), "{e}");
+        let m = Manifest::parse(&p, GOOD).unwrap();
+        m.validate(&p).unwrap();
+    }
+}
