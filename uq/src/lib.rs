@@ -4,5 +4,6 @@
 //! trait only): MCMC posteriors and their diagnostics, designed experiments
 //! and ANOVA, and the sim-to-real gap diagnosis.
 
+pub mod gap;
 pub mod likelihood;
 pub mod mcmc;

@@ -1,0 +1,557 @@
+//! The diagnosis itself: base fit, residual structure, candidates, verdict.
+
+use super::fit::{fit_from_starts, Fitted};
+use super::noise::difference_noise_sd;
+use super::report::{BaseSummary, GapPlot, GapReport, RankedEffect};
+use super::score::{score_test, sensitivities};
+use super::structure::{
+    chi2_isf, chi2_sf, default_window, discrepancy_band, lag1, significant_windows, whiteness,
+};
+use super::{GapError, GapOptions};
+use palpate_core::{Effect, ForwardError, ForwardModel, Loading};
+use rayon::prelude::*;
+use std::collections::BTreeMap;
+use std::sync::Arc;
+
+/// Fewest samples the diagnosis works with.
+const MIN_SAMPLES: usize = 16;
+
+/// -2 log-likelihood of residuals `r` under AR(1) Gaussian errors with the
+/// lag-1 coefficient and innovation variance at their estimates (exact
+/// likelihood of a stationary AR(1), Box & Jenkins): e_0 = sqrt(1 - rho^2) r_0,
+/// e_i = r_i - rho r_{i-1}, -2 log L = n ln(2 pi s^2) + n - ln(1 - rho^2),
+/// s^2 = sum e^2 / n. A misfit that is smooth (rho near 1) is partly absorbed by
+/// the correlation, so an extra parameter must remove more than what the
+/// correlation already explains.
+fn ar1_deviance(r: &[f64]) -> f64 {
+    let n = r.len() as f64;
+    let rho = lag1(r).clamp(-0.99, 0.99);
+    let c = (1.0 - rho * rho).sqrt();
+    let mut ss = (c * r[0]).powi(2);
+    for w in r.windows(2) {
+        ss += (w[1] - rho * w[0]).powi(2);
+    }
+    let s2 = (ss / n).max(f64::MIN_POSITIVE);
+    n * (2.0 * std::f64::consts::PI * s2).ln() + n - (1.0 - rho * rho).ln()
+}
+
+fn rms(v: &[f64]) -> f64 {
+    if v.is_empty() {
+        return 0.0;
+    }
+    (v.iter().map(|x| x * x).sum::<f64>() / v.len() as f64).sqrt()
+}
+
+fn residuals(observed: &[f64], predicted: &[f64]) -> Vec<f64> {
+    observed.iter().zip(predicted).map(|(y, f)| y - f).collect()
+}
+
+fn sse(r: &[f64]) -> f64 {
+    r.iter().map(|v| v * v).sum()
+}
+
+/// A shared model and the parameters held fixed in it.
+type Proxy = (Arc<dyn ForwardModel>, Vec<(String, f64)>);
+
+/// The base model as a shared (`Arc`) model the calibration can own: one of
+/// its enrichments with the effect's own parameters held at "off", which
+/// reproduces the base exactly. Preference goes to enrichments that need
+/// nothing from the history (zero offset, tool compliance, ...).
+fn base_proxy(base: &dyn ForwardModel, loading: &Loading) -> Result<Proxy, GapError> {
+    let order = [
+        Effect::ZeroOffset,
+        Effect::ToolCompliance,
+        Effect::Compressibility,
+        Effect::MaterialForm,
+        Effect::Viscoelasticity,
+    ];
+    let offered = base.effects();
+    let p = base.space().len();
+    let theta0 = base.space().initial();
+    let want = base.predict(&theta0, loading)?;
+    for effect in order.iter().chain(offered.iter()) {
+        if !offered.contains(effect) {
+            continue;
+        }
+        let Ok(rich) = base.enrich(*effect) else {
+            continue;
+        };
+        let off = rich.embed(&theta0);
+        if rich.space().names()[..p] != base.space().names()[..] {
+            continue;
+        }
+        if rich.predict(&off, loading).ok().as_ref() != Some(&want) {
+            continue;
+        }
+        let fixed = rich.space().params[p..]
+            .iter()
+            .zip(&off[p..])
+            .map(|(s, v)| (s.name.clone(), *v))
+            .collect();
+        return Ok((Arc::from(rich), fixed));
+    }
+    Err(GapError::InvalidOption {
+        option: "base",
+        reason: format!(
+            "{} offers no enrichment that reproduces it when switched off; nothing to diagnose",
+            base.name()
+        ),
+    })
+}
+
+/// Starting points of the base fit: the space's initial values, and the same
+/// with every parameter in MPa scaled by the least-squares factor
+/// <f0, y> / <f0, f0> (exact for laws linear in their moduli).
+fn base_starts(base: &dyn ForwardModel, loading: &Loading, observed: &[f64]) -> Vec<Vec<f64>> {
+    let theta0 = base.space().initial();
+    let mut starts = Vec::new();
+    if let Ok(f0) = base.predict(&theta0, loading) {
+        let ff: f64 = f0.iter().map(|v| v * v).sum();
+        let fy: f64 = f0.iter().zip(observed).map(|(a, b)| a * b).sum();
+        let a = fy / ff;
+        if a.is_finite() && a > 0.0 {
+            let scaled = base
+                .space()
+                .params
+                .iter()
+                .zip(&theta0)
+                .map(|(s, v)| if s.unit == "MPa" { v * a } else { *v })
+                .collect();
+            starts.push(scaled);
+        }
+    }
+    starts.push(theta0);
+    starts
+}
+
+/// Extra starts for the new parameters of an enrichment: time constants
+/// (unit `s`) on a grid across the record's duration (one decade apart
+/// between successive terms), with their companion weights at 0.1.
+fn time_constant_starts(
+    rich: &dyn ForwardModel,
+    p: usize,
+    around: &[f64],
+    duration: f64,
+) -> Vec<Vec<f64>> {
+    let specs = &rich.space().params;
+    let taus: Vec<usize> = (p..specs.len()).filter(|&j| specs[j].unit == "s").collect();
+    if taus.is_empty() || duration.is_nan() || duration <= 0.0 {
+        return Vec::new();
+    }
+    let weights: Vec<usize> = (p..specs.len())
+        .filter(|&j| specs[j].unit == "1" && specs[j].upper <= 1.0)
+        .collect();
+    [duration / 100.0, duration / 20.0, duration / 4.0]
+        .iter()
+        .map(|&b| {
+            let mut s = around.to_vec();
+            for (k, &j) in taus.iter().enumerate() {
+                s[j] = b * 10f64.powi(k as i32);
+            }
+            for &j in &weights {
+                s[j] = 0.1;
+            }
+            s
+        })
+        .collect()
+}
+
+struct Context<'a> {
+    loading: &'a Loading,
+    observed: &'a [f64],
+    sigma: f64,
+    n_fit: usize,
+    p: usize,
+    base_theta: Vec<f64>,
+    base_full: &'a Fitted,
+    base_prefix: &'a Fitted,
+    base_residual: Vec<f64>,
+    candidates: usize,
+    alpha: f64,
+    rel_var_sd2: f64,
+}
+
+/// Score test, refits and comparison of one enrichment.
+fn assess(
+    effect: Effect,
+    rich: Arc<dyn ForwardModel>,
+    ctx: &Context<'_>,
+) -> Result<(RankedEffect, Fitted), GapError> {
+    let (n, n_fit, p) = (ctx.observed.len(), ctx.n_fit, ctx.p);
+    let specs = rich.space().params.clone();
+    let q = specs.len() - p;
+    let off = rich.embed(&ctx.base_theta);
+    let jac = sensitivities(rich.as_ref(), &off, ctx.loading)?;
+    let at_lower: Vec<bool> = (p..specs.len()).map(|j| off[j] <= specs[j].lower).collect();
+    let at_upper: Vec<bool> = (p..specs.len()).map(|j| off[j] >= specs[j].upper).collect();
+    let score = score_test(&ctx.base_residual, &jac, p, ctx.sigma, &at_lower, &at_upper);
+
+    // Starts: the Gauss-Newton step from "off", "off" itself (moved inside
+    // the bounds), and a grid of time constants when the effect has any.
+    let mut gn = off.clone();
+    for (k, d) in score.step.iter().enumerate() {
+        let j = p + k;
+        let x = off[j] + d;
+        if x.is_finite() && x > specs[j].lower && x < specs[j].upper {
+            gn[j] = x;
+        }
+    }
+    let mut starts = vec![gn, off.clone()];
+    let duration = ctx
+        .loading
+        .time
+        .as_ref()
+        .map(|t| t[t.len() - 1] - t[0])
+        .unwrap_or(0.0);
+    starts.extend(time_constant_starts(rich.as_ref(), p, &off, duration));
+    let full = fit_from_starts(&rich, ctx.loading, ctx.observed, n, &starts, &[])?;
+    // The held-out fit starts from the full-record optimum and the step from "off".
+    let prefix_starts = vec![full.theta.clone(), starts[0].clone()];
+    let prefix = fit_from_starts(&rich, ctx.loading, ctx.observed, n_fit, &prefix_starts, &[])?;
+
+    let r_after = residuals(ctx.observed, &full.predicted);
+    let sigma2 = ctx.sigma * ctx.sigma;
+    let lr = (ctx.base_full.sse - full.sse) / sigma2;
+    let lr_p = chi2_sf(lr, q as f64);
+    let h_before = residuals(&ctx.observed[n_fit..], &ctx.base_prefix.predicted[n_fit..]);
+    let h_after = residuals(&ctx.observed[n_fit..], &prefix.predicted[n_fit..]);
+    let heldout_gain = (sse(&h_before) - sse(&h_after)) / sigma2;
+    let dev_base = ar1_deviance(&ctx.base_residual);
+    let dev_rich = ar1_deviance(&r_after);
+    let nf = n as f64;
+    let delta_aic = dev_rich - dev_base + 2.0 * q as f64;
+    let delta_bic = dev_rich - dev_base + q as f64 * nf.ln();
+    let lr_level = ctx.alpha / ctx.candidates.max(1) as f64;
+    let gain_threshold = chi2_isf(ctx.alpha, 1.0);
+    let earns = lr_p < lr_level && heldout_gain > gain_threshold;
+
+    let names = rich.space().names();
+    let own: Vec<String> = names[p..].to_vec();
+    let params: BTreeMap<String, f64> = own
+        .iter()
+        .zip(&full.theta[p..])
+        .map(|(k, v)| (k.clone(), *v))
+        .collect();
+    let all_params: BTreeMap<String, f64> = names
+        .iter()
+        .zip(&full.theta)
+        .map(|(k, v)| (k.clone(), *v))
+        .collect();
+    let standard_errors = own
+        .iter()
+        .map(|k| (k.clone(), full.report.standard_error(k)))
+        .collect();
+    let ident = &full.report.identifiability;
+    let own_involved = ident.involved.iter().any(|k| own.contains(k));
+    let identifiable = ident.identifiable || !own_involved;
+    let max_correlation = full
+        .report
+        .correlation
+        .iter()
+        .enumerate()
+        .flat_map(|(a, row)| {
+            row.iter()
+                .enumerate()
+                .filter(move |(b, _)| *b != a)
+                .map(|(_, c)| c.abs())
+        })
+        .filter(|c| c.is_finite())
+        .fold(0.0, f64::max);
+    let after = whiteness(&r_after, specs.len(), ctx.sigma, ctx.rel_var_sd2);
+    let evidence = format!(
+        "score test {:.1} on {} dof (p = {:.1e}); refit: likelihood ratio {:.1} on {q} parameters (p = {:.1e}, \
+         needs < {:.1e}); held-out gain {:.1} (needs > {:.1}), held-out RMS {:.3e} -> {:.3e}; dAIC {:.1}, dBIC {:.1} \
+         under AR(1) errors; residual RMS/noise {:.2} -> {:.2}, runs p {:.1e} -> {:.1e}; {}",
+        score.statistic,
+        score.dof,
+        score.p_value,
+        lr,
+        lr_p,
+        lr_level,
+        heldout_gain,
+        gain_threshold,
+        rms(&h_before),
+        rms(&h_after),
+        delta_aic,
+        delta_bic,
+        rms(&ctx.base_residual) / ctx.sigma,
+        after.rms_over_noise,
+        whiteness(&ctx.base_residual, p, ctx.sigma, ctx.rel_var_sd2).runs_p,
+        after.runs_p,
+        ident.reason
+    );
+    let ranked = RankedEffect {
+        effect: effect.name().to_string(),
+        params,
+        misfit_before: rms(&ctx.base_residual),
+        misfit_after: rms(&r_after),
+        heldout_before: rms(&h_before),
+        heldout_after: rms(&h_after),
+        evidence,
+        identifiable,
+        confounded_with: Vec::new(),
+        earns,
+        model: rich.name(),
+        all_params,
+        standard_errors,
+        score,
+        lr_statistic: lr,
+        lr_p,
+        heldout_gain,
+        delta_aic_ar1: delta_aic,
+        delta_bic_ar1: delta_bic,
+        after,
+        max_correlation,
+        identifiability: ident.reason.clone(),
+    };
+    Ok((ranked, full))
+}
+
+/// Diagnoses the gap between `base` and `observed` (one value per sample of
+/// `loading`, in the unit of `base.observable()`). See the module docs.
+pub fn diagnose(
+    base: &dyn ForwardModel,
+    loading: &Loading,
+    observed: &[f64],
+    options: &GapOptions,
+) -> Result<GapReport, GapError> {
+    options.validate()?;
+    let n = observed.len();
+    if n != loading.len() {
+        return Err(GapError::LengthMismatch {
+            observed: n,
+            samples: loading.len(),
+        });
+    }
+    if n < MIN_SAMPLES {
+        return Err(GapError::TooFewSamples {
+            got: n,
+            needed: MIN_SAMPLES,
+        });
+    }
+    if let Some(index) = observed.iter().position(|v| !v.is_finite()) {
+        return Err(GapError::NonFinite { index });
+    }
+    loading
+        .validate()
+        .map_err(|e| GapError::Forward(ForwardError::InvalidLoading(e)))?;
+    let (axis_name, x) = match &loading.time {
+        Some(t) => ("time_s".to_string(), t.clone()),
+        None => (
+            loading.drive_kind.column().to_string(),
+            loading.drive.clone(),
+        ),
+    };
+    let noise = difference_noise_sd(observed, loading.time.as_deref())?;
+    let sigma = noise.sd;
+    if sigma.is_nan() || sigma <= 0.0 {
+        return Err(GapError::ZeroNoise);
+    }
+    let p = base.space().len();
+    let n_fit = (((1.0 - options.holdout_fraction) * n as f64).round() as usize)
+        .clamp((p + 3).max(n / 2), n - 3);
+
+    // Base fit on all samples and on the first part only.
+    let (proxy, fixed) = base_proxy(base, loading)?;
+    let starts: Vec<Vec<f64>> = base_starts(base, loading, observed)
+        .iter()
+        .map(|s| proxy.embed(s))
+        .collect();
+    let base_full = fit_from_starts(&proxy, loading, observed, n, &starts, &fixed)?;
+    let base_theta = base_full.theta[..p].to_vec();
+    let mut prefix_starts = vec![base_full.theta.clone()];
+    prefix_starts.extend(starts);
+    let base_prefix = fit_from_starts(&proxy, loading, observed, n_fit, &prefix_starts, &fixed)?;
+    let base_residual = residuals(observed, &base_full.predicted);
+
+    // Where: whole-record tests and windows.
+    let tests = whiteness(&base_residual, p, sigma, noise.rel_var_sd2);
+    let w = options.window.unwrap_or_else(|| default_window(n)).min(n);
+    let windows = significant_windows(&base_residual, &axis_name, &x, sigma, w, options.alpha);
+    let mut reasons = Vec::new();
+    if tests.misfit_p < options.alpha {
+        reasons.push(format!(
+            "misfit RMS/noise {:.2} (p = {:.1e})",
+            tests.rms_over_noise, tests.misfit_p
+        ));
+    }
+    if tests.runs_p < options.alpha {
+        reasons.push(format!(
+            "{} runs for {:.0} expected (p = {:.1e})",
+            tests.runs, tests.runs_expected, tests.runs_p
+        ));
+    }
+    if tests.lag1_p < options.alpha {
+        reasons.push(format!(
+            "lag-1 autocorrelation {:.2} (p = {:.1e})",
+            tests.lag1_autocorrelation, tests.lag1_p
+        ));
+    }
+    if !windows.is_empty() {
+        reasons.push(format!("{} window(s) of significant misfit", windows.len()));
+    }
+    let gap_significant = !reasons.is_empty();
+    let reason = if gap_significant {
+        reasons.join("; ")
+    } else {
+        format!(
+            "misfit consistent with noise at level {:.0e}: RMS/noise {:.2} (p = {:.2}), runs p = {:.2}, lag-1 p = {:.2}, no window",
+            options.alpha, tests.rms_over_noise, tests.misfit_p, tests.runs_p, tests.lag1_p
+        )
+    };
+
+    // Attribute: every applicable enrichment.
+    let effects: Vec<Effect> = match &options.effects {
+        Some(list) => list
+            .iter()
+            .copied()
+            .filter(|e| base.effects().contains(e))
+            .collect(),
+        None => base.effects(),
+    };
+    let mut enriched: Vec<(Effect, Arc<dyn ForwardModel>)> = Vec::new();
+    for e in effects {
+        if let Ok(rich) = base.enrich(e) {
+            // Skip enrichments that cannot run on this history (e.g. no time for QLV).
+            if rich.predict(&rich.embed(&base_theta), loading).is_ok() {
+                enriched.push((e, Arc::from(rich)));
+            }
+        }
+    }
+    let ctx = Context {
+        loading,
+        observed,
+        sigma,
+        n_fit,
+        p,
+        base_theta: base_theta.clone(),
+        base_full: &base_full,
+        base_prefix: &base_prefix,
+        base_residual: base_residual.clone(),
+        candidates: enriched.len(),
+        alpha: options.alpha,
+        rel_var_sd2: noise.rel_var_sd2,
+    };
+    // Candidates are independent: assessed in parallel, collected in order.
+    let mut assessed: Vec<(RankedEffect, Fitted)> = enriched
+        .into_par_iter()
+        .filter_map(|(e, rich)| {
+            let t0 = std::time::Instant::now();
+            let a = assess(e, rich, &ctx).ok();
+            eprintln!(
+                "DEBUG {e} {:.2}s evals {:?}",
+                t0.elapsed().as_secs_f64(),
+                a.as_ref().map(|a| (
+                    a.1.report.evaluations,
+                    a.1.report.iterations,
+                    a.1.report.termination.clone()
+                ))
+            );
+            a
+        })
+        .collect();
+    assessed.sort_by(|a, b| {
+        b.0.earns
+            .cmp(&a.0.earns)
+            .then(a.0.delta_bic_ar1.total_cmp(&b.0.delta_bic_ar1))
+    });
+
+    // Confounding: earning effects whose fits differ by less than the data can resolve.
+    let confound_threshold = chi2_isf(options.confound_alpha, 1.0);
+    let sigma2 = sigma * sigma;
+    for a in 0..assessed.len() {
+        let mut with = Vec::new();
+        for b in 0..assessed.len() {
+            if a != b && assessed[a].0.earns && assessed[b].0.earns {
+                let d = (assessed[a].1.sse - assessed[b].1.sse).abs() / sigma2;
+                if d < confound_threshold {
+                    with.push(assessed[b].0.effect.clone());
+                }
+            }
+        }
+        if !with.is_empty() {
+            assessed[a].0.identifiable = false;
+            let note = format!(
+                "; the data cannot tell it apart from {} (SSE difference below chi2(1) {:.1} x noise^2)",
+                with.join(", "),
+                confound_threshold
+            );
+            assessed[a].0.evidence.push_str(&note);
+        }
+        assessed[a].0.confounded_with = with;
+    }
+
+    let best_earning = assessed.iter().find(|a| a.0.earns);
+    let (verdict, confounded, explanation) = match (gap_significant, best_earning) {
+        (false, _) => (
+            "none".to_string(),
+            Vec::new(),
+            format!("No significant gap: the base misfit is {reason}."),
+        ),
+        (true, None) => (
+            "none".to_string(),
+            Vec::new(),
+            format!(
+                "The base model misses the data ({reason}), but no candidate effect earns its parameters \
+                 (significant likelihood ratio and held-out gain); the gap is left unexplained."
+            ),
+        ),
+        (true, Some(best)) => {
+            let r = &best.0;
+            let mut text = format!(
+                "The base model misses the data ({reason}). Adding `{}` brings the misfit from {:.3e} to {:.3e} \
+                 (noise {:.3e}) and the held-out misfit from {:.3e} to {:.3e}.",
+                r.effect, r.misfit_before, r.misfit_after, sigma, r.heldout_before, r.heldout_after
+            );
+            if !r.confounded_with.is_empty() {
+                text.push_str(&format!(
+                    " It cannot be told apart from {} with these data.",
+                    r.confounded_with.join(", ")
+                ));
+            }
+            (r.effect.clone(), r.confounded_with.clone(), text)
+        }
+    };
+
+    let (band_mean, band_lower, band_upper) = discrepancy_band(&base_residual, sigma, w);
+    let best_fit = assessed.first();
+    let plot = GapPlot {
+        axis: axis_name,
+        x,
+        drive_name: loading.drive_kind.column().to_string(),
+        drive: loading.drive.clone(),
+        observed: observed.to_vec(),
+        base_fit: base_full.predicted.clone(),
+        base_residual: base_residual.clone(),
+        band_mean,
+        band_lower,
+        band_upper,
+        enriched_effect: best_fit.map(|a| a.0.effect.clone()),
+        enriched_fit: best_fit.map(|a| a.1.predicted.clone()),
+        enriched_residual: best_fit.map(|a| residuals(observed, &a.1.predicted)),
+        heldout_from: n_fit,
+    };
+    let base_names = base.space().names();
+    let heldout_base = residuals(&observed[n_fit..], &base_prefix.predicted[n_fit..]);
+    Ok(GapReport {
+        verdict,
+        noise_sd: sigma,
+        where_: windows,
+        ranking: assessed.into_iter().map(|a| a.0).collect(),
+        confounded,
+        explanation,
+        base: BaseSummary {
+            model: base.name(),
+            params: base_names.into_iter().zip(base_theta).collect(),
+            misfit: rms(&base_residual),
+            heldout: rms(&heldout_base),
+            tests,
+            gap_significant,
+            reason,
+        },
+        noise,
+        samples: n,
+        heldout_samples: n - n_fit,
+        plot,
+    })
+}

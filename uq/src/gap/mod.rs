@@ -1,0 +1,38 @@
+//! Sim-to-real gap diagnosis (GAP.md): where a calibrated base model misses
+//! the data, which unmodelled effect explains it, and by how much adding it
+//! shrinks the misfit on fitted and held-out data.
+//!
+//! The method (details and failure modes in `docs/gap-diagnosis.md`):
+//!
+//! 1. **Noise** from the data alone: second-order pseudo-residuals
+//!    ([`noise::difference_noise_sd`]), blind to a smooth misfit.
+//! 2. **Locate**: fit the base model (palpate-inverse, Levenberg-Marquardt);
+//!    test its residuals against the noise (chi-square of the misfit, lag-1
+//!    autocorrelation, Wald-Wolfowitz runs) and scan running windows for a
+//!    significant bias or scatter ([`structure`]); a discrepancy band.
+//! 3. **Attribute**: for every effect the base model offers
+//!    (`ForwardModel::effects`/`enrich`), a score test at the "off" point
+//!    ([`score`]), then a refit from several starts; compare by the
+//!    likelihood ratio against the noise, information criteria under AR(1)
+//!    errors, and the misfit on the held-out end of the record (fitted
+//!    without it); identifiability from the calibration report and
+//!    confounding between effects whose fits the data cannot tell apart.
+//! 4. **Verdict**: `none` when the base misfit is consistent with noise or no
+//!    effect earns its parameters; else the best effect that does.
+
+mod diagnose;
+mod error;
+mod fit;
+pub mod noise;
+mod options;
+mod report;
+pub mod score;
+pub mod structure;
+
+pub use diagnose::diagnose;
+pub use error::GapError;
+pub use noise::{difference_noise_sd, NoiseEstimate};
+pub use options::GapOptions;
+pub use report::{BaseSummary, GapPlot, GapReport, RankedEffect};
+pub use score::{score_test, sensitivities, ScoreTest};
+pub use structure::{discrepancy_band, significant_windows, whiteness, GapWindow, WhitenessTests};
