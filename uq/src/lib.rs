@@ -4,6 +4,9 @@
 //! trait only): MCMC posteriors and their diagnostics, designed experiments
 //! and ANOVA, and the sim-to-real gap diagnosis.
 
+pub mod anova;
+pub mod doe;
 pub mod gap;
 pub mod likelihood;
 pub mod mcmc;
+pub mod stats;
