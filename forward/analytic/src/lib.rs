@@ -28,7 +28,7 @@ mod wrap;
 mod zero_offset;
 
 pub use c1::{c1_area_mm2, C1Compression, C1Geometry};
-pub use compressible::Compressible;
+pub use compressible::{lateral_stress_free, Compressible};
 pub use homogeneous::Homogeneous;
 pub use material_form::{richer_law, MaterialForm, RicherLaw};
 pub use mode::Mode;

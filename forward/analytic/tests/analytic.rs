@@ -3,14 +3,14 @@
 //! viscoelastic responses, and the "effect off" property of every enrichment.
 
 use palpate_analytic::{
-    c1_area_mm2, qlv_convolve, C1Compression, C1Geometry, Compressible, Homogeneous, Mode,
-    ToolCompliance, Viscoelastic, ZeroOffset,
+    c1_area_mm2, lateral_stress_free, qlv_convolve, C1Compression, C1Geometry, Compressible,
+    Homogeneous, Mode, ToolCompliance, Viscoelastic, ZeroOffset,
 };
 use palpate_core::{
     Drive, Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
     ParamSpec, Table,
 };
-use palpate_material::Law;
+use palpate_material::{Law, Volumetric};
 use std::path::Path;
 
 fn shared(rel: &str) -> std::path::PathBuf {
@@ -316,6 +316,29 @@ fn compressible_c1_matches_an_independent_solve_and_the_incompressible_limit() {
             f[k] < incompressible[k],
             "a compressible cylinder is softer"
         );
+    }
+    // The fast principal-stretch solve agrees with the material crate's general one, for several laws.
+    for (law, theta) in [
+        (Law::NeoHookean, vec![c10]),
+        (Law::ReducedPolynomial(2), ECOFLEX_RP2.to_vec()),
+        (Law::MooneyRivlin, vec![3e-4, 1e-4]),
+        (Law::Ogden(2), vec![1e-3, 2.5, 4e-4, -2.0]),
+    ] {
+        let mu = law.shear_modulus(&theta);
+        for d1 in [0.05 / mu, 1.0 / mu] {
+            for l in [0.6, 0.8, 0.95, 1.2] {
+                let fast = lateral_stress_free(&law, &theta, d1, l).unwrap();
+                let general = palpate_material::homogeneous::uniaxial_compressible(
+                    &law,
+                    &theta,
+                    Volumetric::D1(d1),
+                    l,
+                )
+                .unwrap();
+                close(fast.0, general.0, 1e-8, "compressible nominal stress");
+                close(fast.1, general.1, 1e-10, "lateral stretch");
+            }
+        }
     }
     let nearly = model.predict(&[c10, 1e-6 / c10], &load).unwrap();
     for (a, b) in nearly.iter().zip(&incompressible) {
