@@ -55,7 +55,7 @@ pub enum MaterialError {
         /// The stretch given.
         stretch: f64,
     },
-    /// A Newton solve for a homogeneous state did not converge.
+    /// A solve for a homogeneous state did not converge (or found no root to converge to).
     #[error(
         "{what}: Newton did not converge after {iterations} iterations (residual {residual:e})"
     )]

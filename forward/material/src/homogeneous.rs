@@ -38,12 +38,24 @@ pub fn planar(law: &Law, p: &[f64], stretch: f64) -> f64 {
     nominal(law, p, [stretch, 1.0, 1.0 / stretch], 2)
 }
 
-/// Maximum Newton iterations of [`uniaxial_compressible`].
-const MAX_NEWTON: usize = 60;
+/// Maximum safeguarded-Newton iterations of [`uniaxial_compressible`].
+const MAX_NEWTON: usize = 200;
+/// Maximum doublings/halvings of the lateral stretch while bracketing the root.
+const MAX_BRACKET: usize = 60;
 
 /// Uniaxial stress of the compressible material `Psi = W(J^{-1/3} F) + U(J)`:
-/// `F = diag(s, t, t)` with the lateral stretch `t` solved from `P_22(t) = 0` by damped Newton
-/// (`dP_22/dt = A_2222 + A_2233`, from [`Law::stress_tangent`]), started at `t = s^-1/2`.
+/// `F = diag(s, t, t)` with the lateral stretch `t` solved from `P_22(t) = 0`.
+///
+/// Solver: the root is first bracketed, starting at the incompressible `t = s^-1/2` and
+/// halving/doubling `t` (`P_22 -> -inf` as `t -> 0` for the laws here, `P_22 > 0` for large `t`),
+/// then Newton steps (`dP_22/dt = A_2222 + A_2233` from [`Law::stress_tangent`]) are taken inside
+/// the bracket, falling back to bisection whenever a step would leave it (`rtsafe`, Press et al.,
+/// *Numerical Recipes*, 3rd ed., sec. 9.4; hand-written because it is 30 lines on a scalar).
+///
+/// The bracket grows outwards from `s^-1/2`, so the root found is the nearest one on the side the
+/// residual points to. With a small bulk modulus and strong compression `U = (J - 1)^2 / D1`
+/// (bounded as `J -> 0`) allows a near-collapse root (`t ~ s`, e.g. neo-Hookean with `K = 3 mu0`
+/// at `s = 0.1`): that is the law's answer, not a solver artefact.
 ///
 /// Returns `(P_11, t)`. With [`Volumetric::Incompressible`] it returns the incompressible limit
 /// `(uniaxial(s), s^-1/2)` (an isochoric energy alone has no lateral-stress-free state other than a
@@ -62,33 +74,68 @@ pub fn uniaxial_compressible(
     if vol == Volumetric::Incompressible {
         return Ok((uniaxial(law, p, stretch), 1.0 / stretch.sqrt()));
     }
-    let scale = law.shear_modulus(p).abs().max(f64::MIN_POSITIVE);
-    let mut t = 1.0 / stretch.sqrt();
-    let mut residual = f64::INFINITY;
-    for _ in 0..MAX_NEWTON {
-        let st = law.stress_tangent(p, vol, &Matrix3::from_diagonal(&[stretch, t, t].into()));
-        residual = st.p[(1, 1)];
-        if residual.abs() <= 1e-12 * scale {
-            return Ok((st.p[(0, 0)], t));
-        }
-        let slope = st.a[(4, 4)] + st.a[(4, 8)];
-        let mut step = -residual / slope;
-        if !step.is_finite() {
-            break;
-        }
-        // Keep the stretch positive: never move more than half way to zero.
-        if t + step <= 0.5 * t {
-            step = -0.5 * t;
-        }
-        t += step;
-        if step.abs() <= 1e-15 * t {
-            let st = law.stress_tangent(p, vol, &Matrix3::from_diagonal(&[stretch, t, t].into()));
-            return Ok((st.p[(0, 0)], t));
+    let state =
+        |t: f64| law.stress_tangent(p, vol, &Matrix3::from_diagonal(&[stretch, t, t].into()));
+    let lateral = |t: f64| state(t).p[(1, 1)];
+    let fail = |what: &str, iterations: usize, residual: f64| MaterialError::NoConvergence {
+        what: format!("{what} the uniaxial lateral stretch of {law} at stretch {stretch}"),
+        iterations,
+        residual,
+    };
+
+    // Bracket: lo with P22 < 0, hi with P22 > 0.
+    let t0 = 1.0 / stretch.sqrt();
+    let r0 = lateral(t0);
+    if r0 == 0.0 {
+        return Ok((state(t0).p[(0, 0)], t0));
+    }
+    let (mut lo, mut hi) = (t0, t0);
+    let mut found = false;
+    for _ in 0..MAX_BRACKET {
+        if r0 > 0.0 {
+            lo *= 0.5;
+            if lateral(lo) < 0.0 {
+                found = true;
+                break;
+            }
+            hi = lo;
+        } else {
+            hi *= 2.0;
+            if lateral(hi) > 0.0 {
+                found = true;
+                break;
+            }
+            lo = hi;
         }
     }
-    Err(MaterialError::NoConvergence {
-        what: format!("uniaxial lateral stretch of {law} at stretch {stretch}"),
-        iterations: MAX_NEWTON,
-        residual,
-    })
+    if !found {
+        return Err(fail(
+            "no sign change of P22 found (no lateral-stress-free state?) bracketing",
+            MAX_BRACKET,
+            r0,
+        ));
+    }
+
+    let scale = law.shear_modulus(p).abs().max(f64::MIN_POSITIVE);
+    let mut t = 0.5 * (lo + hi);
+    let mut residual = f64::NAN;
+    for _ in 0..MAX_NEWTON {
+        let st = state(t);
+        residual = st.p[(1, 1)];
+        if residual.abs() <= 1e-12 * scale || (hi - lo) <= 1e-15 * t {
+            return Ok((st.p[(0, 0)], t));
+        }
+        if residual < 0.0 {
+            lo = t;
+        } else {
+            hi = t;
+        }
+        let newton = t - residual / (st.a[(4, 4)] + st.a[(4, 8)]);
+        t = if newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+    }
+    Err(fail("safeguarded Newton on", MAX_NEWTON, residual))
 }

@@ -672,3 +672,66 @@ fn invariant_and_principal_paths_agree() {
         }
     }
 }
+
+#[test]
+fn compressible_uniaxial_converges_at_extreme_stretches() {
+    // Where the law is Drucker stable the solve must succeed with tension pulling and compression
+    // pushing; beyond (MR with C01 < 0 at s = 0.1, RP with C20 < 0 at s = 8) a lateral-stress-free
+    // state may not exist (Err) or may be tensile under compression (Ok): both are the law's answer.
+    for (law, p) in cases() {
+        let range = drucker(&law, &p).uniaxial;
+        for k_over_mu in [3.0, 1000.0] {
+            let vol = Volumetric::from_bulk_modulus(k_over_mu * law.shear_modulus(&p));
+            for s in [0.1, 0.3, 3.0, 8.0] {
+                let solved = homogeneous::uniaxial_compressible(&law, &p, vol, s);
+                if !range.contains(s) {
+                    continue;
+                }
+                let (nominal, t) =
+                    solved.unwrap_or_else(|e| panic!("{law} K/mu0 = {k_over_mu} s = {s}: {e}"));
+                assert!(
+                    nominal.is_finite() && t > 0.0,
+                    "{law} s={s}: {nominal}, {t}"
+                );
+                assert_eq!(nominal > 0.0, s > 1.0, "{law} s={s}: {nominal}, {t}");
+            }
+        }
+    }
+    let unstable = homogeneous::uniaxial_compressible(
+        &Law::ReducedPolynomial(2),
+        &[0.3, -0.02],
+        Volumetric::D1(0.1),
+        8.0,
+    );
+    assert!(
+        matches!(unstable, Err(MaterialError::NoConvergence { .. })),
+        "{unstable:?}"
+    );
+    assert!(matches!(
+        homogeneous::uniaxial_compressible(&Law::NeoHookean, &[0.1], Volumetric::D1(0.1), 0.0),
+        Err(MaterialError::BadStretch { .. })
+    ));
+}
+
+#[test]
+fn benchmark_materials_are_valid_and_drucker_stable() {
+    // shared/BENCHMARKS.md, Materials (1 Pa = 1e-6 MPa).
+    let materials = [
+        ("ecoflex-nh", Law::NeoHookean, vec![1101.295e-6]),
+        (
+            "ecoflex-rp2",
+            Law::ReducedPolynomial(2),
+            vec![686.428e-6, 1929.606e-6],
+        ),
+        ("rtv6166-ab", Law::ArrudaBoyce, vec![4.98e-3, 1.05]),
+        ("rubber-ab", Law::ArrudaBoyce, vec![73.40e-3, 1.01]),
+        ("kidney-ab", Law::ArrudaBoyce, vec![1.58e-3, 1.05]),
+    ];
+    for (id, law, p) in materials {
+        law.check(&p).unwrap_or_else(|e| panic!("{id}: {e}"));
+        let r = drucker(&law, &p);
+        for range in [r.uniaxial, r.biaxial, r.planar] {
+            assert_eq!((range.lower, range.upper), (0.1, 10.0), "{id}: {r:?}");
+        }
+    }
+}
