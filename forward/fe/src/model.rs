@@ -60,8 +60,10 @@ pub(crate) trait Setup: Send + Sync {
     fn bulk(&self) -> Bulk;
     fn options(&self) -> SolverOptions;
     fn build(&self) -> Result<Solver, FeError>;
-    /// Applies the parameters that follow the law's (e.g. friction).
-    fn apply_extra(&self, _solver: &mut Solver, _extra: &[f64]) {}
+    /// Sets what depends on the parameters before a run: contact penalties
+    /// (scaled by the shear modulus `mu`) and the parameters that follow the
+    /// law's (e.g. friction).
+    fn prepare(&self, _solver: &mut Solver, _mu: f64, _extra: &[f64]) {}
 }
 
 pub(crate) fn to_forward(e: FeError) -> ForwardError {
@@ -113,7 +115,7 @@ pub(crate) fn simulate(
     let n_law = law.params().len();
     let mat = LawMaterial::new(law.clone(), theta[..n_law].to_vec()).map_err(to_forward)?;
     let mu = law.shear_modulus(&theta[..n_law]);
-    setup.apply_extra(solver, &theta[n_law..]);
+    setup.prepare(solver, mu, &theta[n_law..]);
     let vol = setup.bulk().volumetric(mu);
     let forces = solver
         .run(&mat, vol, &loading.drive, &setup.options(), progress)

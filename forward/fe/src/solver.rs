@@ -84,6 +84,9 @@ pub struct RunStats {
     pub cuts: usize,
     pub augmentations: usize,
     pub factorisations: usize,
+    /// Wall time in assembly and in factorise-and-solve (s).
+    pub assembly_seconds: f64,
+    pub solve_seconds: f64,
 }
 
 /// A failed run: where it stopped, and the forces of the samples that did converge.
@@ -272,6 +275,19 @@ impl Solver {
         drive: f64,
         tangent: bool,
     ) -> Result<Assembled, FeError> {
+        let t0 = std::time::Instant::now();
+        let r = self.assemble_inner(mat, vol, drive, tangent);
+        self.stats.assembly_seconds += t0.elapsed().as_secs_f64();
+        r
+    }
+
+    fn assemble_inner(
+        &mut self,
+        mat: &dyn PointMaterial,
+        vol: Volumetric,
+        drive: f64,
+        tangent: bool,
+    ) -> Result<Assembled, FeError> {
         let mu = mat.shear_modulus();
         let kin = self.kinematics;
         let constraints: Vec<VolumeConstraint> = (0..self.outs.len())
@@ -426,7 +442,9 @@ impl Solver {
             self.stats.iterations += 1;
             du.iter_mut().zip(&self.residual).for_each(|(d, r)| *d = -r);
             let values = std::mem::take(&mut self.values);
+            let t0 = std::time::Instant::now();
             let solved = self.lu.solve(&values, &mut du);
+            self.stats.solve_seconds += t0.elapsed().as_secs_f64();
             self.values = values;
             solved?;
             self.stats.factorisations += 1;

@@ -3,9 +3,11 @@
 //! whose symbolic analysis (ordering, elimination structure) is computed once
 //! and reused for every numeric factorisation.
 
-use faer::linalg::solvers::Solve;
-use faer::sparse::linalg::solvers::{Lu, SymbolicLu};
+use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
+use faer::{Conj, Par};
 
 use crate::FeError;
 
@@ -90,10 +92,16 @@ impl Pattern {
     }
 }
 
-/// A sparse LU solver that keeps the symbolic factorisation.
+/// A sparse LU solver that keeps the symbolic factorisation (column
+/// ordering and elimination structure) and the numeric storage and scratch
+/// between factorisations. Runs sequentially inside faer: the element loop
+/// and the callers (several evaluators) hold the cores.
 pub struct SparseLu {
     symbolic_mat: SymbolicSparseColMat<usize>,
     symbolic_lu: SymbolicLu<usize>,
+    numeric: NumericLu<usize, f64>,
+    factor_scratch: MemBuffer,
+    solve_scratch: MemBuffer,
     /// Number of numeric factorisations done.
     pub factorisations: usize,
 }
@@ -108,13 +116,26 @@ impl SparseLu {
             None,
             pattern.row_idx.clone(),
         );
-        let symbolic_lu =
-            SymbolicLu::try_new(symbolic_mat.as_ref()).map_err(|e| FeError::Factorisation {
-                reason: format!("symbolic analysis: {e:?}"),
-            })?;
+        let symbolic_lu = factorize_symbolic_lu(
+            symbolic_mat.as_ref(),
+            LuSymbolicParams {
+                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                ..Default::default()
+            },
+        )
+        .map_err(|e| FeError::Factorisation {
+            reason: format!("symbolic analysis: {e:?}"),
+        })?;
+        let factor_scratch = MemBuffer::new(
+            symbolic_lu.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+        );
+        let solve_scratch = MemBuffer::new(symbolic_lu.solve_in_place_scratch::<f64>(1, Par::Seq));
         Ok(SparseLu {
             symbolic_mat,
             symbolic_lu,
+            numeric: NumericLu::new(),
+            factor_scratch,
+            solve_scratch,
             factorisations: 0,
         })
     }
@@ -123,13 +144,25 @@ impl SparseLu {
     /// overwrites `rhs` with the solution.
     pub fn solve(&mut self, values: &[f64], rhs: &mut [f64]) -> Result<(), FeError> {
         let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), values);
-        let lu = Lu::try_new_with_symbolic(self.symbolic_lu.clone(), mat).map_err(|e| {
-            FeError::Factorisation {
+        let lu = self
+            .symbolic_lu
+            .factorize_numeric_lu(
+                &mut self.numeric,
+                mat,
+                Par::Seq,
+                MemStack::new(&mut self.factor_scratch),
+                Default::default(),
+            )
+            .map_err(|e| FeError::Factorisation {
                 reason: format!("{e:?}"),
-            }
-        })?;
+            })?;
         self.factorisations += 1;
-        lu.solve_in_place(faer::ColMut::from_slice_mut(rhs));
+        lu.solve_in_place_with_conj(
+            Conj::No,
+            faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
+            Par::Seq,
+            MemStack::new(&mut self.solve_scratch),
+        );
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(FeError::Factorisation {
                 reason: "singular tangent (non-finite solution)".into(),

@@ -1,0 +1,249 @@
+//! `N1Needle`: needle indentation of a cylinder (BENCHMARKS.md N1) —
+//! diameter 70 mm, height 80 mm, bottom fixed, a rigid needle (hemispherical
+//! tip 2.5 mm tangent to a 15 degree cone) pressed on the axis with Coulomb
+//! friction 0.8. The force is the needle reaction for the whole body,
+//! positive in compression.
+//!
+//! The mesh is graded toward the indentation point ([`N1Needle::mesh`]); the
+//! contact surface is the whole top face. Effects: `friction` (the friction
+//! coefficient becomes a parameter).
+
+use palpate_core::{
+    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+};
+use palpate_material::Law;
+
+use crate::contact::{ContactOptions, ContactSet, RigidTool};
+use crate::kinematics::Kinematics;
+use crate::mesh::{Grading, Mesh};
+use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
+use crate::solver::{Constraints, Progress, Solver, SolverOptions};
+use crate::tool::ToolShape;
+use crate::FeError;
+
+/// Mesh density of the N1 model: level `n` has elements of `0.4 / n` mm in a
+/// 5 x 5 mm zone under the needle, growing by `1 + 0.2 / n` beyond it.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct MeshDensity {
+    pub level: usize,
+}
+
+impl MeshDensity {
+    pub const COARSE: MeshDensity = MeshDensity { level: 1 };
+    pub const MEDIUM: MeshDensity = MeshDensity { level: 2 };
+    pub const FINE: MeshDensity = MeshDensity { level: 3 };
+
+    /// Size of the fine elements (mm).
+    pub fn h_fine(&self) -> f64 {
+        0.4 / self.level.max(1) as f64
+    }
+
+    /// The grading of this level with a fine zone of `fine_length` mm.
+    pub fn grading(&self, fine_length: f64) -> Grading {
+        let n = self.level.max(1) as f64;
+        Grading {
+            h_fine: self.h_fine(),
+            fine_length,
+            growth: 1.0 + 0.2 / n,
+        }
+    }
+}
+
+/// Base (bottom face) condition.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Base {
+    /// Fixed in all directions (BENCHMARKS.md).
+    Bonded,
+    /// Free to slide radially (u_z = 0 only).
+    Sliding,
+}
+
+/// The N1 model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct N1Needle {
+    pub law: Law,
+    pub bulk: Bulk,
+    pub friction: f64,
+    pub tool: ToolShape,
+    pub base: Base,
+    pub mesh: MeshDensity,
+    /// Cylinder radius and height (mm).
+    pub radius: f64,
+    pub height: f64,
+    /// Size of the uniformly fine zone under the tool (mm, radial and axial).
+    pub fine_zone: f64,
+    /// Contact penalty factor: `eps_N = penalty * mu0 / h_fine` (augmented, so
+    /// the converged force does not depend on it).
+    pub penalty: f64,
+    /// Accepted penetration after augmentation (mm).
+    pub penetration_tol: f64,
+    pub options: SolverOptions,
+    friction_is_parameter: bool,
+    space: ParamSpace,
+}
+
+impl N1Needle {
+    /// BENCHMARKS.md N1 with the given law: friction 0.8, bonded base, exact
+    /// incompressibility, medium mesh.
+    pub fn new(law: Law) -> Self {
+        N1Needle {
+            space: law_space(&law),
+            law,
+            bulk: Bulk::Exact,
+            friction: 0.8,
+            tool: ToolShape::n1_needle(),
+            base: Base::Bonded,
+            mesh: MeshDensity::MEDIUM,
+            radius: 35.0,
+            height: 80.0,
+            fine_zone: 5.0,
+            penalty: 100.0,
+            penetration_tol: 1e-4,
+            options: SolverOptions {
+                max_step: 0.25,
+                first_step: 0.05,
+                ..SolverOptions::default()
+            },
+            friction_is_parameter: false,
+        }
+    }
+
+    /// The mesh this model uses.
+    pub fn build_mesh(&self) -> Result<Mesh, FeError> {
+        let g = self.mesh.grading(self.fine_zone);
+        Mesh::graded_rectangle(self.radius, self.height, g, g)
+    }
+
+    /// Runs one history with a progress observer; returns the solver too
+    /// (fields for VTK output).
+    pub fn simulate(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+        progress: Option<&dyn Fn(&Progress)>,
+    ) -> Result<(Simulation, Solver), ForwardError> {
+        let mut solver = self.build().map_err(to_forward)?;
+        let sim = simulate(self, &self.space, &mut solver, theta, loading, progress)?;
+        Ok((sim, solver))
+    }
+}
+
+impl Setup for N1Needle {
+    fn law(&self) -> &Law {
+        &self.law
+    }
+    fn bulk(&self) -> Bulk {
+        self.bulk
+    }
+    fn options(&self) -> SolverOptions {
+        self.options
+    }
+    fn build(&self) -> Result<Solver, FeError> {
+        if !(self.friction >= 0.0 && self.friction.is_finite()) {
+            return Err(FeError::InvalidConfig {
+                field: "friction".into(),
+                reason: format!("{} must be >= 0", self.friction),
+            });
+        }
+        let mesh = self.build_mesh()?;
+        let mut c = Constraints::default();
+        for &n in mesh.node_set("axis")? {
+            c.fixed.push((n, 0));
+        }
+        for &n in mesh.node_set("bottom")? {
+            c.fixed.push((n, 1));
+            if self.base == Base::Bonded && mesh.nodes[n][0] > 0.0 {
+                c.fixed.push((n, 0));
+            }
+        }
+        let tool = RigidTool {
+            shape: self.tool,
+            origin: [0.0, self.height],
+            direction: [0.0, -1.0],
+        };
+        // Penalties scale with the initial shear modulus, set per run.
+        let options = ContactOptions {
+            friction: self.friction,
+            penalty_normal: 0.0,
+            penalty_tangent: 0.0,
+            penetration_tol: self.penetration_tol,
+        };
+        let contact = ContactSet::new(
+            &self.tool.name(),
+            tool,
+            &mesh,
+            "top",
+            Kinematics::Axisymmetric,
+            options,
+        )?;
+        Solver::new(
+            mesh,
+            Kinematics::Axisymmetric,
+            c,
+            Some(contact),
+            self.bulk.incompressibility(),
+        )
+    }
+    fn prepare(&self, solver: &mut Solver, mu: f64, extra: &[f64]) {
+        let h = self.mesh.h_fine();
+        if let Some(cs) = solver.contact.as_mut() {
+            cs.options.penalty_normal = self.penalty * mu / h;
+            cs.options.penalty_tangent = self.penalty * mu / h;
+            cs.options.friction = if self.friction_is_parameter {
+                extra.first().copied().unwrap_or(self.friction)
+            } else {
+                self.friction
+            };
+        }
+    }
+}
+
+impl ForwardModel for N1Needle {
+    fn name(&self) -> String {
+        format!(
+            "N1 FE needle indentation, {}, friction {}",
+            self.law, self.friction
+        )
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+    fn observable(&self) -> Observable {
+        Observable::ForceN
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(FeEvaluator {
+            setup: self,
+            space: &self.space,
+            solver: None,
+        })
+    }
+    fn effects(&self) -> Vec<Effect> {
+        if self.friction_is_parameter {
+            Vec::new()
+        } else {
+            vec![Effect::Friction]
+        }
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        match effect {
+            Effect::Friction if !self.friction_is_parameter => {
+                let mut m = self.clone();
+                m.friction_is_parameter = true;
+                m.space = self.space.extended(&[ParamSpec::new(
+                    "friction",
+                    "1",
+                    0.0,
+                    2.0,
+                    self.friction,
+                )]);
+                Ok(Box::new(m))
+            }
+            _ => Err(ForwardError::InvalidConfig {
+                field: "effect".into(),
+                reason: format!("`{effect}` does not apply to {}", self.name()),
+            }),
+        }
+    }
+}
