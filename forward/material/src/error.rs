@@ -56,9 +56,7 @@ pub enum MaterialError {
         stretch: f64,
     },
     /// A solve for a homogeneous state did not converge (or found no root to converge to).
-    #[error(
-        "{what}: Newton did not converge after {iterations} iterations (residual {residual:e})"
-    )]
+    #[error("{what}: no convergence after {iterations} iterations (residual {residual:e})")]
     NoConvergence {
         /// What was being solved.
         what: String,
