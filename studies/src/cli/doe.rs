@@ -1,10 +1,355 @@
-//! `palpate doe` (not yet implemented).
+//! `palpate doe`: generate a factorial design from a TOML manifest and, when
+//! the manifest names a response palpate can compute, run it and analyse it.
+//!
+//! Manifest (serde, unknown fields rejected; paths relative to the manifest):
+//!
+//! ```toml
+//! [design]
+//! seed = 2024             # run order randomised from this seed (omit: standard order)
+//! replicates = 1
+//! generators = []         # two-level fractions, e.g. ["D=ABC"]
+//!
+//! [[factors]]
+//! name = "law"
+//! levels = ["neo-hookean", "mooney-rivlin", "yeoh", "arruda-boyce"]
+//!
+//! [[factors]]
+//! name = "residual"
+//! levels = ["absolute", "relative"]
+//!
+//! [response.calibration]  # optional: each run is an analytic calibration
+//! metric = "r2"           # r2 or rms of the fit
+//! data = { uniaxial = "../../../shared/data/treloar/uniaxial.csv" }
+//!
+//! [analysis]              # optional
+//! max_order = 1
+//! alpha = 0.05
+//! ```
+//!
+//! Calibration factors: `law` (a law name), `residual` (absolute, relative,
+//! normalised), `data` (a data-set name of `response.calibration.data`, or
+//! several joined by `+`), `estimator` (lm, bfgs, lbfgs). Factors of the FE
+//! benchmarks (`friction`, `space`, `mesh`) are not supported yet.
 
-/// Options of `palpate doe`.
+use super::anova::{format_analysis, write_outputs};
+use crate::calibration::{calibrate, parse_method, Request, TestData, TestKind};
+use crate::output::write_atomic;
+use anyhow::Context;
+use palpate_inverse::ResidualKind;
+use palpate_material::Law;
+use palpate_uq::anova::{analyse, AnovaOptions, FactorColumn};
+use palpate_uq::doe::{Design, Factor};
+use rayon::prelude::*;
+use serde::Deserialize;
+use std::collections::BTreeMap;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Generate (and run) a designed experiment from a TOML manifest.
+///
+/// Writes design.csv (run order, standard order, replicate, levels and the
+/// response), design.json (with defining relation, resolution and aliases)
+/// and, when the response is computed, anova.json and plots/ into --out.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    /// The design manifest (TOML).
+    #[arg(long)]
+    pub manifest: PathBuf,
+    /// Output directory (default: print only).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Manifest {
+    #[serde(default)]
+    design: DesignSpec,
+    factors: Vec<Factor>,
+    response: Option<ResponseSpec>,
+    #[serde(default)]
+    analysis: AnalysisSpec,
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct DesignSpec {
+    seed: Option<u64>,
+    #[serde(default = "one")]
+    replicates: usize,
+    #[serde(default)]
+    generators: Vec<String>,
+}
+
+fn one() -> usize {
+    1
+}
+
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnalysisSpec {
+    max_order: Option<usize>,
+    alpha: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields, rename_all = "snake_case")]
+enum ResponseSpec {
+    Calibration(CalibrationResponse),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct CalibrationResponse {
+    /// `r2` or `rms`.
+    metric: String,
+    /// Data-set name -> homogeneous-test file (columns stretch, stress_MPa);
+    /// the name is also the test mode unless it is given as `NAME:MODE`.
+    data: BTreeMap<String, String>,
+    /// Defaults for settings that are not factors.
+    law: Option<String>,
+    residual: Option<String>,
+    estimator: Option<String>,
+}
+
+const FE_FACTORS: [&str; 4] = ["friction", "space", "mesh", "benchmark"];
 
 /// Runs `palpate doe`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`palpate doe` is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(&args.manifest)
+        .with_context(|| format!("cannot read {}", args.manifest.display()))?;
+    let manifest: Manifest =
+        toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.manifest.display()))?;
+    let base_dir = args
+        .manifest
+        .parent()
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let gens: Vec<&str> = manifest
+        .design
+        .generators
+        .iter()
+        .map(String::as_str)
+        .collect();
+    let mut design = if gens.is_empty() {
+        Design::full_factorial(manifest.factors.clone(), manifest.design.replicates)?
+    } else {
+        Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)?
+    };
+    if let Some(seed) = manifest.design.seed {
+        design = design.randomised(seed);
+    }
+    println!("{}", describe(&design));
+    if let Some(out) = &args.out {
+        // The design alone first, so it is there even if a run fails.
+        write_atomic(
+            &out.join("design.csv"),
+            design_csv(&design, "", None).as_bytes(),
+        )?;
+    }
+    let response = match &manifest.response {
+        Some(ResponseSpec::Calibration(c)) => Some(run_calibrations(&design, c, &base_dir)?),
+        None => None,
+    };
+    let metric = match &manifest.response {
+        Some(ResponseSpec::Calibration(c)) => c.metric.clone(),
+        None => "response".into(),
+    };
+    if let Some(out) = &args.out {
+        write_atomic(
+            &out.join("design.csv"),
+            design_csv(&design, &metric, response.as_deref()).as_bytes(),
+        )?;
+        crate::output::write_json(&out.join("design.json"), &design_record(&design))?;
+        println!("wrote {}", out.join("design.csv").display());
+    }
+    if let Some(y) = response {
+        let factors: Vec<FactorColumn> = (0..design.factors.len())
+            .map(|f| FactorColumn {
+                name: design.factors[f].name.clone(),
+                levels: design.factors[f].levels.clone(),
+                codes: design.runs.iter().map(|r| r.levels[f]).collect(),
+            })
+            .collect();
+        let options = AnovaOptions {
+            max_order: manifest.analysis.max_order,
+            alpha: manifest.analysis.alpha.unwrap_or(0.05),
+            ..Default::default()
+        };
+        let analysis = analyse(&metric, &factors, &y, &options)?;
+        print!("{}", format_analysis(&analysis));
+        if let Some(out) = &args.out {
+            write_outputs(
+                &analysis,
+                Some(&out.join("anova.json")),
+                Some(&out.join("plots")),
+            )?;
+        }
+    }
+    Ok(())
+}
+
+fn describe(d: &Design) -> String {
+    let mut s = String::new();
+    let levels: Vec<String> = d
+        .factors
+        .iter()
+        .map(|f| format!("{} ({})", f.name, f.levels.join("/")))
+        .collect();
+    let _ = writeln!(s, "Design: {} runs; factors {}", d.len(), levels.join(", "));
+    if !d.generators.is_empty() {
+        let g: Vec<String> = d.generators.iter().map(|g| g.to_string()).collect();
+        let w: Vec<String> = d
+            .defining_relation()
+            .iter()
+            .map(|w| w.to_string())
+            .collect();
+        let _ = writeln!(
+            s,
+            "Generators {}; I = {}; resolution {}",
+            g.join(", "),
+            w.join(" = "),
+            d.resolution().unwrap_or(0)
+        );
+        for c in d.alias_chains(2) {
+            let _ = writeln!(s, "  {c}");
+        }
+    }
+    s
+}
+
+#[derive(serde::Serialize)]
+struct DesignRecord<'a> {
+    design: &'a Design,
+    defining_relation: Vec<String>,
+    resolution: Option<usize>,
+    alias_chains: Vec<String>,
+}
+
+fn design_record(d: &Design) -> DesignRecord<'_> {
+    DesignRecord {
+        design: d,
+        defining_relation: d
+            .defining_relation()
+            .iter()
+            .map(|w| w.to_string())
+            .collect(),
+        resolution: d.resolution(),
+        alias_chains: d
+            .alias_chains(d.factors.len())
+            .iter()
+            .map(|c| c.to_string())
+            .collect(),
+    }
+}
+
+fn design_csv(d: &Design, metric: &str, y: Option<&[f64]>) -> String {
+    let mut s = String::from("run_order,standard_order,replicate");
+    for f in &d.factors {
+        let _ = write!(s, ",{}", f.name);
+    }
+    if y.is_some() {
+        let _ = write!(s, ",{metric}");
+    }
+    s.push('\n');
+    for (i, r) in d.runs.iter().enumerate() {
+        let _ = write!(s, "{},{},{}", r.run_order, r.standard_order, r.replicate);
+        for f in 0..d.factors.len() {
+            let _ = write!(s, ",{}", d.level_name(r, f));
+        }
+        if let Some(y) = y {
+            let _ = write!(s, ",{}", y[i]);
+        }
+        s.push('\n');
+    }
+    s
+}
+
+/// One calibration per run, in parallel (each run is independent; results
+/// do not depend on the thread count). Returns the metric per run.
+fn run_calibrations(
+    d: &Design,
+    spec: &CalibrationResponse,
+    base: &Path,
+) -> anyhow::Result<Vec<f64>> {
+    for f in &d.factors {
+        if FE_FACTORS.contains(&f.name.as_str()) {
+            anyhow::bail!("factor `{}`: finite-element responses (N1 needle: law x friction) are not supported by `palpate doe` yet", f.name);
+        }
+        if !["law", "residual", "data", "estimator"].contains(&f.name.as_str()) {
+            anyhow::bail!("factor `{}` has no meaning for a calibration response; known factors: law, residual, data, estimator", f.name);
+        }
+    }
+    if !["r2", "rms"].contains(&spec.metric.as_str()) {
+        anyhow::bail!(
+            "response.calibration.metric = `{}`; expected r2 or rms",
+            spec.metric
+        );
+    }
+    let mut sets = BTreeMap::new();
+    for (name, file) in &spec.data {
+        let (set, mode) = name.split_once(':').unwrap_or((name, name));
+        let test =
+            TestKind::parse(mode).with_context(|| format!("response.calibration.data `{name}`"))?;
+        sets.insert(
+            set.to_string(),
+            TestData::read(set, test, &base.join(file))?,
+        );
+    }
+    let setting = |run: &palpate_uq::doe::Run, factor: &str| -> Option<String> {
+        d.factors
+            .iter()
+            .position(|f| f.name == factor)
+            .map(|k| d.level_name(run, k).to_string())
+    };
+    d.runs
+        .par_iter()
+        .map(|run| {
+            let law_text = setting(run, "law")
+                .or_else(|| spec.law.clone())
+                .unwrap_or_else(|| "neo-hookean".into());
+            let law: Law = law_text
+                .parse()
+                .map_err(|e| anyhow::anyhow!("law `{law_text}`: {e}"))?;
+            let residual_text = setting(run, "residual")
+                .or_else(|| spec.residual.clone())
+                .unwrap_or_else(|| "absolute".into());
+            let residual: ResidualKind = residual_text
+                .parse()
+                .map_err(|e| anyhow::anyhow!("residual `{residual_text}`: {e}"))?;
+            let method = parse_method(
+                &setting(run, "estimator")
+                    .or_else(|| spec.estimator.clone())
+                    .unwrap_or_else(|| "lm".into()),
+            )?;
+            let fitted: Vec<TestData> = match setting(run, "data") {
+                Some(names) => names
+                    .split('+')
+                    .map(|n| {
+                        sets.get(n.trim()).cloned().ok_or_else(|| {
+                            anyhow::anyhow!("data set `{n}` is not in response.calibration.data")
+                        })
+                    })
+                    .collect::<anyhow::Result<_>>()?,
+                None => sets.values().cloned().collect(),
+            };
+            let c = calibrate(Request {
+                law,
+                fitted: &fitted,
+                predict: &[],
+                residual,
+                method,
+                fixed: Vec::new(),
+                observer: None,
+            })
+            .with_context(|| {
+                format!(
+                    "run {} (standard order {})",
+                    run.run_order, run.standard_order
+                )
+            })?;
+            Ok(if spec.metric == "r2" { c.r2 } else { c.rms })
+        })
+        .collect()
 }
