@@ -17,9 +17,15 @@ use std::sync::Arc;
 /// (indentation) it is the usual QLV approximation applied to the force.
 ///
 /// Parameters: the wrapped model's, then `g1, tau1_s, g2, tau2_s, ...` with
-/// g_i >= 0, sum g_i < 1, tau_i > 0 and tau_1 <= tau_2 <= ... (checked, so
-/// that terms cannot swap labels). g_i = 0 switches the effect off
-/// ([`ForwardModel::embed`]). Needs `loading.time`.
+/// g_i in [0, 1], sum g_i <= 1 and tau_i > 0 (checked: an error, never a
+/// clamp). g_i = 0 switches the effect off ([`ForwardModel::embed`]). Needs
+/// `loading.time`.
+///
+/// Label switching: the response is symmetric in the terms, so the model
+/// accepts them in any order rather than rejecting tau_1 > tau_2 (a
+/// rejection makes finite-difference steps fail whenever an estimate pushes
+/// two relaxation times together); [`Viscoelastic::canonical_order`] gives
+/// the canonical labelling (increasing tau) for reports and samples.
 pub struct Viscoelastic {
     base: Arc<dyn ForwardModel>,
     terms: usize,
@@ -59,10 +65,10 @@ impl Viscoelastic {
         self.terms
     }
 
-    /// Checks the Prony parameters `[g1, tau1, g2, tau2, ...]`.
+    /// Checks the Prony parameters `[g1, tau1, g2, tau2, ...]`: g_i >= 0
+    /// (bounds), tau_i > 0 and sum g_i <= 1 (so G(inf) = 1 - sum g_i >= 0).
     fn check_prony(&self, prony: &[f64]) -> Result<(), ForwardError> {
         let mut sum = 0.0;
-        let mut last_tau = 0.0;
         for i in 0..self.terms {
             let (g, tau) = (prony[2 * i], prony[2 * i + 1]);
             sum += g;
@@ -73,23 +79,33 @@ impl Viscoelastic {
                     reason: "relaxation time must be positive".into(),
                 });
             }
-            if tau < last_tau {
-                return Err(ForwardError::InvalidParameter {
-                    name: format!("tau{}_s", i + 1),
-                    value: tau,
-                    reason: format!("relaxation times must be ordered (tau{}_s = {last_tau})", i),
-                });
-            }
-            last_tau = tau;
         }
-        if sum.is_nan() || sum >= 1.0 {
+        if sum.is_nan() || sum > 1.0 {
             return Err(ForwardError::InvalidParameter {
                 name: format!("g{}", self.terms),
                 value: prony[2 * (self.terms - 1)],
-                reason: format!("sum of g_i = {sum} must be below 1"),
+                reason: format!("sum of g_i = {sum} must not exceed 1"),
             });
         }
         Ok(())
+    }
+
+    /// The same parameter vector with the Prony terms sorted by increasing
+    /// relaxation time (the canonical labelling: the response does not
+    /// depend on the order of the terms, so estimates and samples should be
+    /// reported in this order to avoid label switching).
+    pub fn canonical_order(&self, theta: &[f64]) -> Vec<f64> {
+        let p = theta.len() - 2 * self.terms;
+        let mut pairs: Vec<(f64, f64)> = (0..self.terms)
+            .map(|i| (theta[p + 2 * i], theta[p + 2 * i + 1]))
+            .collect();
+        pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
+        let mut out = theta[..p].to_vec();
+        for (g, tau) in pairs {
+            out.push(g);
+            out.push(tau);
+        }
+        out
     }
 }
 
