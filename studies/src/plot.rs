@@ -425,6 +425,22 @@ impl Plot {
                 legend.push((b.label.clone(), b.color.clone(), Style::Bars(0.0)));
             }
         }
+        if !legend.is_empty() {
+            // A translucent box so the legend stays readable over data.
+            let longest = legend
+                .iter()
+                .map(|(l, _, _)| l.chars().count())
+                .max()
+                .unwrap_or(0) as f64;
+            let _ = writeln!(
+                out,
+                r##"<rect x="{}" y="{}" width="{}" height="{}" fill="white" fill-opacity="0.8" stroke="#cccccc"/>"##,
+                fmt(ox + ml + 4.0),
+                fmt(oy + mt + 2.0),
+                fmt(34.0 + 6.2 * longest),
+                fmt(16.0 * legend.len() as f64 + 4.0)
+            );
+        }
         for (i, (label, c, style)) in legend.iter().enumerate() {
             let y = oy + mt + 14.0 + 16.0 * i as f64;
             let x = ox + ml + 10.0;

@@ -290,13 +290,61 @@ fn write_calibrate_report(step: &CalibrateStep, fits: &[FitEntry], r: &mut Strin
 
 fn run_diagnose(
     step: &DiagnoseStep,
-    _data: &BTreeMap<String, TestData>,
-    _out: &Path,
-    _observer: &dyn RunObserver,
-    _report: &mut String,
+    data: &BTreeMap<String, TestData>,
+    out: &Path,
+    observer: &dyn RunObserver,
+    report: &mut String,
 ) -> anyhow::Result<StepResult> {
-    anyhow::bail!(
-        "step `{}`: the diagnose step is not available yet",
-        step.name
-    )
+    let law: Law = step
+        .base
+        .parse()
+        .map_err(|e| anyhow::anyhow!("step `{}`: base: {e}", step.name))?;
+    let model = crate::cli::diagnose::base_model("C1", law)?;
+    let mut cases = Vec::new();
+    let _ = writeln!(
+        report,
+        "## Gap diagnosis `{}` (base `{}`)\n",
+        step.name, step.base
+    );
+    let _ = writeln!(report, "| data | verdict | noise SD (N) | base misfit (N) | best effect | misfit after (N) | held-out before / after (N) |");
+    let _ = writeln!(report, "|---|---|---|---|---|---|---|");
+    for name in &step.data {
+        observer.message(&format!("{}: diagnosing {name}", step.name));
+        let d = &data[name];
+        let gap =
+            palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &Default::default())
+                .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
+        let best = gap.ranking.first();
+        let _ = writeln!(
+            report,
+            "| {name} | **{}**{} | {:.4} | {:.4} | {} | {} | {} |",
+            gap.verdict,
+            if gap.confounded.is_empty() {
+                String::new()
+            } else {
+                format!(" (confounded with {})", gap.confounded.join(", "))
+            },
+            gap.noise_sd,
+            gap.base.misfit,
+            best.map(|b| b.effect.clone()).unwrap_or_default(),
+            best.map(|b| format!("{:.4}", b.misfit_after))
+                .unwrap_or_default(),
+            best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))
+                .unwrap_or_default(),
+        );
+        let svg = crate::cli::diagnose::gap_svg(&gap, name);
+        write_atomic(
+            &out.join("plots").join(format!("{}-{name}.svg", step.name)),
+            svg.as_bytes(),
+        )?;
+        cases.push(DiagnoseEntry {
+            data: name.clone(),
+            report: serde_json::to_value(&gap)?,
+        });
+    }
+    let _ = writeln!(report, "\nPlots: `plots/{}-<data>.svg` (data, base and enriched fits, residuals with the flagged windows).\n", step.name);
+    Ok(StepResult::Diagnose {
+        name: step.name.clone(),
+        cases,
+    })
 }
