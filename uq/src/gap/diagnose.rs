@@ -2,7 +2,7 @@
 
 use super::fit::{fit_from_starts, Fitted};
 use super::noise::difference_noise_sd;
-use super::report::{BaseSummary, GapPlot, GapReport, RankedEffect};
+use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
 use super::score::{score_test, sensitivities};
 use super::structure::{
     chi2_isf, chi2_sf, default_window, discrepancy_band, lag1, significant_windows, whiteness,
@@ -156,15 +156,74 @@ fn time_constant_starts(
         .collect()
 }
 
+/// Contiguous blocks [first, end) of `n` samples.
+fn blocks(n: usize, folds: usize) -> Vec<(usize, usize)> {
+    (0..folds)
+        .map(|k| (k * n / folds, (k + 1) * n / folds))
+        .collect()
+}
+
+/// Blocked cross-validation: each block left out in turn, the model refitted
+/// to the rest (a local re-estimation from the full-record optimum, the
+/// first of `starts`; the others are fallbacks when that fit fails) and the
+/// block predicted. Returns the out-of-block predictions.
+fn cross_validate(
+    model: &Arc<dyn ForwardModel>,
+    loading: &Loading,
+    observed: &[f64],
+    folds: &[(usize, usize)],
+    starts: &[Vec<f64>],
+    fixed: &[(String, f64)],
+) -> Result<Vec<f64>, GapError> {
+    let n = observed.len();
+    let mut out = vec![0.0; n];
+    for &(a, b) in folds {
+        let keep: Vec<usize> = (0..a).chain(b..n).collect();
+        let mut fitted =
+            fit_from_starts(model, loading, observed, Some(&keep), &starts[..1], fixed);
+        if fitted.is_err() && starts.len() > 1 {
+            fitted = fit_from_starts(model, loading, observed, Some(&keep), &starts[1..], fixed);
+        }
+        let fitted = fitted?;
+        out[a..b].copy_from_slice(&fitted.predicted[a..b]);
+    }
+    Ok(out)
+}
+
+/// Prony terms (`g<i>`, `tau<i>_s`) of a parameter map relabelled by
+/// increasing relaxation time: the response is symmetric in the terms, so
+/// this canonical order avoids label switching in reports.
+fn canonical_prony<T: Clone>(map: &mut BTreeMap<String, T>, taus: &BTreeMap<String, f64>) {
+    let mut terms: Vec<(f64, Option<T>, Option<T>)> = Vec::new();
+    let mut i = 1;
+    while let Some(&tau) = taus.get(&format!("tau{i}_s")) {
+        terms.push((
+            tau,
+            map.remove(&format!("g{i}")),
+            map.remove(&format!("tau{i}_s")),
+        ));
+        i += 1;
+    }
+    terms.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (k, (_, g, tau)) in terms.into_iter().enumerate() {
+        if let Some(g) = g {
+            map.insert(format!("g{}", k + 1), g);
+        }
+        if let Some(tau) = tau {
+            map.insert(format!("tau{}_s", k + 1), tau);
+        }
+    }
+}
+
 struct Context<'a> {
     loading: &'a Loading,
     observed: &'a [f64],
     sigma: f64,
-    n_fit: usize,
+    folds: Vec<(usize, usize)>,
     p: usize,
     base_theta: Vec<f64>,
     base_full: &'a Fitted,
-    base_prefix: &'a Fitted,
+    base_cv: Vec<f64>,
     base_residual: Vec<f64>,
     candidates: usize,
     alpha: f64,
@@ -177,7 +236,7 @@ fn assess(
     rich: Arc<dyn ForwardModel>,
     ctx: &Context<'_>,
 ) -> Result<(RankedEffect, Fitted), GapError> {
-    let (n, n_fit, p) = (ctx.observed.len(), ctx.n_fit, ctx.p);
+    let (n, p) = (ctx.observed.len(), ctx.p);
     let specs = rich.space().params.clone();
     let q = specs.len() - p;
     let off = rich.embed(&ctx.base_theta);
@@ -204,17 +263,24 @@ fn assess(
         .map(|t| t[t.len() - 1] - t[0])
         .unwrap_or(0.0);
     starts.extend(time_constant_starts(rich.as_ref(), p, &off, duration));
-    let full = fit_from_starts(&rich, ctx.loading, ctx.observed, n, &starts, &[])?;
-    // The held-out fit starts from the full-record optimum and the step from "off".
-    let prefix_starts = vec![full.theta.clone(), starts[0].clone()];
-    let prefix = fit_from_starts(&rich, ctx.loading, ctx.observed, n_fit, &prefix_starts, &[])?;
+    let full = fit_from_starts(&rich, ctx.loading, ctx.observed, None, &starts, &[])?;
+    let cv_starts = vec![full.theta.clone(), starts[0].clone(), starts[1].clone()];
+    let cv = cross_validate(
+        &rich,
+        ctx.loading,
+        ctx.observed,
+        &ctx.folds,
+        &cv_starts,
+        &[],
+    )?;
 
     let r_after = residuals(ctx.observed, &full.predicted);
     let sigma2 = ctx.sigma * ctx.sigma;
     let lr = (ctx.base_full.sse - full.sse) / sigma2;
     let lr_p = chi2_sf(lr, q as f64);
-    let h_before = residuals(&ctx.observed[n_fit..], &ctx.base_prefix.predicted[n_fit..]);
-    let h_after = residuals(&ctx.observed[n_fit..], &prefix.predicted[n_fit..]);
+    let h_before = residuals(ctx.observed, &ctx.base_cv);
+    let h_after = residuals(ctx.observed, &cv);
+    let later = ctx.folds[ctx.folds.len() - 1].0;
     let heldout_gain = (sse(&h_before) - sse(&h_after)) / sigma2;
     let dev_base = ar1_deviance(&ctx.base_residual);
     let dev_rich = ar1_deviance(&r_after);
@@ -227,20 +293,24 @@ fn assess(
 
     let names = rich.space().names();
     let own: Vec<String> = names[p..].to_vec();
-    let params: BTreeMap<String, f64> = own
+    let mut params: BTreeMap<String, f64> = own
         .iter()
         .zip(&full.theta[p..])
         .map(|(k, v)| (k.clone(), *v))
         .collect();
-    let all_params: BTreeMap<String, f64> = names
+    let mut all_params: BTreeMap<String, f64> = names
         .iter()
         .zip(&full.theta)
         .map(|(k, v)| (k.clone(), *v))
         .collect();
-    let standard_errors = own
+    let mut standard_errors: BTreeMap<String, Option<f64>> = own
         .iter()
         .map(|k| (k.clone(), full.report.standard_error(k)))
         .collect();
+    let fitted_values = params.clone();
+    canonical_prony(&mut params, &fitted_values);
+    canonical_prony(&mut all_params, &fitted_values);
+    canonical_prony(&mut standard_errors, &fitted_values);
     let ident = &full.report.identifiability;
     let own_involved = ident.involved.iter().any(|k| own.contains(k));
     let identifiable = ident.identifiable || !own_involved;
@@ -260,7 +330,8 @@ fn assess(
     let after = whiteness(&r_after, specs.len(), ctx.sigma, ctx.rel_var_sd2);
     let evidence = format!(
         "score test {:.1} on {} dof (p = {:.1e}); refit: likelihood ratio {:.1} on {q} parameters (p = {:.1e}, \
-         needs < {:.1e}); held-out gain {:.1} (needs > {:.1}), held-out RMS {:.3e} -> {:.3e}; dAIC {:.1}, dBIC {:.1} \
+         needs < {:.1e}); blocked cross-validation gain {:.1} (needs > {:.1}), held-out RMS {:.3e} -> {:.3e} \
+         (later segment {:.3e} -> {:.3e}); dAIC {:.1}, dBIC {:.1} \
          under AR(1) errors; residual RMS/noise {:.2} -> {:.2}, runs p {:.1e} -> {:.1e}; {}",
         score.statistic,
         score.dof,
@@ -272,6 +343,8 @@ fn assess(
         gain_threshold,
         rms(&h_before),
         rms(&h_after),
+        rms(&h_before[later..]),
+        rms(&h_after[later..]),
         delta_aic,
         delta_bic,
         rms(&ctx.base_residual) / ctx.sigma,
@@ -287,6 +360,8 @@ fn assess(
         misfit_after: rms(&r_after),
         heldout_before: rms(&h_before),
         heldout_after: rms(&h_after),
+        later_before: rms(&h_before[later..]),
+        later_after: rms(&h_after[later..]),
         evidence,
         identifiable,
         confounded_with: Vec::new(),
@@ -348,20 +423,19 @@ pub fn diagnose(
         return Err(GapError::ZeroNoise);
     }
     let p = base.space().len();
-    let n_fit = (((1.0 - options.holdout_fraction) * n as f64).round() as usize)
-        .clamp((p + 3).max(n / 2), n - 3);
+    let folds = blocks(n, options.folds);
 
-    // Base fit on all samples and on the first part only.
+    // Base fit on all samples, and blocked cross-validation.
     let (proxy, fixed) = base_proxy(base, loading)?;
     let starts: Vec<Vec<f64>> = base_starts(base, loading, observed)
         .iter()
         .map(|s| proxy.embed(s))
         .collect();
-    let base_full = fit_from_starts(&proxy, loading, observed, n, &starts, &fixed)?;
+    let base_full = fit_from_starts(&proxy, loading, observed, None, &starts, &fixed)?;
     let base_theta = base_full.theta[..p].to_vec();
-    let mut prefix_starts = vec![base_full.theta.clone()];
-    prefix_starts.extend(starts);
-    let base_prefix = fit_from_starts(&proxy, loading, observed, n_fit, &prefix_starts, &fixed)?;
+    let mut cv_starts = vec![base_full.theta.clone()];
+    cv_starts.extend(starts.iter().cloned());
+    let base_cv = cross_validate(&proxy, loading, observed, &folds, &cv_starts, &fixed)?;
     let base_residual = residuals(observed, &base_full.predicted);
 
     // Where: whole-record tests and windows.
@@ -422,34 +496,32 @@ pub fn diagnose(
         loading,
         observed,
         sigma,
-        n_fit,
+        folds: folds.clone(),
         p,
         base_theta: base_theta.clone(),
         base_full: &base_full,
-        base_prefix: &base_prefix,
+        base_cv: base_cv.clone(),
         base_residual: base_residual.clone(),
         candidates: enriched.len(),
         alpha: options.alpha,
         rel_var_sd2: noise.rel_var_sd2,
     };
     // Candidates are independent: assessed in parallel, collected in order.
-    let mut assessed: Vec<(RankedEffect, Fitted)> = enriched
+    let outcomes: Vec<(Effect, Result<(RankedEffect, Fitted), GapError>)> = enriched
         .into_par_iter()
-        .filter_map(|(e, rich)| {
-            let t0 = std::time::Instant::now();
-            let a = assess(e, rich, &ctx).ok();
-            eprintln!(
-                "DEBUG {e} {:.2}s evals {:?}",
-                t0.elapsed().as_secs_f64(),
-                a.as_ref().map(|a| (
-                    a.1.report.evaluations,
-                    a.1.report.iterations,
-                    a.1.report.termination.clone()
-                ))
-            );
-            a
-        })
+        .map(|(e, rich)| (e, assess(e, rich, &ctx)))
         .collect();
+    let mut assessed = Vec::new();
+    let mut failed = Vec::new();
+    for (e, outcome) in outcomes {
+        match outcome {
+            Ok(a) => assessed.push(a),
+            Err(err) => failed.push(FailedCandidate {
+                effect: e.name().to_string(),
+                error: err.to_string(),
+            }),
+        }
+    }
     assessed.sort_by(|a, b| {
         b.0.earns
             .cmp(&a.0.earns)
@@ -493,7 +565,7 @@ pub fn diagnose(
             Vec::new(),
             format!(
                 "The base model misses the data ({reason}), but no candidate effect earns its parameters \
-                 (significant likelihood ratio and held-out gain); the gap is left unexplained."
+                 (significant likelihood ratio and cross-validated gain); the gap is left unexplained."
             ),
         ),
         (true, Some(best)) => {
@@ -529,15 +601,17 @@ pub fn diagnose(
         enriched_effect: best_fit.map(|a| a.0.effect.clone()),
         enriched_fit: best_fit.map(|a| a.1.predicted.clone()),
         enriched_residual: best_fit.map(|a| residuals(observed, &a.1.predicted)),
-        heldout_from: n_fit,
+        folds: folds.clone(),
+        base_cv: base_cv.clone(),
     };
     let base_names = base.space().names();
-    let heldout_base = residuals(&observed[n_fit..], &base_prefix.predicted[n_fit..]);
+    let heldout_base = residuals(observed, &base_cv);
     Ok(GapReport {
         verdict,
         noise_sd: sigma,
         where_: windows,
         ranking: assessed.into_iter().map(|a| a.0).collect(),
+        failed,
         confounded,
         explanation,
         base: BaseSummary {
@@ -551,7 +625,7 @@ pub fn diagnose(
         },
         noise,
         samples: n,
-        heldout_samples: n - n_fit,
+        folds: options.folds,
         plot,
     })
 }

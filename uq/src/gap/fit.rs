@@ -1,10 +1,14 @@
-//! Fitting a model to the whole record or to its first part, through
+//! Fitting a model to the whole record or to the record with a window left out, through
 //! palpate-inverse (Levenberg-Marquardt in the unbounded parameter space),
 //! from several starting points.
 
 use super::GapError;
-use palpate_core::{ForwardModel, Loading, ParamSpec};
-use palpate_inverse::{fit, DataSet, FitOptions, FitReport, Objective, ResidualKind};
+use palpate_core::{
+    Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+};
+use palpate_inverse::{
+    fit, DataSet, FitOptions, FitReport, LmOptions, Method, Objective, ResidualKind,
+};
 use std::sync::Arc;
 
 /// A fitted model.
@@ -20,12 +24,72 @@ pub(crate) struct Fitted {
     pub report: FitReport,
 }
 
-/// The first `n` samples of a history.
-pub(crate) fn prefix(loading: &Loading, n: usize) -> Loading {
-    Loading {
-        drive_kind: loading.drive_kind,
-        drive: loading.drive[..n].to_vec(),
-        time: loading.time.as_ref().map(|t| t[..n].to_vec()),
+/// A model seen through a subset of the samples of one fixed history: it
+/// always simulates the whole `full` history (so history-dependent models
+/// such as QLV stay exact) and returns only the samples `keep`. This lets the
+/// calibration fit a record with a window left out (blocked
+/// cross-validation); the loading handed to its evaluator only sets the
+/// output length.
+struct Masked {
+    inner: Arc<dyn ForwardModel>,
+    full: Loading,
+    keep: Vec<usize>,
+}
+
+struct MaskedEvaluator<'a> {
+    model: &'a Masked,
+    inner: Box<dyn Evaluator + 'a>,
+    buffer: Vec<f64>,
+}
+
+impl Evaluator for MaskedEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        _loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let m = self.model;
+        self.buffer.resize(m.full.len(), 0.0);
+        self.inner.predict_into(theta, &m.full, &mut self.buffer)?;
+        for (o, &k) in out.iter_mut().zip(&m.keep) {
+            *o = self.buffer[k];
+        }
+        Ok(())
+    }
+}
+
+impl ForwardModel for Masked {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+    fn space(&self) -> &ParamSpace {
+        self.inner.space()
+    }
+    fn observable(&self) -> Observable {
+        self.inner.observable()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(MaskedEvaluator {
+            model: self,
+            inner: self.inner.evaluator(),
+            buffer: Vec::new(),
+        })
+    }
+}
+
+/// Levenberg-Marquardt settings of the diagnosis: tolerances far below what
+/// the statistics resolve (a likelihood ratio of 1 is a relative SSE change
+/// of about 1/n), and a budget that stops the fits of degenerate
+/// enrichments (e.g. a Prony term drifting to tau -> 0 in noise) early.
+fn gap_lm_options() -> LmOptions {
+    LmOptions {
+        ftol: 1e-10,
+        xtol: 1e-9,
+        gtol: 1e-10,
+        max_evaluations: 1500,
+        max_iterations: 200,
+        ..LmOptions::default()
     }
 }
 
@@ -55,25 +119,37 @@ pub(crate) fn interior(spec: &ParamSpec, x: f64) -> f64 {
     v
 }
 
-/// Fits `model` to the first `n_fit` samples from each start (moved inside
-/// the bounds; parameters in `fixed` held at their values) and keeps the
-/// lowest SSE. Starts whose fit fails are skipped;
-/// the error of the first is returned when all fail.
+/// Fits `model` to the samples `keep` of the record (all when `None`) from
+/// each start (moved inside the bounds; parameters in `fixed` held at their
+/// values) and keeps the lowest SSE. Starts whose fit fails are skipped; the
+/// error of the first is returned when all fail. Predictions cover the whole
+/// record.
 pub(crate) fn fit_from_starts(
     model: &Arc<dyn ForwardModel>,
     loading: &Loading,
     observed: &[f64],
-    n_fit: usize,
+    keep: Option<&[usize]>,
     starts: &[Vec<f64>],
     fixed: &[(String, f64)],
 ) -> Result<Fitted, GapError> {
-    let fit_loading = prefix(loading, n_fit);
-    let set = DataSet::new(
-        "data",
-        model.clone(),
-        fit_loading,
-        observed[..n_fit].to_vec(),
-    );
+    let set = match keep {
+        None => DataSet::new("data", model.clone(), loading.clone(), observed.to_vec()),
+        Some(keep) => {
+            let masked: Arc<dyn ForwardModel> = Arc::new(Masked {
+                inner: model.clone(),
+                full: loading.clone(),
+                keep: keep.to_vec(),
+            });
+            let drive = keep.iter().map(|&k| loading.drive[k]).collect();
+            let y = keep.iter().map(|&k| observed[k]).collect();
+            DataSet::new(
+                "data (window left out)",
+                masked,
+                Loading::quasi_static(loading.drive_kind, drive),
+                y,
+            )
+        }
+    };
     let objective = Objective::new(vec![set], ResidualKind::Absolute, fixed).map_err(|source| {
         GapError::Fit {
             model: model.name(),
@@ -97,6 +173,7 @@ pub(crate) fn fit_from_starts(
             .collect();
         let options = FitOptions {
             start: Some(start),
+            method: Method::LevenbergMarquardt(gap_lm_options()),
             ..FitOptions::default()
         };
         match fit(&objective, &options) {
@@ -127,11 +204,17 @@ pub(crate) fn fit_from_starts(
     };
     let theta = report.theta();
     let predicted = model.predict(&theta, loading)?;
-    let sse = predicted[..n_fit]
-        .iter()
-        .zip(&observed[..n_fit])
-        .map(|(p, y)| (y - p).powi(2))
-        .sum();
+    let sse = match keep {
+        None => predicted
+            .iter()
+            .zip(observed)
+            .map(|(p, y)| (y - p).powi(2))
+            .sum(),
+        Some(keep) => keep
+            .iter()
+            .map(|&k| (observed[k] - predicted[k]).powi(2))
+            .sum(),
+    };
     Ok(Fitted {
         theta,
         sse,

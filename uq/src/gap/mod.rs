@@ -33,6 +33,6 @@ pub use diagnose::diagnose;
 pub use error::GapError;
 pub use noise::{difference_noise_sd, NoiseEstimate};
 pub use options::GapOptions;
-pub use report::{BaseSummary, GapPlot, GapReport, RankedEffect};
+pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
 pub use score::{score_test, sensitivities, ScoreTest};
 pub use structure::{discrepancy_band, significant_windows, whiteness, GapWindow, WhitenessTests};

@@ -13,8 +13,10 @@ pub struct GapOptions {
     /// autocorrelation, windows, likelihood ratio, held-out gain); each family
     /// is Bonferroni-corrected for its number of tests.
     pub alpha: f64,
-    /// Fraction of the record, at its end, held out from the fits.
-    pub holdout_fraction: f64,
+    /// Number of contiguous blocks of the record for blocked cross-validation:
+    /// each block is left out in turn, predicted by the model fitted to the
+    /// rest; the last block is the later segment of the history.
+    pub folds: usize,
     /// Running-window length in samples (default n / 15 within [8, 60]).
     pub window: Option<usize>,
     /// Candidate effects (default: every effect the base model offers).
@@ -28,7 +30,7 @@ impl Default for GapOptions {
     fn default() -> Self {
         GapOptions {
             alpha: 1e-3,
-            holdout_fraction: 0.25,
+            folds: 8,
             window: None,
             effects: None,
             confound_alpha: 0.01,
@@ -51,10 +53,10 @@ impl GapOptions {
                 reason: format!("{} must lie in (0, 1)", self.confound_alpha),
             });
         }
-        if !(self.holdout_fraction > 0.0 && self.holdout_fraction < 0.6) {
+        if !(2..=20).contains(&self.folds) {
             return Err(GapError::InvalidOption {
-                option: "holdout_fraction",
-                reason: format!("{} must lie in (0, 0.6)", self.holdout_fraction),
+                option: "folds",
+                reason: format!("{} must lie in [2, 20]", self.folds),
             });
         }
         if let Some(w) = self.window {

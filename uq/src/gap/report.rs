@@ -19,10 +19,15 @@ pub struct RankedEffect {
     pub misfit_before: f64,
     /// RMS residual of the enriched fit on the fitted samples.
     pub misfit_after: f64,
-    /// RMS residual on the held-out end of the record, base fitted without it.
+    /// RMS residual of held-out predictions of the base model (blocked
+    /// cross-validation: each block predicted by a fit to the other blocks).
     pub heldout_before: f64,
-    /// Same for the enriched model fitted without it.
+    /// Same for the enriched model.
     pub heldout_after: f64,
+    /// The same restricted to the last block (the later segment of the
+    /// history, predicted from the earlier part and what follows none).
+    pub later_before: f64,
+    pub later_after: f64,
     /// A sentence with the numbers behind the rank.
     pub evidence: String,
     /// Whether the enriched fit determines its parameters and is not
@@ -45,7 +50,7 @@ pub struct RankedEffect {
     pub lr_statistic: f64,
     /// Its chi-square p-value on the effect's degrees of freedom.
     pub lr_p: f64,
-    /// Held-out gain (SSE_base - SSE_enriched) / sigma^2 on the held-out samples.
+    /// Held-out gain (SSE_base - SSE_enriched) / sigma^2 of the cross-validated predictions.
     pub heldout_gain: f64,
     /// Change of AIC and BIC (enriched - base) under an AR(1) error model.
     pub delta_aic_ar1: f64,
@@ -58,6 +63,13 @@ pub struct RankedEffect {
     pub identifiability: String,
 }
 
+/// A candidate whose refit could not be made (reported, not hidden).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct FailedCandidate {
+    pub effect: String,
+    pub error: String,
+}
+
 /// The base model's fit.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct BaseSummary {
@@ -65,7 +77,7 @@ pub struct BaseSummary {
     pub params: BTreeMap<String, f64>,
     /// RMS residual on all samples (data unit).
     pub misfit: f64,
-    /// RMS residual on the held-out end, fitted without it.
+    /// RMS residual of the cross-validated (held-out) predictions.
     pub heldout: f64,
     pub tests: WhitenessTests,
     /// Whether the base misfit is significantly more than noise.
@@ -94,8 +106,10 @@ pub struct GapPlot {
     pub enriched_effect: Option<String>,
     pub enriched_fit: Option<Vec<f64>>,
     pub enriched_residual: Option<Vec<f64>>,
-    /// Index of the first held-out sample.
-    pub heldout_from: usize,
+    /// Cross-validation blocks [first, end) of sample indices.
+    pub folds: Vec<(usize, usize)>,
+    /// Held-out (cross-validated) predictions of the base model.
+    pub base_cv: Vec<f64>,
 }
 
 /// The diagnosis (GAP.md JSON contract: `verdict`, `noise_sd`, `where`,
@@ -111,6 +125,8 @@ pub struct GapReport {
     pub where_: Vec<GapWindow>,
     /// Candidates, best first.
     pub ranking: Vec<RankedEffect>,
+    /// Candidates that could not be assessed, with the reason.
+    pub failed: Vec<FailedCandidate>,
     /// Effects the data cannot tell apart from the verdict (empty when the
     /// verdict is clear).
     pub confounded: Vec<String>,
@@ -118,9 +134,9 @@ pub struct GapReport {
     pub explanation: String,
     pub base: BaseSummary,
     pub noise: NoiseEstimate,
-    /// Samples fitted and held out.
+    /// Samples, and blocks of the cross-validation.
     pub samples: usize,
-    pub heldout_samples: usize,
+    pub folds: usize,
     pub plot: GapPlot,
 }
 
@@ -160,7 +176,7 @@ impl GapReport {
         );
         let _ = writeln!(
             s,
-            "- significant gap: {} ({})\n- samples: {} ({} held out at the end)\n",
+            "- significant gap: {} ({})\n- samples: {} (blocked cross-validation over {} blocks)\n",
             if self.base.gap_significant {
                 "yes"
             } else {
@@ -168,7 +184,7 @@ impl GapReport {
             },
             self.base.reason,
             self.samples,
-            self.heldout_samples
+            self.folds
         );
         let _ = writeln!(s, "## Where\n");
         if self.where_.is_empty() {
@@ -224,6 +240,13 @@ impl GapReport {
                 } else {
                     format!(" (confounded with {})", r.confounded_with.join(", "))
                 }
+            );
+        }
+        for f in &self.failed {
+            let _ = writeln!(
+                s,
+                "| {} | could not be assessed: {} | | | | | | | |",
+                f.effect, f.error
             );
         }
         let _ = writeln!(s, "\n### Evidence\n");
