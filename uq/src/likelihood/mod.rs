@@ -5,13 +5,16 @@
 //!   AR(1)-correlated (exact likelihood).
 //! * [`Posterior`]: data sets + priors as a [`crate::mcmc::LogDensity`] in the
 //!   unbounded space, with the transforms' log-Jacobian.
+//! * [`fit_and_laplace`]: least-squares fit, Laplace approximation, chain start.
 //! * [`predictive_band`]: posterior predictive bands.
 
+pub mod map_start;
 pub mod noise;
 pub mod posterior;
 pub mod predictive;
 pub mod prior;
 
+pub use map_start::{fit_and_laplace, PosteriorStart, StartError};
 pub use noise::{ar1_log_likelihood, gaussian_log_likelihood, Correlation, NoiseModel, NoiseSd};
 pub use posterior::{DataSet, LikelihoodError, Posterior};
 pub use predictive::{predictive_band, PredictiveBand};

@@ -21,7 +21,7 @@
 //! stream; every chain of every population is reported.
 
 use super::chains::{Chains, SampleRun};
-use super::density::{Counted, LogDensity};
+use super::density::{Counted, LogDensity, Standardized};
 use super::error::McmcError;
 use super::rng::{chain_rng, std_normal, uniform};
 use super::start::Start;
@@ -167,6 +167,9 @@ pub fn sample_demc(
 ) -> Result<SampleRun, McmcError> {
     let d = density.dim();
     start.check(d)?;
+    let std = Standardized::new(density, start);
+    let unit = Start::ball(vec![0.0; d], 1.0);
+    let (density, start): (&dyn LogDensity, &Start) = (&std, &unit);
     if settings.populations == 0
         || settings.chains < 1
         || settings.draws < 4
@@ -200,7 +203,7 @@ pub fn sample_demc(
     }
     Ok(SampleRun {
         sampler: "demc".into(),
-        chains: Chains::from_nested(&all),
+        chains: Chains::from_nested(&all).map(|y| std.to_original(y)),
         log_density: logp,
         acceptance,
         evaluations,

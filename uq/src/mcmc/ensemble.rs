@@ -13,7 +13,7 @@
 //! emcee output.
 
 use super::chains::{Chains, SampleRun};
-use super::density::{Counted, LogDensity};
+use super::density::{Counted, LogDensity, Standardized};
 use super::error::McmcError;
 use super::rng::{chain_rng, uniform};
 use super::start::Start;
@@ -149,6 +149,9 @@ pub fn sample_ensemble(
 ) -> Result<SampleRun, McmcError> {
     let d = density.dim();
     start.check(d)?;
+    let std = Standardized::new(density, start);
+    let unit = Start::ball(vec![0.0; d], 1.0);
+    let (density, start): (&dyn LogDensity, &Start) = (&std, &unit);
     let nw = settings.walkers_for(d);
     if nw < 2 * d + 2 {
         return Err(McmcError::InvalidSettings {
@@ -183,7 +186,7 @@ pub fn sample_ensemble(
     }
     Ok(SampleRun {
         sampler: "ensemble".into(),
-        chains: Chains::from_nested(&all),
+        chains: Chains::from_nested(&all).map(|y| std.to_original(y)),
         log_density: logp,
         acceptance,
         evaluations,

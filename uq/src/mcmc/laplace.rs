@@ -48,9 +48,13 @@ impl Laplace {
     }
 }
 
-fn hessian(f: &mut dyn FnMut(&[f64]) -> f64, z: &[f64], f0: f64) -> (DMatrix<f64>, DVector<f64>) {
+fn hessian(
+    f: &mut dyn FnMut(&[f64]) -> f64,
+    z: &[f64],
+    f0: f64,
+    h: &[f64],
+) -> (DMatrix<f64>, DVector<f64>) {
     let d = z.len();
-    let h: Vec<f64> = z.iter().map(|v| 1e-4 * v.abs().max(1.0)).collect();
     let mut hess = DMatrix::zeros(d, d);
     let mut grad = DVector::zeros(d);
     let mut zz = z.to_vec();
@@ -108,15 +112,28 @@ pub fn laplace(density: &dyn LogDensity, z0: &[f64]) -> Result<Laplace, McmcErro
         });
     }
     let mut lambda = 1e-3;
+    // Difference steps: first relative to z, then a tenth of the current
+    // posterior SD, so badly scaled coordinates get sensible steps.
+    let mut h: Vec<f64> = z.iter().map(|v| 1e-4 * v.abs().max(1.0)).collect();
     for _ in 0..200 {
-        let (hess, grad) = hessian(&mut f, &z, fz);
+        let (hess, grad) = hessian(&mut f, &z, fz, &h);
         // Newton step on -log p: (A + lambda diag) dz = grad with A = -H.
         let a = -hess;
+        if let Some(ch) = a.clone().cholesky() {
+            let inv = ch.inverse();
+            for k in 0..d {
+                h[k] = 0.1 * inv[(k, k)].sqrt();
+            }
+        }
         let mut improved = false;
         for _ in 0..30 {
             let mut m = a.clone();
+            // Damping floor relative to the largest curvature, so a flat
+            // coordinate (a parameter near a bound, whose log-transform
+            // flattens the density) still gets a finite step.
+            let floor = 1e-8 * (0..d).map(|i| a[(i, i)].abs()).fold(1e-300, f64::max);
             for i in 0..d {
-                m[(i, i)] += lambda * a[(i, i)].abs().max(1e-12);
+                m[(i, i)] += lambda * a[(i, i)].abs().max(floor);
             }
             let Some(ch) = m.cholesky() else {
                 lambda *= 10.0;
@@ -139,7 +156,7 @@ pub fn laplace(density: &dyn LogDensity, z0: &[f64]) -> Result<Laplace, McmcErro
             break;
         }
     }
-    let (hess, _) = hessian(&mut f, &z, fz);
+    let (hess, _) = hessian(&mut f, &z, fz, &h);
     let a = -hess;
     let ch = a.clone().cholesky().ok_or_else(|| McmcError::Laplace {
         reason: "the negative Hessian at the mode is not positive definite (flat or non-identifiable direction)".into(),

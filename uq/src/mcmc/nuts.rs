@@ -28,7 +28,7 @@
 //! (finite differences unless the density provides exact ones).
 
 use super::chains::{Chains, SampleRun};
-use super::density::{Counted, LogDensity};
+use super::density::{Counted, LogDensity, Standardized};
 use super::error::McmcError;
 use super::rng::{chain_rng, std_normal, uniform, ChainRng};
 use super::start::Start;
@@ -492,6 +492,9 @@ pub fn sample_nuts(
 ) -> Result<SampleRun, McmcError> {
     let d = density.dim();
     start.check(d)?;
+    let std = Standardized::new(density, start);
+    let unit = Start::ball(vec![0.0; d], 1.0);
+    let (density, start): (&dyn LogDensity, &Start) = (&std, &unit);
     if settings.chains == 0
         || settings.draws < 4
         || settings.max_depth == 0
@@ -526,7 +529,7 @@ pub fn sample_nuts(
         run.step_size.push(o.eps);
         run.evaluations += o.evaluations;
     }
-    run.chains = Chains::from_nested(&all);
+    run.chains = Chains::from_nested(&all).map(|y| std.to_original(y));
     run.wall_time_s = t0.elapsed().as_secs_f64();
     Ok(run)
 }

@@ -12,17 +12,34 @@ use serde::{Deserialize, Serialize};
 pub struct Start {
     pub center: Vec<f64>,
     pub scale: Vec<f64>,
+    /// Optional lower-triangular Cholesky factor L of a covariance (e.g. the
+    /// Laplace covariance, row-major). When present the samplers move in
+    /// y with z = center + L y, which decorrelates the posterior for NUTS and
+    /// DE-MCz (a fixed linear map: no Jacobian term); otherwise L = diag(scale).
+    #[serde(default)]
+    pub cholesky: Option<Vec<Vec<f64>>>,
 }
 
 impl Start {
     /// A start with the same scale in every coordinate.
     pub fn ball(center: Vec<f64>, scale: f64) -> Start {
         let scale = vec![scale; center.len()];
-        Start { center, scale }
+        Start {
+            center,
+            scale,
+            cholesky: None,
+        }
     }
 
     pub(crate) fn check(&self, dim: usize) -> Result<(), McmcError> {
-        for got in [self.center.len(), self.scale.len()] {
+        let rows = self.cholesky.as_ref().map_or(dim, |l| {
+            if l.iter().all(|r| r.len() == dim) {
+                l.len()
+            } else {
+                0
+            }
+        });
+        for got in [self.center.len(), self.scale.len(), rows] {
             if got != dim {
                 return Err(McmcError::DimensionMismatch { expected: dim, got });
             }
