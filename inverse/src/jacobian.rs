@@ -74,24 +74,44 @@ pub fn jacobian_unbounded(
             Some(owned_r0.as_slice())
         }
     };
-    let column = |evs: &mut crate::Evaluators<'_>, j: usize| -> Result<Vec<f64>, InverseError> {
-        let h = options.relative_step * z[j].abs().max(1.0);
-        let mut zp = z.to_vec();
-        zp[j] += h;
-        let hp = zp[j] - z[j]; // the step actually taken (exact in floating point)
-        let rp = objective.residuals(evs, &zp, "finite-difference step")?;
-        match r0 {
-            Some(r0) => Ok(rp.iter().zip(r0).map(|(a, b)| (a - b) / hp).collect()),
-            None => {
-                let mut zm = z.to_vec();
-                zm[j] -= h;
-                let span = zp[j] - zm[j];
-                let rm = objective.residuals(evs, &zm, "finite-difference step")?;
-                Ok(rp.iter().zip(&rm).map(|(a, b)| (a - b) / span).collect())
+    // One column and the evaluations it cost. When one side of a central
+    // difference fails (e.g. the step leaves the law's admissible domain),
+    // the other side is used as a one-sided difference.
+    let column =
+        |evs: &mut crate::Evaluators<'_>, j: usize| -> Result<(Vec<f64>, usize), InverseError> {
+            let h = options.relative_step * z[j].abs().max(1.0);
+            let mut zp = z.to_vec();
+            zp[j] += h;
+            let mut zm = z.to_vec();
+            zm[j] -= h;
+            let diff = |a: &[f64], b: &[f64], span: f64| {
+                a.iter()
+                    .zip(b)
+                    .map(|(x, y)| (x - y) / span)
+                    .collect::<Vec<f64>>()
+            };
+            let rp = objective.residuals(evs, &zp, "finite-difference step");
+            if let (Some(r0), Ok(rp)) = (r0, &rp) {
+                return Ok((diff(rp, r0, zp[j] - z[j]), 1));
             }
-        }
-    };
-    let columns: Vec<Vec<f64>> = if options.parallel {
+            let rm = objective.residuals(evs, &zm, "finite-difference step");
+            match (rp, rm) {
+                (Ok(rp), Ok(rm)) => Ok((diff(&rp, &rm, zp[j] - zm[j]), 2)),
+                (Ok(rp), Err(_)) => {
+                    let base = objective.residuals(evs, z, "finite-difference base point")?;
+                    Ok((diff(&rp, &base, zp[j] - z[j]), 3))
+                }
+                (Err(_), Ok(rm)) => {
+                    let base = match r0 {
+                        Some(r0) => r0.to_vec(),
+                        None => objective.residuals(evs, z, "finite-difference base point")?,
+                    };
+                    Ok((diff(&base, &rm, z[j] - zm[j]), 3))
+                }
+                (Err(e), Err(_)) => Err(e),
+            }
+        };
+    let columns: Vec<(Vec<f64>, usize)> = if options.parallel {
         (0..q)
             .into_par_iter()
             .map_init(|| objective.evaluators(), column)
@@ -102,14 +122,15 @@ pub fn jacobian_unbounded(
             .map(|j| column(&mut evs, j))
             .collect::<Result<_, _>>()?
     };
-    let per_column = if options.central { 2 } else { 1 };
+    let evaluations = base_evaluations + columns.iter().map(|c| c.1).sum::<usize>();
+    let columns: Vec<Vec<f64>> = columns.into_iter().map(|c| c.0).collect();
     let mut matrix = DMatrix::zeros(m, q);
     for (j, col) in columns.iter().enumerate() {
         matrix.column_mut(j).copy_from_slice(col);
     }
     Ok(JacobianEval {
         matrix,
-        evaluations: per_column * q + base_evaluations,
+        evaluations,
     })
 }
 

@@ -23,7 +23,10 @@ fn loading() -> Loading {
 fn cases() -> Vec<(Law, Vec<(&'static str, f64)>)> {
     vec![
         (Law::NeoHookean, vec![("C10", 1101.295 * PA)]),
-        (Law::ReducedPolynomial(2), vec![("C10", 686.428 * PA), ("C20", 1929.606 * PA)]),
+        (
+            Law::ReducedPolynomial(2),
+            vec![("C10", 686.428 * PA), ("C20", 1929.606 * PA)],
+        ),
     ]
 }
 
@@ -47,14 +50,22 @@ fn noise_free_curves_are_recovered_to_1e_6() {
     for (law, truth) in cases() {
         let theta: Vec<f64> = truth.iter().map(|t| t.1).collect();
         for residual in [ResidualKind::Absolute, ResidualKind::Relative] {
-            let objective = Objective::new(vec![synthetic(law, &theta, None)], residual, &[]).unwrap();
+            let objective =
+                Objective::new(vec![synthetic(law, &theta, None)], residual, &[]).unwrap();
             let r = fit(&objective, &FitOptions::default()).unwrap();
             assert!(r.converged, "{law} {residual}: {:?}", r.termination);
             for (name, t) in &truth {
                 let v = r.value(name).unwrap();
-                assert!((v / t - 1.0).abs() < 1e-6, "{law} {residual}: {name} = {v} vs {t}");
+                assert!(
+                    (v / t - 1.0).abs() < 1e-6,
+                    "{law} {residual}: {name} = {v} vs {t}"
+                );
             }
-            assert!(r.identifiability.identifiable, "{law}: {:?}", r.identifiability);
+            assert!(
+                r.identifiability.identifiable,
+                "{law}: {:?}",
+                r.identifiability
+            );
         }
     }
 }
@@ -72,11 +83,17 @@ fn noisy_curves_are_recovered_within_three_standard_errors() {
             assert!(r.converged, "{law}: {:?}", r.termination);
             // sigma estimates the 2 % noise.
             let sigma = r.sigma2.unwrap().sqrt();
-            assert!((sigma / 0.02 - 1.0).abs() < 0.15, "{law} seed {seed}: sigma {sigma}");
+            assert!(
+                (sigma / 0.02 - 1.0).abs() < 0.15,
+                "{law} seed {seed}: sigma {sigma}"
+            );
             for (name, t) in &truth {
                 let (v, se) = (r.value(name).unwrap(), r.standard_error(name).unwrap());
                 assert!(se > 0.0 && se < 0.2 * t, "{law}: {name} se {se}");
-                assert!((v - t).abs() < 3.0 * se, "{law} seed {seed}: {name} = {v} +- {se} vs {t}");
+                assert!(
+                    (v - t).abs() < 3.0 * se,
+                    "{law} seed {seed}: {name} = {v} +- {se} vs {t}"
+                );
             }
         }
     }

@@ -1,0 +1,205 @@
+//! Treloar (1944) fits of five laws to uniaxial data alone and to the three
+//! modes jointly, with absolute and relative residuals, compared with an
+//! independent scipy implementation (`docs/validation/treloar_scipy.py`,
+//! output committed as `docs/validation/treloar_scipy.json`): SSE to 4
+//! significant digits always, parameters where our report says the fit is
+//! identifiable. Both sides run the same deterministic starting points and
+//! keep the best SSE.
+//!
+//! `TRELOAR_TABLE=1 cargo test -p palpate-tests --test treloar_fits -- --nocapture`
+//! prints the markdown table of `docs/validation/treloar.md`.
+
+use palpate_analytic::{Homogeneous, Mode};
+use palpate_core::{Drive, Loading, Table};
+use palpate_inverse::{fit, DataSet, FitOptions, FitReport, Objective, ResidualKind};
+use palpate_material::Law;
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+fn shared() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/treloar")
+}
+
+fn data_set(law: Law, mode: &str) -> DataSet {
+    let file = match mode {
+        "uniaxial" => "uniaxial.csv",
+        "equibiaxial" => "biaxial.csv",
+        "planar" => "pure_shear.csv",
+        other => panic!("unknown mode {other}"),
+    };
+    let table = Table::read(shared().join(file)).unwrap();
+    let stretch = table.column("stretch").unwrap().to_vec();
+    let stress = table.column("stress_MPa").unwrap().to_vec();
+    let model = Homogeneous::new(law, mode.parse::<Mode>().unwrap());
+    DataSet::new(
+        mode,
+        Arc::new(model),
+        Loading::quasi_static(Drive::Stretch, stretch),
+        stress,
+    )
+}
+
+fn law_of(name: &str) -> Law {
+    match name {
+        "neo_hookean" => Law::NeoHookean,
+        "mooney_rivlin" => Law::MooneyRivlin,
+        "yeoh" => Law::ReducedPolynomial(3),
+        "arruda_boyce" => Law::ArrudaBoyce,
+        "ogden3" => Law::Ogden(3),
+        other => panic!("unknown law {other}"),
+    }
+}
+
+/// Best fit over the reference's starting points.
+fn best_fit(case: &Value) -> FitReport {
+    let law = law_of(case["law"].as_str().unwrap());
+    let modes: Vec<&str> = case["data"].as_str().unwrap().split('+').collect();
+    let residual: ResidualKind = case["residual"].as_str().unwrap().parse().unwrap();
+    let sets = modes.iter().map(|m| data_set(law, m)).collect();
+    let objective = Objective::new(sets, residual, &[]).unwrap();
+    let mut best: Option<FitReport> = None;
+    for start in case["starts"].as_array().unwrap() {
+        let start: Vec<f64> = start
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        let options = FitOptions {
+            start: Some(start),
+            ..FitOptions::default()
+        };
+        // Some random Ogden starts are outside the law's domain (sum mu <= 0): skipped, as in scipy.
+        match fit(&objective, &options) {
+            Ok(r) => {
+                if best.as_ref().is_none_or(|b| r.sse < b.sse) {
+                    best = Some(r);
+                }
+            }
+            Err(e) if std::env::var("TRELOAR_TABLE").is_ok() => eprintln!("start failed: {e}"),
+            Err(_) => {}
+        }
+    }
+    // Polish: restart from the best point (fresh damping and scaling) while
+    // the SSE still drops, as degenerate Ogden terms (mu_i -> 0) stall the
+    // scaled LM of the first run.
+    let mut best = best.expect("at least one start succeeds");
+    for _ in 0..20 {
+        let options = FitOptions {
+            start: Some(best.theta()),
+            ..FitOptions::default()
+        };
+        match fit(&objective, &options) {
+            Ok(r) if r.sse < best.sse * (1.0 - 1e-9) => best = r,
+            _ => break,
+        }
+    }
+    best
+}
+
+fn reference() -> Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/treloar_scipy.json");
+    serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
+}
+
+fn check(law: &str) {
+    let reference = reference();
+    let table = std::env::var("TRELOAR_TABLE").is_ok();
+    for case in reference["fits"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|c| c["law"] == law)
+    {
+        let r = best_fit(case);
+        let label = format!("{} / {} / {}", law, case["data"], case["residual"]);
+        let sse_ref = case["sse"].as_f64().unwrap();
+        if table {
+            let params: Vec<String> = r
+                .parameters
+                .iter()
+                .map(|p| format!("{} = {:.5e}", p.name, p.value))
+                .collect();
+            eprintln!(
+                "| {} | {} | {} | {:.6e} | {:.6e} | {} | {:.5} | {} |",
+                law,
+                case["data"].as_str().unwrap(),
+                case["residual"].as_str().unwrap(),
+                r.sse,
+                sse_ref,
+                params.join(", "),
+                r.r_squared,
+                if r.identifiability.identifiable {
+                    "yes".to_string()
+                } else {
+                    format!("no ({})", r.identifiability.reason)
+                },
+            );
+        }
+        // Known limitation: when the reference optimum sits on a bound
+        // (Ogden alpha = +-20) or on the law's admissibility limit
+        // (Mooney-Rivlin C10 + C01 = 0, not a box bound of the parameter
+        // space), LM in the transformed space only creeps towards it; there
+        // we require the SSE within 2 % above the reference (never below).
+        let p = &case["params"];
+        let on_boundary = p
+            .as_object()
+            .unwrap()
+            .iter()
+            .any(|(k, v)| k.starts_with("alpha") && v.as_f64().unwrap().abs() > 19.999)
+            || (law == "mooney_rivlin"
+                && (p["C10"].as_f64().unwrap() + p["C01"].as_f64().unwrap()).abs() < 1e-9);
+        let tolerance = if on_boundary { 2e-2 } else { 5e-5 };
+        assert!(
+            r.sse >= sse_ref * (1.0 - 5e-5) && r.sse - sse_ref <= tolerance * sse_ref,
+            "{label}: SSE {} vs scipy {sse_ref} (boundary optimum: {on_boundary})",
+            r.sse
+        );
+        assert_eq!(r.n_residuals as u64, case["n"].as_u64().unwrap(), "{label}");
+        if r.identifiability.identifiable && !on_boundary {
+            for (name, v) in case["params"].as_object().unwrap() {
+                let v = v.as_f64().unwrap();
+                let got = r.value(name).unwrap();
+                assert!(
+                    (got - v).abs() <= 5e-5 * v.abs(),
+                    "{label}: {name} = {got} vs scipy {v}"
+                );
+            }
+        }
+    }
+}
+
+#[test]
+fn neo_hookean_matches_scipy() {
+    check("neo_hookean");
+}
+
+#[test]
+fn mooney_rivlin_matches_scipy() {
+    check("mooney_rivlin");
+}
+
+#[test]
+fn yeoh_matches_scipy() {
+    check("yeoh");
+}
+
+#[test]
+fn arruda_boyce_matches_scipy() {
+    check("arruda_boyce");
+}
+
+#[test]
+fn ogden3_matches_scipy_and_is_not_identifiable_on_uniaxial_data_alone() {
+    check("ogden3");
+    let reference = reference();
+    let case = reference["fits"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|c| c["law"] == "ogden3" && c["data"] == "uniaxial" && c["residual"] == "absolute")
+        .unwrap();
+    let r = best_fit(case);
+    assert!(!r.identifiability.identifiable, "{:?}", r.identifiability);
+}
