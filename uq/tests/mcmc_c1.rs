@@ -79,26 +79,28 @@ fn posterior(law: &str) -> Posterior {
     Posterior::new(vec![ds], vec![Prior::Flat; n]).unwrap()
 }
 
-fn samplers() -> Vec<Sampler> {
+/// The three samplers; `long` for the harder Mooney-Rivlin target.
+fn samplers(long: bool) -> Vec<Sampler> {
+    let k = if long { 3 } else { 2 };
     vec![
         Sampler::Ensemble(EnsembleSettings {
             ensembles: 2,
             walkers: 16,
             tune: 500,
-            draws: 4000,
+            draws: 2000 * k,
             ..Default::default()
         }),
         Sampler::Demc(DemcSettings {
             populations: 2,
             chains: 3,
             tune: 1000,
-            draws: 4000,
+            draws: 2000 * k,
             ..Default::default()
         }),
         Sampler::Nuts(NutsSettings {
             chains: 4,
             tune: 600,
-            draws: 1000,
+            draws: 500 * k,
             ..Default::default()
         }),
     ]
@@ -146,7 +148,7 @@ fn c1_rp2_posterior_agrees_with_laplace_and_emcee() {
         );
     }
     let emcee = emcee_reference();
-    for sampler in samplers() {
+    for sampler in samplers(false) {
         let run = sampler.run(&post, &st.start, 7, None).unwrap();
         let s = physical(&post, &run);
         for (k, p) in s.iter().enumerate() {
@@ -212,7 +214,7 @@ fn mooney_rivlin_posterior_is_correlated_and_every_sampler_converges() {
     let lap_corr = st.laplace.covariance[0][1]
         / (st.laplace.covariance[0][0] * st.laplace.covariance[1][1]).sqrt();
     let mut corrs = Vec::new();
-    for sampler in samplers() {
+    for sampler in samplers(true) {
         let run = sampler.run(&post, &st.start, 8, None).unwrap();
         let x = run.chains.map(|z| post.space().from_unbounded(z));
         let s = summarize(&x, &post.names());
