@@ -10,6 +10,9 @@ fn main() {
     let mut m = N1Needle::new("neo-hookean".parse().unwrap());
     m.mesh = MeshDensity { level };
     m.friction = friction;
+    if let Some(p) = args.get(5).and_then(|s| s.parse::<f64>().ok()) {
+        m.penalty = p;
+    }
     if let Some(r) = args.get(4).and_then(|s| s.parse::<f64>().ok()) {
         m.bulk = palpate_fe::Bulk::Ratio(r);
     }

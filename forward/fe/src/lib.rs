@@ -13,6 +13,15 @@
 //!   on a faer sparse LU that keeps its symbolic factorisation.
 //! * [`n1`], [`c1`] — the forward models.
 
+// Index loops mirror the index notation of the equations; negated comparisons
+// (`!(x > 0.0)`) deliberately treat NaN as failure.
+#![allow(
+    clippy::needless_range_loop,
+    clippy::neg_cmp_op_on_partial_ord,
+    clippy::nonminimal_bool,
+    clippy::collapsible_match
+)]
+
 pub mod c1;
 pub mod contact;
 pub mod element;
@@ -26,9 +35,11 @@ pub mod quadrature;
 pub mod solver;
 pub mod sparse;
 pub mod tool;
+pub mod vtu;
 
 pub use c1::{C1Fe, Platens};
 pub use error::FeError;
+pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Needle};
 pub use solver::{Progress, RunStats, SolverOptions};

@@ -113,7 +113,7 @@ pub(crate) fn simulate(
     loading.validate().map_err(ForwardError::InvalidLoading)?;
     let law = setup.law();
     let n_law = law.params().len();
-    let mat = LawMaterial::new(law.clone(), theta[..n_law].to_vec()).map_err(to_forward)?;
+    let mat = LawMaterial::new(*law, theta[..n_law].to_vec()).map_err(to_forward)?;
     let mu = law.shear_modulus(&theta[..n_law]);
     setup.prepare(solver, mu, &theta[n_law..]);
     let vol = setup.bulk().volumetric(mu);

@@ -12,7 +12,7 @@ fn check(law: &str, theta: &[f64]) {
         Drive::DisplacementMm,
         (1..=8).map(|k| 0.25 * k as f64).collect(),
     );
-    let mut fe = C1Fe::new(law.clone(), Platens::Frictionless);
+    let mut fe = C1Fe::new(law, Platens::Frictionless);
     fe.elements = (4, 2);
     let f_fe = fe.predict(theta, &loading).unwrap();
     let f_an = C1Compression::new(law).predict(theta, &loading).unwrap();
