@@ -1,10 +1,458 @@
-//! `palpate sample` (not yet implemented).
+//! `palpate sample`: the Bayesian posterior of a law's parameters by MCMC,
+//! with diagnostics, a Laplace approximation beside it, chains, a corner plot
+//! and posterior-predictive bands.
 
-/// Options of `palpate sample`.
+use crate::cli::calibrate::read_data;
+use crate::output::{write_atomic, write_json};
+use crate::plot::{grid_svg, Band, Plot, Series, Style};
+use anyhow::Context;
+use palpate_material::Law;
+use palpate_uq::likelihood::{
+    fit_and_laplace, predictive_band, Correlation, DataSet, NoiseModel, NoiseSd, Posterior, Prior,
+};
+use palpate_uq::mcmc::{
+    correlation, summarize, Chains, DemcSettings, EnsembleSettings, NutsSettings, SampleRun,
+    Sampler,
+};
+use serde_json::{json, Map, Value};
+use std::path::{Path, PathBuf};
+
+/// Sample the posterior of a hyperelastic law's parameters given data.
+///
+/// Data as for `palpate calibrate`: `--data TEST=FILE` for homogeneous tests
+/// (TEST = uniaxial, biaxial, planar; columns stretch,stress_MPa) or
+/// `--benchmark C1 --data FILE` (columns displacement_mm,force_N).
+///
+/// Likelihood: Gaussian; the noise SD of each data set is inferred (prior
+/// half-normal with scale = the set's peak |observation|) unless --sigma is
+/// given; --ar1 adds an AR(1) residual correlation per data set. Priors on
+/// the law's parameters are flat inside its bounds unless --prior is given.
+/// The chains start from the least-squares fit's Laplace approximation.
+///
+/// Example: palpate sample --benchmark C1 --law reduced-polynomial:2 --data c1.csv --sampler nuts --json post.json --plot figs
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(verbatim_doc_comment)]
+pub struct Args {
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
+    #[arg(long)]
+    pub law: String,
+    /// Data: TEST=FILE for homogeneous tests, or FILE with --benchmark C1. Repeatable.
+    #[arg(long = "data", required = true, value_name = "TEST=FILE")]
+    pub data: Vec<String>,
+    /// Benchmark whose force record the data are (C1).
+    #[arg(long, value_name = "ID")]
+    pub benchmark: Option<String>,
+    /// Sampler: ensemble (affine-invariant stretch move), demc (DE-MCz) or nuts.
+    #[arg(long, default_value = "nuts")]
+    pub sampler: String,
+    /// Stored draws per chain (default: ensemble 2000 per walker, demc 5000, nuts 1000).
+    #[arg(long)]
+    pub draws: Option<usize>,
+    /// Warm-up iterations (default: ensemble 1000, demc 2000, nuts 1000).
+    #[arg(long)]
+    pub tune: Option<usize>,
+    /// Parallel units: NUTS chains (4), ensembles (2) or DE-MCz populations (2).
+    #[arg(long)]
+    pub chains: Option<usize>,
+    /// Seed of the random streams (results are identical for a seed whatever the thread count).
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// Known noise SD of every data set (observable unit: N or MPa); inferred when absent.
+    #[arg(long)]
+    pub sigma: Option<f64>,
+    /// Infer an AR(1) correlation of successive residuals per data set (uniform prior on (-1, 1)).
+    #[arg(long)]
+    pub ar1: bool,
+    /// Prior of a parameter: NAME=flat|uniform:L,U|normal:M,S|lognormal:MU,SIGMA|halfnormal:S. Repeatable.
+    #[arg(long = "prior", value_name = "NAME=SPEC")]
+    pub prior: Vec<String>,
+    /// Write the summary as JSON (params by name: mean, sd, hdi_3, hdi_97, rhat, ess_bulk, ess_tail, mcse_mean).
+    #[arg(long, value_name = "OUT.json")]
+    pub json: Option<PathBuf>,
+    /// Write every draw (physical units) as CSV: chain,draw,<params>.
+    #[arg(long, value_name = "OUT.csv")]
+    pub chains_csv: Option<PathBuf>,
+    /// Write corner.svg and predictive_<data>.svg into this folder.
+    #[arg(long, value_name = "DIR")]
+    pub plot: Option<PathBuf>,
+}
+
+fn sampler_from(args: &Args) -> anyhow::Result<Sampler> {
+    Ok(match args.sampler.to_ascii_lowercase().as_str() {
+        "ensemble" | "emcee" | "stretch" => {
+            let mut s = EnsembleSettings::default();
+            s.draws = args.draws.unwrap_or(s.draws);
+            s.tune = args.tune.unwrap_or(s.tune);
+            s.ensembles = args.chains.unwrap_or(s.ensembles);
+            Sampler::Ensemble(s)
+        }
+        "demc" | "de-mc" | "demcz" | "dream" => {
+            let mut s = DemcSettings::default();
+            s.draws = args.draws.unwrap_or(s.draws);
+            s.tune = args.tune.unwrap_or(s.tune);
+            s.populations = args.chains.unwrap_or(s.populations);
+            Sampler::Demc(s)
+        }
+        "nuts" => {
+            let mut s = NutsSettings::default();
+            s.draws = args.draws.unwrap_or(s.draws);
+            s.tune = args.tune.unwrap_or(s.tune);
+            s.chains = args.chains.unwrap_or(s.chains);
+            Sampler::Nuts(s)
+        }
+        other => anyhow::bail!("--sampler {other}: expected ensemble, demc or nuts"),
+    })
+}
 
 /// Runs `palpate sample`.
-pub fn run(_args: Args) -> anyhow::Result<()> {
-    anyhow::bail!("`palpate sample` is not implemented yet")
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let law: Law = args
+        .law
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    let sampler = sampler_from(&args)?;
+    let data = read_data(&args.data, args.benchmark.as_deref())?;
+    if let Some(s) = args.sigma {
+        anyhow::ensure!(
+            s.is_finite() && s > 0.0,
+            "--sigma {s}: must be a positive number"
+        );
+    }
+    let sets: Vec<DataSet> = data
+        .iter()
+        .map(|t| {
+            let peak = t
+                .observed
+                .iter()
+                .fold(0.0f64, |m, v| m.max(v.abs()))
+                .max(1e-12);
+            DataSet {
+                name: t.name.clone(),
+                model: t.test.model(law.clone()),
+                loading: t.loading.clone(),
+                observed: t.observed.clone(),
+                noise: NoiseModel {
+                    sd: match args.sigma {
+                        Some(s) => NoiseSd::Known(s),
+                        None => NoiseSd::Inferred(Prior::HalfNormal { sd: peak }),
+                    },
+                    correlation: if args.ar1 {
+                        Correlation::Ar1Inferred(Prior::Uniform {
+                            lower: -1.0,
+                            upper: 1.0,
+                        })
+                    } else {
+                        Correlation::Independent
+                    },
+                },
+            }
+        })
+        .collect();
+    let space = sets[0].model.space().clone();
+    let mut priors = vec![Prior::Flat; space.len()];
+    for p in &args.prior {
+        let (name, spec) =
+            crate::cli::calibrate::split_pair(p, "NAME=SPEC, e.g. C10=lognormal:-7,1")?;
+        let k = space.index_of(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--prior {p}: unknown parameter `{name}` (the law has {})",
+                space.names().join(", ")
+            )
+        })?;
+        priors[k] = spec
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--prior {p}: {e}"))?;
+    }
+    let post = Posterior::new(sets, priors)?;
+    let names = post.names();
+
+    eprintln!("least-squares fit and Laplace approximation ...");
+    let start = fit_and_laplace(&post).context("finding the start of the chains")?;
+    let (lap_mean, lap_sd) = start.laplace_physical(&post);
+
+    let bar = indicatif::ProgressBar::new(sampler.total_iterations());
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} iterations ({eta})")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.set_message(args.sampler.clone());
+    let tick = |n: u64| bar.inc(n);
+    let run = sampler.run(&post, &start.start, args.seed, Some(&tick))?;
+    bar.finish_and_clear();
+
+    let x = run.chains.map(|z| post.space().from_unbounded(z));
+    let summary = summarize(&x, &names);
+    let corr = correlation(&x);
+
+    println!(
+        "{} on {} ({} chains x {} draws, {} evaluations, {:.2} s)",
+        run.sampler,
+        post.datasets()[0].model.name(),
+        x.n_chains,
+        x.n_draws,
+        run.evaluations,
+        run.wall_time_s
+    );
+    println!(
+        "{:<10} {:>12} {:>11} {:>12} {:>12} {:>7} {:>8} {:>8} {:>12} {:>11}",
+        "param",
+        "mean",
+        "sd",
+        "hdi_3%",
+        "hdi_97%",
+        "r_hat",
+        "ess_bulk",
+        "ess_tail",
+        "laplace",
+        "laplace_sd"
+    );
+    for (k, s) in summary.iter().enumerate() {
+        println!(
+            "{:<10} {:>12.5e} {:>11.3e} {:>12.5e} {:>12.5e} {:>7.4} {:>8.0} {:>8.0} {:>12.5e} {:>11.3e}",
+            s.name, s.mean, s.sd, s.hdi_3, s.hdi_97, s.rhat, s.ess_bulk, s.ess_tail, lap_mean[k], lap_sd[k]
+        );
+    }
+    if names.len() > 1 {
+        println!("posterior correlation:");
+        for (i, row) in corr.iter().enumerate() {
+            let cells: Vec<String> = row.iter().map(|c| format!("{c:>7.3}")).collect();
+            println!("  {:<10}{}", names[i], cells.join(" "));
+        }
+    }
+    let worst = summary.iter().map(|s| s.rhat).fold(0.0, f64::max);
+    if worst >= 1.01 {
+        eprintln!("warning: max R-hat = {worst:.4} >= 1.01: run longer (--draws) before trusting the summary");
+    }
+
+    if let Some(path) = &args.json {
+        write_json(
+            path,
+            &report(
+                &args, &post, &run, &summary, &corr, &lap_mean, &lap_sd, &start,
+            ),
+        )?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(path) = &args.chains_csv {
+        write_atomic(path, x.to_csv(&names).as_bytes())?;
+        eprintln!("wrote {}", path.display());
+    }
+    if let Some(dir) = &args.plot {
+        plots(dir, &post, &x, args.seed)?;
+        eprintln!("wrote plots into {}", dir.display());
+    }
+    Ok(())
+}
+
+#[allow(clippy::too_many_arguments)]
+fn report(
+    args: &Args,
+    post: &Posterior,
+    run: &SampleRun,
+    summary: &[palpate_uq::mcmc::ParamSummary],
+    corr: &[Vec<f64>],
+    lap_mean: &[f64],
+    lap_sd: &[f64],
+    start: &palpate_uq::likelihood::PosteriorStart,
+) -> Value {
+    let mut params = Map::new();
+    for (k, s) in summary.iter().enumerate() {
+        let spec = &post.space().params[k];
+        params.insert(
+            s.name.clone(),
+            json!({
+                "unit": spec.unit,
+                "prior": post.priors()[k].to_string(),
+                "mean": s.mean, "sd": s.sd, "hdi_3": s.hdi_3, "hdi_97": s.hdi_97,
+                "rhat": s.rhat, "ess_bulk": s.ess_bulk, "ess_tail": s.ess_tail, "mcse_mean": s.mcse_mean,
+                "laplace_mean": lap_mean[k], "laplace_sd": lap_sd[k],
+            }),
+        );
+    }
+    json!({
+        "law": args.law,
+        "model": post.datasets()[0].model.name(),
+        "data": args.data,
+        "sampler": run.sampler,
+        "seed": args.seed,
+        "chains": run.chains.n_chains,
+        "draws_per_chain": run.chains.n_draws,
+        "params": params,
+        "correlation": { "names": post.names(), "matrix": corr },
+        "evaluations": run.evaluations,
+        "wall_time_s": run.wall_time_s,
+        "acceptance_mean": run.acceptance.iter().sum::<f64>() / run.acceptance.len().max(1) as f64,
+        "divergences": run.divergences,
+        "step_size": run.step_size,
+        "laplace": {
+            "log_evidence": start.laplace.log_evidence,
+            "evidence_meaningful": post.priors_proper(),
+            "note": "Laplace estimate of log p(data); comparable between models only with proper priors on every parameter",
+        },
+        "least_squares": start.fit.parameters.iter().map(|p| json!({
+            "name": p.name, "value": p.value, "standard_error": p.standard_error,
+        })).collect::<Vec<_>>(),
+    })
+}
+
+/// Every `step`-th point of the chains (for scatter plots).
+fn thinned(x: &Chains, max_points: usize) -> Vec<&[f64]> {
+    let total = x.n_chains * x.n_draws;
+    let step = total.div_ceil(max_points.max(1)).max(1);
+    x.points().step_by(step).collect()
+}
+
+fn histogram(v: &[f64], bins: usize) -> (Vec<f64>, Vec<f64>, f64) {
+    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let w = ((hi - lo) / bins as f64).max(1e-300);
+    let mut counts = vec![0.0; bins];
+    for &x in v {
+        let b = (((x - lo) / w) as usize).min(bins - 1);
+        counts[b] += 1.0;
+    }
+    let centres = (0..bins).map(|b| lo + (b as f64 + 0.5) * w).collect();
+    (centres, counts, w)
+}
+
+fn plots(dir: &Path, post: &Posterior, x: &Chains, seed: u64) -> anyhow::Result<()> {
+    let names = post.names();
+    let d = x.dim;
+    let pts = thinned(x, 2000);
+    let mut cells = Vec::with_capacity(d * d);
+    for i in 0..d {
+        for j in 0..d {
+            cells.push(if i == j {
+                let v: Vec<f64> = x.points().map(|p| p[i]).collect();
+                let (c, n, w) = histogram(&v, 40);
+                let mut p = Plot::new(names[i].clone(), names[i].clone(), "draws");
+                p.push(Series::line(names[i].clone(), &c, &n).style(Style::Bars(w)));
+                Some(p)
+            } else if i > j {
+                let xs: Vec<f64> = pts.iter().map(|p| p[j]).collect();
+                let ys: Vec<f64> = pts.iter().map(|p| p[i]).collect();
+                let mut p = Plot::new(
+                    format!("{} vs {}", names[i], names[j]),
+                    names[j].clone(),
+                    names[i].clone(),
+                );
+                p.push(Series::markers("draws", &xs, &ys));
+                Some(p)
+            } else {
+                None
+            });
+        }
+    }
+    write_atomic(
+        &dir.join("corner.svg"),
+        grid_svg(&cells, d, "posterior").as_bytes(),
+    )?;
+    for (s, ds) in post.datasets().iter().enumerate() {
+        let band = predictive_band(post, s, x, 400, 0.94, seed)?;
+        let unit = ds.model.observable().column();
+        let mut p = Plot::new(
+            format!("posterior predictive: {}", ds.name),
+            ds.loading.drive_kind.column(),
+            unit,
+        );
+        p.bands.push(Band {
+            label: "94 % new observation".into(),
+            x: band.drive.clone(),
+            lower: band.lower_observed.clone(),
+            upper: band.upper_observed.clone(),
+            color: "#9ecae1".into(),
+        });
+        p.bands.push(Band {
+            label: "94 % model".into(),
+            x: band.drive.clone(),
+            lower: band.lower.clone(),
+            upper: band.upper.clone(),
+            color: "#d62728".into(),
+        });
+        p.push(Series::markers("data", &ds.loading.drive, &ds.observed).color("#333"));
+        p.push(Series::line("posterior median", &band.drive, &band.median).color("#d62728"));
+        let file = format!(
+            "predictive_{}.svg",
+            ds.name.replace(|c: char| !c.is_ascii_alphanumeric(), "_")
+        );
+        write_atomic(&dir.join(file), p.to_svg().as_bytes())?;
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn samples_c1_and_writes_json_csv_and_plots() {
+        let data =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv");
+        let dir = tempfile::tempdir().unwrap();
+        let json_path = dir.path().join("post.json");
+        let args = Args {
+            law: "reduced-polynomial:2".into(),
+            data: vec![data.display().to_string()],
+            benchmark: Some("C1".into()),
+            sampler: "demc".into(),
+            draws: Some(300),
+            tune: Some(300),
+            chains: Some(2),
+            seed: 3,
+            sigma: None,
+            ar1: false,
+            prior: vec!["C10=lognormal:-7.3,1".into()],
+            json: Some(json_path.clone()),
+            chains_csv: Some(dir.path().join("chains.csv")),
+            plot: Some(dir.path().join("figs")),
+        };
+        run(args).unwrap();
+        let v: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+        for name in ["C10", "C20", "sigma"] {
+            for key in [
+                "mean",
+                "sd",
+                "hdi_3",
+                "hdi_97",
+                "rhat",
+                "ess_bulk",
+                "ess_tail",
+                "mcse_mean",
+            ] {
+                assert!(v["params"][name][key].is_number(), "{name}.{key}");
+            }
+        }
+        assert_eq!(v["params"]["C10"]["prior"], "lognormal:-7.3,1");
+        assert!(v["evaluations"].as_u64().unwrap() > 0 && v["wall_time_s"].as_f64().unwrap() > 0.0);
+        let c10 = v["params"]["C10"]["mean"].as_f64().unwrap();
+        assert!((c10 / 6.8e-4 - 1.0).abs() < 0.05, "{c10}");
+        let csv = std::fs::read_to_string(dir.path().join("chains.csv")).unwrap();
+        assert_eq!(csv.lines().count(), 1 + 6 * 300);
+        assert!(dir.path().join("figs/corner.svg").exists());
+        assert!(dir.path().join("figs/predictive_C1.svg").exists());
+    }
+
+    #[test]
+    fn bad_options_are_named() {
+        let args = |sampler: &str, prior: &str| Args {
+            law: "neo-hookean".into(),
+            data: vec!["x.csv".into()],
+            benchmark: Some("C1".into()),
+            sampler: sampler.into(),
+            draws: None,
+            tune: None,
+            chains: None,
+            seed: 0,
+            sigma: None,
+            ar1: false,
+            prior: vec![prior.into()],
+            json: None,
+            chains_csv: None,
+            plot: None,
+        };
+        let e = sampler_from(&args("gibbs", "")).unwrap_err().to_string();
+        assert!(e.contains("gibbs"), "{e}");
+        let e = run(args("nuts", "C10=flat")).unwrap_err().to_string();
+        assert!(e.contains("x.csv"), "{e}");
+    }
 }

@@ -21,9 +21,10 @@
 //! stream; every chain of every population is reported.
 
 use super::chains::{Chains, SampleRun};
-use super::density::{Counted, LogDensity, Standardized};
+use super::density::{Counted, LogDensity};
 use super::error::McmcError;
 use super::rng::{chain_rng, std_normal, uniform};
+use super::standardized::Standardized;
 use super::start::Start;
 use rand::Rng;
 use rayon::prelude::*;

@@ -13,9 +13,10 @@
 //! emcee output.
 
 use super::chains::{Chains, SampleRun};
-use super::density::{Counted, LogDensity, Standardized};
+use super::density::{Counted, LogDensity};
 use super::error::McmcError;
 use super::rng::{chain_rng, uniform};
+use super::standardized::Standardized;
 use super::start::Start;
 use rand::Rng;
 use rayon::prelude::*;

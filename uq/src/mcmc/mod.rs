@@ -12,6 +12,10 @@
 //! * [`summary`]: mean, SD, HDI, correlation.
 //! * [`laplace()`]: mode, Hessian covariance and Laplace evidence.
 
+// Index loops over coordinates mirror the equations (x_i, L_ij) more
+// plainly than zipped iterators in this numerical code.
+#![allow(clippy::needless_range_loop)]
+
 pub mod chains;
 pub mod demc;
 pub mod density;
@@ -21,6 +25,7 @@ pub mod error;
 pub mod laplace;
 pub mod nuts;
 pub mod rng;
+mod standardized;
 pub mod start;
 pub mod summary;
 

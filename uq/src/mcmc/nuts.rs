@@ -28,9 +28,10 @@
 //! (finite differences unless the density provides exact ones).
 
 use super::chains::{Chains, SampleRun};
-use super::density::{Counted, LogDensity, Standardized};
+use super::density::{Counted, LogDensity};
 use super::error::McmcError;
 use super::rng::{chain_rng, std_normal, uniform, ChainRng};
+use super::standardized::Standardized;
 use super::start::Start;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
