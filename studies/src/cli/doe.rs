@@ -97,6 +97,30 @@ struct AnalysisSpec {
 #[serde(deny_unknown_fields, rename_all = "snake_case")]
 enum ResponseSpec {
     Calibration(CalibrationResponse),
+    Simulation(SimulationResponse),
+}
+
+/// A finite-element response: each run simulates benchmark N1 (needle
+/// indentation) with the run's law, friction and mesh, and is scored against
+/// a reference curve (columns displacement_mm, force_N) by R^2 or RMS.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SimulationResponse {
+    /// `N1` (the needle-indentation benchmark).
+    benchmark: String,
+    /// `r2` or `rms` (N) of the simulated force against the reference.
+    metric: String,
+    /// The reference curve (relative to the manifest).
+    reference: String,
+    /// Material parameters of each law level, by law spelling, e.g.
+    /// `{ "neo-hookean" = { C10 = 1.101295e-3 } }` (MPa). Defaults: the
+    /// ecoflex-nh and ecoflex-rp2 materials of BENCHMARKS.md.
+    #[serde(default)]
+    params: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Defaults for settings that are not factors.
+    law: Option<String>,
+    friction: Option<f64>,
+    mesh: Option<String>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -114,6 +138,18 @@ struct CalibrationResponse {
 }
 
 const FE_FACTORS: [&str; 4] = ["friction", "space", "mesh", "benchmark"];
+
+/// The BENCHMARKS.md material of a law for the N1 design (MPa).
+fn default_params(law: &Law) -> Option<Vec<(String, f64)>> {
+    match law.to_string().as_str() {
+        "neo-hookean" => Some(vec![("C10".into(), 1.101295e-3)]),
+        "reduced-polynomial:2" => Some(vec![
+            ("C10".into(), 0.686428e-3),
+            ("C20".into(), 1.929606e-3),
+        ]),
+        _ => None,
+    }
+}
 
 /// Runs `palpate doe`.
 pub fn run(args: Args) -> anyhow::Result<()> {
@@ -150,10 +186,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let response = match &manifest.response {
         Some(ResponseSpec::Calibration(c)) => Some(run_calibrations(&design, c, &base_dir)?),
+        Some(ResponseSpec::Simulation(s)) => Some(run_simulations(&design, s, &base_dir)?),
         None => None,
     };
     let metric = match &manifest.response {
         Some(ResponseSpec::Calibration(c)) => c.metric.clone(),
+        Some(ResponseSpec::Simulation(s)) => s.metric.clone(),
         None => "response".into(),
     };
     if let Some(out) = &args.out {
@@ -275,7 +313,7 @@ fn run_calibrations(
 ) -> anyhow::Result<Vec<f64>> {
     for f in &d.factors {
         if FE_FACTORS.contains(&f.name.as_str()) {
-            anyhow::bail!("factor `{}`: finite-element responses (N1 needle: law x friction) are not supported by `palpate doe` yet", f.name);
+            anyhow::bail!("factor `{}` needs a finite-element response: use [response.simulation] (benchmark N1)", f.name);
         }
         if !["law", "residual", "data", "estimator"].contains(&f.name.as_str()) {
             anyhow::bail!("factor `{}` has no meaning for a calibration response; known factors: law, residual, data, estimator", f.name);
@@ -352,4 +390,91 @@ fn run_calibrations(
             Ok(if spec.metric == "r2" { c.r2 } else { c.rms })
         })
         .collect()
+}
+
+/// One N1 simulation per run (in parallel over runs; each run's numbers do
+/// not depend on the thread count), scored against the reference curve.
+fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow::Result<Vec<f64>> {
+    use palpate_core::{data::Table, Drive, ForwardModel, Loading};
+    use palpate_fe::{MeshDensity, N1Needle};
+    if !spec.benchmark.eq_ignore_ascii_case("n1") {
+        anyhow::bail!(
+            "response.simulation.benchmark = `{}`: only N1 is supported",
+            spec.benchmark
+        );
+    }
+    for f in &d.factors {
+        if !["law", "friction", "mesh"].contains(&f.name.as_str()) {
+            anyhow::bail!("factor `{}` has no meaning for an N1 simulation; known factors: law, friction, mesh", f.name);
+        }
+    }
+    if !["r2", "rms"].contains(&spec.metric.as_str()) {
+        anyhow::bail!(
+            "response.simulation.metric = `{}`; expected r2 or rms",
+            spec.metric
+        );
+    }
+    let reference = Table::read(base.join(&spec.reference))?;
+    let x = reference.column("displacement_mm")?.to_vec();
+    let y = reference.column("force_N")?.to_vec();
+    let loading = Loading::quasi_static(Drive::DisplacementMm, x);
+    let setting = |run: &palpate_uq::doe::Run, factor: &str| -> Option<String> {
+        d.factors
+            .iter()
+            .position(|f| f.name == factor)
+            .map(|k| d.level_name(run, k).to_string())
+    };
+    let bar = indicatif::ProgressBar::new(d.runs.len() as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{bar:30} {pos}/{len} N1 runs [{elapsed_precise}, eta {eta}]",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let out = d
+        .runs
+        .par_iter()
+        .map(|run| {
+            let at = || format!("run {} (standard order {})", run.run_order, run.standard_order);
+            let law_text = setting(run, "law").or_else(|| spec.law.clone()).unwrap_or_else(|| "neo-hookean".into());
+            let law: Law = law_text.parse().map_err(|e| anyhow::anyhow!("{}: law `{law_text}`: {e}", at()))?;
+            let friction_text = setting(run, "friction").or_else(|| spec.friction.map(|f| f.to_string())).unwrap_or_else(|| "0.8".into());
+            let friction: f64 = friction_text
+                .parse()
+                .map_err(|_| anyhow::anyhow!("{}: friction level `{friction_text}` is not a number", at()))?;
+            let mesh_text = setting(run, "mesh").or_else(|| spec.mesh.clone()).unwrap_or_else(|| "coarse".into());
+            let mesh = match mesh_text.as_str() {
+                "coarse" => MeshDensity::COARSE,
+                "medium" => MeshDensity::MEDIUM,
+                "fine" => MeshDensity::FINE,
+                other => MeshDensity {
+                    level: other
+                        .parse()
+                        .map_err(|_| anyhow::anyhow!("{}: mesh level `{other}`: expected coarse, medium, fine or a refinement level", at()))?,
+                },
+            };
+            let mut model = N1Needle::new(law);
+            model.friction = friction;
+            model.mesh = mesh;
+            let theta: Vec<f64> = match spec.params.get(&law_text) {
+                Some(p) => model
+                    .space()
+                    .names()
+                    .iter()
+                    .map(|n| p.get(n).copied().ok_or_else(|| anyhow::anyhow!("response.simulation.params.\"{law_text}\": parameter `{n}` missing")))
+                    .collect::<anyhow::Result<_>>()?,
+                None => {
+                    let p = default_params(&law)
+                        .ok_or_else(|| anyhow::anyhow!("law `{law_text}`: give its parameters in response.simulation.params"))?;
+                    p.into_iter().map(|(_, v)| v).collect()
+                }
+            };
+            let f = model.predict(&theta, &loading).with_context(at)?;
+            bar.inc(1);
+            let (r2, rms) = crate::calibration::r2_rms(&y, &f);
+            Ok(if spec.metric == "r2" { r2 } else { rms })
+        })
+        .collect();
+    bar.finish_and_clear();
+    out
 }
