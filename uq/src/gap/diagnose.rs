@@ -230,12 +230,11 @@ struct Context<'a> {
     rel_var_sd2: f64,
 }
 
+/// A candidate's ranking entry and its full-record fit, or why it failed.
+type Assessment = Result<(RankedEffect, Fitted), GapError>;
+
 /// Score test, refits and comparison of one enrichment.
-fn assess(
-    effect: Effect,
-    rich: Arc<dyn ForwardModel>,
-    ctx: &Context<'_>,
-) -> Result<(RankedEffect, Fitted), GapError> {
+fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Assessment {
     let (n, p) = (ctx.observed.len(), ctx.p);
     let specs = rich.space().params.clone();
     let q = specs.len() - p;
@@ -507,7 +506,7 @@ pub fn diagnose(
         rel_var_sd2: noise.rel_var_sd2,
     };
     // Candidates are independent: assessed in parallel, collected in order.
-    let outcomes: Vec<(Effect, Result<(RankedEffect, Fitted), GapError>)> = enriched
+    let outcomes: Vec<(Effect, Assessment)> = enriched
         .into_par_iter()
         .map(|(e, rich)| (e, assess(e, rich, &ctx)))
         .collect();
@@ -522,21 +521,29 @@ pub fn diagnose(
             }),
         }
     }
+    // Rank: effects that earn their parameters first, then by the held-out
+    // (cross-validated) gain, which charges every extra parameter through its
+    // prediction error rather than through a fixed penalty; AR(1) BIC breaks ties.
     assessed.sort_by(|a, b| {
         b.0.earns
             .cmp(&a.0.earns)
+            .then(b.0.heldout_gain.total_cmp(&a.0.heldout_gain))
             .then(a.0.delta_bic_ar1.total_cmp(&b.0.delta_bic_ar1))
     });
 
-    // Confounding: earning effects whose fits differ by less than the data can resolve.
+    // Confounding: two earning effects the data cannot tell apart, because
+    // their fits (in sample) or their held-out predictions differ by less
+    // than a chi2(1) quantile of the noise: the likelihood ratio between the
+    // two enriched models is not decisive.
     let confound_threshold = chi2_isf(options.confound_alpha, 1.0);
     let sigma2 = sigma * sigma;
     for a in 0..assessed.len() {
         let mut with = Vec::new();
         for b in 0..assessed.len() {
             if a != b && assessed[a].0.earns && assessed[b].0.earns {
-                let d = (assessed[a].1.sse - assessed[b].1.sse).abs() / sigma2;
-                if d < confound_threshold {
+                let fit = (assessed[a].1.sse - assessed[b].1.sse).abs() / sigma2;
+                let held_out = (assessed[a].0.heldout_gain - assessed[b].0.heldout_gain).abs();
+                if fit < confound_threshold || held_out < confound_threshold {
                     with.push(assessed[b].0.effect.clone());
                 }
             }
@@ -544,7 +551,8 @@ pub fn diagnose(
         if !with.is_empty() {
             assessed[a].0.identifiable = false;
             let note = format!(
-                "; the data cannot tell it apart from {} (SSE difference below chi2(1) {:.1} x noise^2)",
+                "; the data cannot tell it apart from {} (fitted or held-out SSE difference below \
+                 chi2(1) quantile {:.1} x noise^2)",
                 with.join(", "),
                 confound_threshold
             );
