@@ -165,3 +165,59 @@ pub fn score_test(
         };
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// For a linear model the score statistic equals the likelihood ratio:
+    /// sigma^2 S = SSE(base fit) - SSE(full fit), exactly.
+    #[test]
+    fn score_statistic_equals_the_linear_likelihood_ratio() {
+        let x: Vec<f64> = (0..50).map(|i| 0.1 * i as f64).collect();
+        // Data: 2 x + 0.3 x^2 + a deterministic wiggle standing in for noise.
+        let y: Vec<f64> = x
+            .iter()
+            .enumerate()
+            .map(|(i, v)| 2.0 * v + 0.3 * v * v + 0.05 * ((i * 7 % 11) as f64 - 5.0))
+            .collect();
+        let sxx: f64 = x.iter().map(|v| v * v).sum();
+        let a: f64 = x.iter().zip(&y).map(|(u, w)| u * w).sum::<f64>() / sxx;
+        let r: Vec<f64> = x.iter().zip(&y).map(|(u, w)| w - a * u).collect();
+        let jac = DMatrix::from_fn(50, 2, |i, j| if j == 0 { x[i] } else { x[i] * x[i] });
+        let sigma = 0.1;
+        let s = score_test(&r, &jac, 1, sigma, &[false], &[false]);
+        // Full least squares by the normal equations (2 x 2).
+        let (s11, s12, s22) = (
+            sxx,
+            x.iter().map(|v| v.powi(3)).sum::<f64>(),
+            x.iter().map(|v| v.powi(4)).sum::<f64>(),
+        );
+        let (b1, b2) = (
+            x.iter().zip(&y).map(|(u, w)| u * w).sum::<f64>(),
+            x.iter().zip(&y).map(|(u, w)| u * u * w).sum::<f64>(),
+        );
+        let det = s11 * s22 - s12 * s12;
+        let (fa, fb) = ((s22 * b1 - s12 * b2) / det, (s11 * b2 - s12 * b1) / det);
+        let sse = |f: &dyn Fn(f64) -> f64| {
+            x.iter()
+                .zip(&y)
+                .map(|(u, w)| (w - f(*u)).powi(2))
+                .sum::<f64>()
+        };
+        let lr = sse(&|u| a * u) - sse(&|u| fa * u + fb * u * u);
+        assert!(
+            (s.statistic * sigma * sigma - lr).abs() < 1e-9 * lr,
+            "{} vs {lr}",
+            s.statistic * sigma * sigma
+        );
+        assert_eq!(s.dof, 1);
+        // The Gauss-Newton step from "off" is the full least-squares coefficient.
+        assert!((s.step[0] - fb).abs() < 1e-9 * fb.abs());
+        // One-sided: a parameter on its lower bound cannot take a negative step.
+        let neg: Vec<f64> = r.iter().zip(&x).map(|(ri, u)| ri - 0.6 * u * u).collect();
+        let blocked = score_test(&neg, &jac, 1, sigma, &[true], &[false]);
+        assert_eq!((blocked.statistic, blocked.dof), (0.0, 0));
+        assert!(score_test(&neg, &jac, 1, sigma, &[false], &[false]).statistic > 0.0);
+    }
+}
