@@ -6,6 +6,7 @@
 
 pub mod anova;
 pub mod doe;
+pub mod emulator;
 pub mod gap;
 pub mod likelihood;
 pub mod mcmc;

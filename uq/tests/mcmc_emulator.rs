@@ -1,0 +1,93 @@
+//! The GP curve emulator reproduces the C1 model inside its training box and
+//! gives the same posterior as the model itself (the analytic stand-in for
+//! an FE model, whose direct sampling would be too slow).
+
+use palpate_analytic::C1Compression;
+use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_uq::emulator::CurveEmulator;
+use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, Posterior, Prior};
+use palpate_uq::mcmc::{summarize, DemcSettings, Sampler};
+use std::path::Path;
+use std::sync::Arc;
+
+fn data() -> (Loading, Vec<f64>, f64) {
+    let t = Table::read(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv"),
+    )
+    .unwrap();
+    let sigma = t
+        .comments
+        .iter()
+        .find_map(|c| {
+            c.split_once("sigma_N = ")
+                .map(|(_, v)| v.trim().parse().unwrap())
+        })
+        .unwrap();
+    let l = Loading::quasi_static(
+        Drive::DisplacementMm,
+        t.column("displacement_mm").unwrap().to_vec(),
+    );
+    (l, t.column("force_N").unwrap().to_vec(), sigma)
+}
+
+fn posterior(model: Arc<dyn ForwardModel>) -> Posterior {
+    let (loading, observed, sigma) = data();
+    let ds = DataSet {
+        name: "c1".into(),
+        model,
+        loading,
+        observed,
+        noise: NoiseModel::known(sigma),
+    };
+    Posterior::new(vec![ds], vec![Prior::Flat; 2]).unwrap()
+}
+
+#[test]
+fn emulated_posterior_matches_the_direct_one() {
+    let model = Arc::new(C1Compression::new("reduced-polynomial:2".parse().unwrap()));
+    let direct = posterior(model.clone());
+    let st = fit_and_laplace(&direct).unwrap();
+    let (mean, sd) = st.laplace_physical(&direct);
+    // Training box: Laplace mean +- 8 SD.
+    let lower: Vec<f64> = (0..2).map(|k| mean[k] - 8.0 * sd[k]).collect();
+    let upper: Vec<f64> = (0..2).map(|k| mean[k] + 8.0 * sd[k]).collect();
+    let (loading, _, sigma) = data();
+    let em = CurveEmulator::train(model.as_ref(), &loading, &lower, &upper, 30).unwrap();
+    let v = em.validate(model.as_ref(), 20).unwrap();
+    eprintln!("length scales {:?}; validation {v:?}", em.length_scales());
+    // Far below the noise (sigma is 2 % of the peak force).
+    assert!(v.max_relative_error < 1e-3, "{v:?}");
+    let peak = 2.72;
+    assert!(v.max_relative_error * peak < 0.05 * sigma);
+
+    let emulated = posterior(Arc::new(em));
+    let st_e = fit_and_laplace(&emulated).unwrap();
+    let sampler = Sampler::Demc(DemcSettings {
+        draws: 4000,
+        ..Default::default()
+    });
+    let a = sampler.run(&direct, &st.start, 3, None).unwrap();
+    let b = sampler.run(&emulated, &st_e.start, 3, None).unwrap();
+    let sa = summarize(
+        &a.chains.map(|z| direct.space().from_unbounded(z)),
+        &direct.names(),
+    );
+    let sb = summarize(
+        &b.chains.map(|z| emulated.space().from_unbounded(z)),
+        &emulated.names(),
+    );
+    for k in 0..2 {
+        eprintln!(
+            "{}: direct {:.6e} +- {:.3e}, emulated {:.6e} +- {:.3e}",
+            sa[k].name, sa[k].mean, sa[k].sd, sb[k].mean, sb[k].sd
+        );
+        let mc = (sa[k].mcse_mean.powi(2) + sb[k].mcse_mean.powi(2)).sqrt();
+        assert!(
+            (sa[k].mean - sb[k].mean).abs() < 0.05 * sa[k].sd + 4.0 * mc,
+            "{}",
+            sa[k].name
+        );
+        assert!((sb[k].sd / sa[k].sd - 1.0).abs() < 0.05, "{}", sa[k].name);
+        assert!(sb[k].rhat < 1.01);
+    }
+}
