@@ -164,6 +164,7 @@ impl ForwardModel for C1Compression {
                     Box::new(C1Compression::with_geometry(richer.law, self.geometry)),
                     richer.embed_law_params,
                     self.law.to_string(),
+                    richer.space,
                 )))
             }
             Effect::Compressibility => Ok(Box::new(Compressible::with_geometry(

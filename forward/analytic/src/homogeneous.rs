@@ -107,6 +107,7 @@ impl ForwardModel for Homogeneous {
                     Box::new(Homogeneous::new(richer.law, self.mode)),
                     richer.embed_law_params,
                     self.law.to_string(),
+                    richer.space,
                 )))
             }
             Effect::Viscoelasticity => Ok(Box::new(Viscoelastic::new(Box::new(self.clone()), 2))),

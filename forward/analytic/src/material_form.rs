@@ -1,6 +1,7 @@
 //! Enrichment `material_form`: a richer hyperelastic law that contains the
 //! base law as a special case.
 
+use crate::convert::law_space;
 use palpate_core::{
     Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
 };
@@ -14,6 +15,8 @@ pub struct RicherLaw {
     /// Values appended to the base law's parameters to give the richer law's
     /// parameters that reproduce the base law exactly (e.g. C20 = 0).
     pub embed_law_params: Vec<f64>,
+    /// The richer law's parameters as the enrichment sees them (see [`richer_law`]).
+    pub space: ParamSpace,
 }
 
 /// The next richer law of the same family, whose parameters are the base
@@ -24,6 +27,14 @@ pub struct RicherLaw {
 /// * Ogden N -> N+1: mu(N+1) = 0 (alpha(N+1) at its starting value).
 ///
 /// Mooney-Rivlin and Arruda-Boyce have no nested richer law here (`None`).
+///
+/// For the reduced polynomial the added coefficient is bounded below by 0:
+/// the enrichment adds a *stiffening* higher-order term (the departure from
+/// neo-Hookean that soft solids show in compression). A softening departure
+/// over moderate strains is the signature of a series compliance or of
+/// relaxation during loading, and a free sign would let this enrichment
+/// mimic those effects. Its starting value is a tenth of the richer law's
+/// C10 start. Ogden's added modulus keeps its free sign.
 pub fn richer_law(law: &Law) -> Option<RicherLaw> {
     let richer = match law {
         Law::NeoHookean => Law::ReducedPolynomial(2),
@@ -42,9 +53,17 @@ pub fn richer_law(law: &Law) -> Option<RicherLaw> {
         // The first extra parameter is the new modulus (C(N+1)0 or mu(N+1)): zero.
         .map(|(i, p)| if i == 0 { 0.0 } else { p.initial })
         .collect();
+    let mut space = law_space(&richer);
+    if let Law::ReducedPolynomial(_) = richer {
+        let start = 0.1 * space.params[0].initial.abs();
+        let added = &mut space.params[base_len];
+        added.lower = 0.0;
+        added.initial = start;
+    }
     Some(RicherLaw {
         law: richer,
         embed_law_params,
+        space,
     })
 }
 
@@ -55,17 +74,43 @@ pub struct MaterialForm {
     inner: Box<dyn ForwardModel>,
     off_tail: Vec<f64>,
     base_law: String,
+    space: ParamSpace,
 }
 
 impl MaterialForm {
     /// `inner` uses the richer law; `off_tail` completes a base parameter
-    /// vector to the richer law's "off" point; `base_law` names the base law.
-    pub fn new(inner: Box<dyn ForwardModel>, off_tail: Vec<f64>, base_law: String) -> Self {
+    /// vector to the richer law's "off" point; `base_law` names the base law;
+    /// `space` is the enrichment's parameter space (the inner model's names,
+    /// possibly narrower bounds, checked before delegating).
+    pub fn new(
+        inner: Box<dyn ForwardModel>,
+        off_tail: Vec<f64>,
+        base_law: String,
+        space: ParamSpace,
+    ) -> Self {
         MaterialForm {
             inner,
             off_tail,
             base_law,
+            space,
         }
+    }
+}
+
+struct MaterialFormEvaluator<'a> {
+    space: &'a ParamSpace,
+    inner: Box<dyn Evaluator + 'a>,
+}
+
+impl Evaluator for MaterialFormEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        self.space.check(theta)?;
+        self.inner.predict_into(theta, loading, out)
     }
 }
 
@@ -74,13 +119,16 @@ impl ForwardModel for MaterialForm {
         format!("{} (richer than {})", self.inner.name(), self.base_law)
     }
     fn space(&self) -> &ParamSpace {
-        self.inner.space()
+        &self.space
     }
     fn observable(&self) -> Observable {
         self.inner.observable()
     }
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        self.inner.evaluator()
+        Box::new(MaterialFormEvaluator {
+            space: &self.space,
+            inner: self.inner.evaluator(),
+        })
     }
     fn effects(&self) -> Vec<Effect> {
         self.inner.effects()
@@ -92,8 +140,5 @@ impl ForwardModel for MaterialForm {
         let mut v = base_theta.to_vec();
         v.extend_from_slice(&self.off_tail);
         v
-    }
-    fn predict(&self, theta: &[f64], loading: &Loading) -> Result<Vec<f64>, ForwardError> {
-        self.inner.predict(theta, loading)
     }
 }

@@ -398,6 +398,20 @@ fn every_enrichment_switched_off_reproduces_the_base_exactly() {
         assert!(!both.effects().contains(&Effect::Viscoelasticity));
         assert!(both.enrich(Effect::Viscoelasticity).is_err());
     }
+    // The richer law's added coefficient is a stiffening term: C20 >= 0, off at 0.
+    let rp2 = C1Compression::new(Law::NeoHookean)
+        .enrich(Effect::MaterialForm)
+        .unwrap();
+    assert_eq!(
+        rp2.space().names(),
+        vec!["C10".to_string(), "C20".to_string()]
+    );
+    assert_eq!(rp2.space().params[1].lower, 0.0);
+    assert!(rp2.space().params[1].initial > 0.0);
+    assert!(matches!(
+        rp2.predict(&[1e-3, -1e-4], &load),
+        Err(ForwardError::InvalidParameter { .. })
+    ));
     for effect in [Effect::Friction, Effect::Inclusion] {
         assert!(C1Compression::new(Law::NeoHookean).enrich(effect).is_err());
     }
