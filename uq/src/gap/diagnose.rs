@@ -561,6 +561,25 @@ pub fn diagnose(
         assessed[a].0.confounded_with = with;
     }
 
+    // Within the leading group of effects the held-out predictions cannot
+    // separate, the likelihood on all the data decides the order (they stay
+    // flagged as confounded).
+    if let Some(first) = assessed.first() {
+        if first.0.earns && !first.0.confounded_with.is_empty() {
+            let group = first.0.confounded_with.clone();
+            let lead = (0..assessed.len())
+                .filter(|&k| k == 0 || group.contains(&assessed[k].0.effect))
+                .max_by(|&a, &b| {
+                    assessed[a]
+                        .0
+                        .lr_statistic
+                        .total_cmp(&assessed[b].0.lr_statistic)
+                })
+                .unwrap_or(0);
+            let moved = assessed.remove(lead);
+            assessed.insert(0, moved);
+        }
+    }
     let best_earning = assessed.iter().find(|a| a.0.earns);
     let (verdict, confounded, explanation) = match (gap_significant, best_earning) {
         (false, _) => (
