@@ -397,11 +397,9 @@ pub fn diagnose(
             samples: loading.len(),
         });
     }
-    if n < MIN_SAMPLES {
-        return Err(GapError::TooFewSamples {
-            got: n,
-            needed: MIN_SAMPLES,
-        });
+    let needed = MIN_SAMPLES.max(2 * options.folds);
+    if n < needed {
+        return Err(GapError::TooFewSamples { got: n, needed });
     }
     if let Some(index) = observed.iter().position(|v| !v.is_finite()) {
         return Err(GapError::NonFinite { index });
@@ -655,4 +653,122 @@ pub fn diagnose(
         folds: options.folds,
         plot,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    //! The diagnosis on a toy model defined here (a linear spring with a zero
+    //! offset), so that this crate tests it without any physics crate.
+    use super::*;
+    use palpate_core::{Drive, Evaluator, Observable, ParamSpace, ParamSpec};
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+
+    /// F = k max(d - d0, 0); `offset` says whether d0 is a parameter.
+    struct Spring {
+        offset: bool,
+        space: ParamSpace,
+    }
+
+    impl Spring {
+        fn new(offset: bool) -> Self {
+            let mut p = vec![ParamSpec::new("k", "N/mm", 0.0, f64::INFINITY, 1.0)];
+            if offset {
+                p.push(ParamSpec::new("d0_mm", "mm", -1.0, 1.0, 0.0));
+            }
+            Spring {
+                offset,
+                space: ParamSpace::new(p),
+            }
+        }
+    }
+
+    struct SpringEval(bool);
+
+    impl Evaluator for SpringEval {
+        fn predict_into(
+            &mut self,
+            theta: &[f64],
+            loading: &Loading,
+            out: &mut [f64],
+        ) -> Result<(), ForwardError> {
+            let d0 = if self.0 { theta[1] } else { 0.0 };
+            for (o, d) in out.iter_mut().zip(&loading.drive) {
+                *o = theta[0] * (d - d0).max(0.0);
+            }
+            Ok(())
+        }
+    }
+
+    impl ForwardModel for Spring {
+        fn name(&self) -> String {
+            format!("spring{}", if self.offset { " + offset" } else { "" })
+        }
+        fn space(&self) -> &ParamSpace {
+            &self.space
+        }
+        fn observable(&self) -> Observable {
+            Observable::ForceN
+        }
+        fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+            Box::new(SpringEval(self.offset))
+        }
+        fn effects(&self) -> Vec<Effect> {
+            if self.offset {
+                Vec::new()
+            } else {
+                vec![Effect::ZeroOffset]
+            }
+        }
+        fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+            match (effect, self.offset) {
+                (Effect::ZeroOffset, false) => Ok(Box::new(Spring::new(true))),
+                _ => Err(ForwardError::InvalidConfig {
+                    field: "effect".into(),
+                    reason: "not offered".into(),
+                }),
+            }
+        }
+    }
+
+    fn data(d0: f64, seed: u64) -> (Loading, Vec<f64>) {
+        let d: Vec<f64> = (0..200).map(|i| 0.01 * i as f64).collect();
+        let loading = Loading::quasi_static(Drive::DisplacementMm, d);
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let noise = Normal::new(0.0, 0.01).unwrap();
+        let f = Spring::new(true).predict(&[3.0, d0], &loading).unwrap();
+        (
+            loading,
+            f.into_iter().map(|v| v + noise.sample(&mut rng)).collect(),
+        )
+    }
+
+    #[test]
+    fn finds_a_planted_offset_and_says_none_without_one() {
+        let base = Spring::new(false);
+        let (loading, y) = data(0.1, 1);
+        let r = diagnose(&base, &loading, &y, &GapOptions::default()).unwrap();
+        assert_eq!(r.verdict, "zero_offset", "{}", r.explanation);
+        let best = &r.ranking[0];
+        let (d0, se) = (best.params["d0_mm"], best.standard_errors["d0_mm"].unwrap());
+        assert!((d0 - 0.1).abs() < 3.0 * se, "d0 = {d0} +- {se}");
+        assert!(best.heldout_after < 1.2 * 0.01 && best.misfit_before > 2.0 * best.misfit_after);
+        assert!(!r.where_.is_empty() && r.where_[0].axis == "displacement_mm");
+        assert!((r.noise_sd / 0.01 - 1.0).abs() < 0.2);
+
+        let (loading, y) = data(0.0, 2);
+        let r = diagnose(&base, &loading, &y, &GapOptions::default()).unwrap();
+        assert_eq!(r.verdict, "none", "{}", r.explanation);
+        assert!(!r.base.gap_significant && r.where_.is_empty());
+    }
+
+    #[test]
+    fn a_model_without_enrichments_cannot_be_diagnosed() {
+        let (loading, y) = data(0.0, 3);
+        let err = diagnose(&Spring::new(true), &loading, &y, &GapOptions::default()).unwrap_err();
+        assert!(
+            matches!(err, GapError::InvalidOption { option: "base", .. }),
+            "{err}"
+        );
+    }
 }

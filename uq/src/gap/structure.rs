@@ -182,7 +182,7 @@ pub fn significant_windows(
                 misfit_rms: rms,
                 significance: format!(
                     "{} samples, RMS/noise = {:.2}, bias chi2(1) = {:.1}, scatter chi2({}) = {:.1}, p = {:.2e} \
-                     (flagged at {:.1e} = {alpha:.0e} / {tests} windows x tests)",
+                     (flagged below {:.1e} = {alpha:.0e} / {tests} tests, bias and scatter per window)",
                     m,
                     rms / sigma,
                     bias,
