@@ -34,20 +34,49 @@ pub enum DataError {
         #[source]
         source: std::io::Error,
     },
-    #[error("{file}: no header line (expected column names such as `time_s,displacement_mm,force_N`)")]
+    #[error(
+        "{file}: no header line (expected column names such as `time_s,displacement_mm,force_N`)"
+    )]
     NoHeader { file: PathBuf },
     #[error("{file}:{line}: the header names column `{column}` twice")]
-    DuplicateColumn { file: PathBuf, line: usize, column: String },
+    DuplicateColumn {
+        file: PathBuf,
+        line: usize,
+        column: String,
+    },
     #[error("{file}: missing column `{column}` (header has: {header})")]
-    MissingColumn { file: PathBuf, column: String, header: String },
+    MissingColumn {
+        file: PathBuf,
+        column: String,
+        header: String,
+    },
     #[error("{file}:{line}: expected {expected} fields, found {found}")]
-    FieldCount { file: PathBuf, line: usize, expected: usize, found: usize },
+    FieldCount {
+        file: PathBuf,
+        line: usize,
+        expected: usize,
+        found: usize,
+    },
     #[error("{file}:{line}: column `{column}`: `{value}` is not a number")]
-    NotNumeric { file: PathBuf, line: usize, column: String, value: String },
+    NotNumeric {
+        file: PathBuf,
+        line: usize,
+        column: String,
+        value: String,
+    },
     #[error("{file}:{line}: column `{column}`: value is NaN or infinite")]
-    NotFinite { file: PathBuf, line: usize, column: String },
+    NotFinite {
+        file: PathBuf,
+        line: usize,
+        column: String,
+    },
     #[error("{file}:{line}: column `time_s` is not monotonic ({prev} then {value})")]
-    NonMonotonicTime { file: PathBuf, line: usize, prev: f64, value: f64 },
+    NonMonotonicTime {
+        file: PathBuf,
+        line: usize,
+        prev: f64,
+        value: f64,
+    },
     #[error("{file}: no data rows")]
     Empty { file: PathBuf },
 }
@@ -134,7 +163,12 @@ impl Table {
                         if n[k] == Column::TIME {
                             if let Some(&prev) = columns[k].last() {
                                 if v < prev {
-                                    return Err(DataError::NonMonotonicTime { file, line, prev, value: v });
+                                    return Err(DataError::NonMonotonicTime {
+                                        file,
+                                        line,
+                                        prev,
+                                        value: v,
+                                    });
                                 }
                             }
                         }
@@ -209,14 +243,28 @@ mod tests {
 
     #[test]
     fn errors_name_file_line_and_column() {
-        let e = Table::parse("a.csv", "time_s,force_N\n0,1\n1,abc\n").unwrap_err().to_string();
-        assert!(e.contains("a.csv:3") && e.contains("force_N") && e.contains("abc"), "{e}");
-        let e = Table::parse("a.csv", "time_s,force_N\n0,1\n1,NaN\n").unwrap_err().to_string();
+        let e = Table::parse("a.csv", "time_s,force_N\n0,1\n1,abc\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a.csv:3") && e.contains("force_N") && e.contains("abc"),
+            "{e}"
+        );
+        let e = Table::parse("a.csv", "time_s,force_N\n0,1\n1,NaN\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("a.csv:3") && e.contains("NaN"), "{e}");
-        let e = Table::parse("a.csv", "time_s,force_N\n1,1\n0.5,2\n").unwrap_err().to_string();
+        let e = Table::parse("a.csv", "time_s,force_N\n1,1\n0.5,2\n")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("a.csv:3") && e.contains("monotonic"), "{e}");
-        let e = Table::parse("a.csv", "time_s,force_N\n1,1,3\n").unwrap_err().to_string();
-        assert!(e.contains("a.csv:2") && e.contains("expected 2 fields"), "{e}");
+        let e = Table::parse("a.csv", "time_s,force_N\n1,1,3\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("a.csv:2") && e.contains("expected 2 fields"),
+            "{e}"
+        );
         let t = Table::parse("a.csv", "time_s,force_N\n1,1\n").unwrap();
         let e = t.column("displacement_mm").unwrap_err().to_string();
         assert!(e.contains("a.csv") && e.contains("displacement_mm"), "{e}");

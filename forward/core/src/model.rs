@@ -13,7 +13,12 @@ use crate::{Effect, ForwardError, Loading, Observable, ParamSpace};
 pub trait Evaluator {
     /// Predictions at each sample of `loading`, written into `out`
     /// (`out.len() == loading.len()`), for physical parameters `theta`.
-    fn predict_into(&mut self, theta: &[f64], loading: &Loading, out: &mut [f64]) -> Result<(), ForwardError>;
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError>;
 }
 
 /// A forward model: parameters + loading history -> predicted observations.
@@ -53,7 +58,13 @@ pub trait ForwardModel: Send + Sync {
     /// parameters.
     fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
         let mut v = base_theta.to_vec();
-        v.extend(self.space().params.iter().skip(base_theta.len()).map(|p| p.initial));
+        v.extend(
+            self.space()
+                .params
+                .iter()
+                .skip(base_theta.len())
+                .map(|p| p.initial),
+        );
         v
     }
 
@@ -90,7 +101,12 @@ pub trait ModelExt: ForwardModel {
             ev.predict_into(&tp, loading, &mut plus)?;
             ev.predict_into(&tm, loading, &mut minus)?;
             let span = tp[j] - tm[j];
-            cols.push(plus.iter().zip(&minus).map(|(a, b)| (a - b) / span).collect());
+            cols.push(
+                plus.iter()
+                    .zip(&minus)
+                    .map(|(a, b)| (a - b) / span)
+                    .collect(),
+            );
         }
         Ok(cols)
     }

@@ -38,7 +38,13 @@ pub struct ParamSpec {
 
 impl ParamSpec {
     /// A parameter with bounds and a starting value.
-    pub fn new(name: impl Into<String>, unit: impl Into<String>, lower: f64, upper: f64, initial: f64) -> Self {
+    pub fn new(
+        name: impl Into<String>,
+        unit: impl Into<String>,
+        lower: f64,
+        upper: f64,
+        initial: f64,
+    ) -> Self {
         ParamSpec {
             name: name.into(),
             unit: unit.into(),
@@ -160,17 +166,29 @@ impl ParamSpace {
 
     /// Physical -> unbounded, element-wise.
     pub fn to_unbounded(&self, x: &[f64]) -> Vec<f64> {
-        self.params.iter().zip(x).map(|(p, &v)| p.to_unbounded(v)).collect()
+        self.params
+            .iter()
+            .zip(x)
+            .map(|(p, &v)| p.to_unbounded(v))
+            .collect()
     }
 
     /// Unbounded -> physical, element-wise.
     pub fn from_unbounded(&self, z: &[f64]) -> Vec<f64> {
-        self.params.iter().zip(z).map(|(p, &v)| p.from_unbounded(v)).collect()
+        self.params
+            .iter()
+            .zip(z)
+            .map(|(p, &v)| p.from_unbounded(v))
+            .collect()
     }
 
     /// Sum of log |dx/dz| (log-Jacobian of the whole map).
     pub fn log_jacobian(&self, z: &[f64]) -> f64 {
-        self.params.iter().zip(z).map(|(p, &v)| p.log_abs_dx_dz(v)).sum()
+        self.params
+            .iter()
+            .zip(z)
+            .map(|(p, &v)| p.log_abs_dx_dz(v))
+            .sum()
     }
 
     /// Checks the length and the bounds; the error names the first offender.
@@ -211,11 +229,19 @@ mod tests {
     fn round_trip_and_jacobian_match_finite_differences() {
         for p in specs() {
             let z = p.to_unbounded(p.initial);
-            assert!((p.from_unbounded(z) - p.initial).abs() < 1e-14, "{}", p.name);
+            assert!(
+                (p.from_unbounded(z) - p.initial).abs() < 1e-14,
+                "{}",
+                p.name
+            );
             let h = 1e-6;
             let fd = (p.from_unbounded(z + h) - p.from_unbounded(z - h)) / (2.0 * h);
             assert!((fd - p.dx_dz(z)).abs() < 1e-8, "{}", p.name);
-            assert!((p.dx_dz(z).abs().ln() - p.log_abs_dx_dz(z)).abs() < 1e-12, "{}", p.name);
+            assert!(
+                (p.dx_dz(z).abs().ln() - p.log_abs_dx_dz(z)).abs() < 1e-12,
+                "{}",
+                p.name
+            );
         }
     }
 
