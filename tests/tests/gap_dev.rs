@@ -310,6 +310,12 @@ fn a_series_spring_and_relaxation_on_a_single_ramp_are_reported_as_confounded() 
     );
     let best = entry(&r, &r.verdict);
     assert!(!best.identifiable && best.confounded_with.iter().any(|e| e == other));
+    // Locally the two act on nearly the same direction of the prediction.
+    assert!(
+        best.sensitivity_overlap[other] > 0.95,
+        "{:?}",
+        best.sensitivity_overlap
+    );
     assert!(r.to_markdown().contains("Cannot be told apart"));
     // Both explain the data down to the noise.
     for e in pair {

@@ -3,11 +3,12 @@
 use super::fit::{fit_from_starts, Fitted};
 use super::noise::difference_noise_sd;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
-use super::score::{score_test, sensitivities};
+use super::score::{projected_columns, score_test, sensitivities, sensitivity_overlap};
 use super::structure::{
     chi2_isf, chi2_sf, default_window, discrepancy_band, lag1, significant_windows, whiteness,
 };
 use super::{GapError, GapOptions};
+use nalgebra::DMatrix;
 use palpate_core::{Effect, ForwardError, ForwardModel, Loading};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -230,8 +231,9 @@ struct Context<'a> {
     rel_var_sd2: f64,
 }
 
-/// A candidate's ranking entry and its full-record fit, or why it failed.
-type Assessment = Result<(RankedEffect, Fitted), GapError>;
+/// A candidate's ranking entry, its full-record fit and its projected
+/// sensitivities at "off", or why it failed.
+type Assessment = Result<(RankedEffect, Fitted, DMatrix<f64>), GapError>;
 
 /// Score test, refits and comparison of one enrichment.
 fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Assessment {
@@ -364,6 +366,7 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
         evidence,
         identifiable,
         confounded_with: Vec::new(),
+        sensitivity_overlap: BTreeMap::new(),
         earns,
         model: rich.name(),
         all_params,
@@ -378,7 +381,7 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
         max_correlation,
         identifiability: ident.reason.clone(),
     };
-    Ok((ranked, full))
+    Ok((ranked, full, projected_columns(&jac, p)))
 }
 
 /// Diagnoses the gap between `base` and `observed` (one value per sample of
@@ -519,6 +522,20 @@ pub fn diagnose(
             }),
         }
     }
+    // Local identifiability between effects: overlap of their sensitivity
+    // directions at "off" once the base parameters are refitted.
+    for a in 0..assessed.len() {
+        let overlaps: BTreeMap<String, f64> = (0..assessed.len())
+            .filter(|&b| b != a)
+            .map(|b| {
+                (
+                    assessed[b].0.effect.clone(),
+                    sensitivity_overlap(&assessed[a].2, &assessed[b].2),
+                )
+            })
+            .collect();
+        assessed[a].0.sensitivity_overlap = overlaps;
+    }
     // Rank: effects that earn their parameters first, then by the held-out
     // (cross-validated) gain, which charges every extra parameter through its
     // prediction error rather than through a fixed penalty; AR(1) BIC breaks ties.
@@ -548,6 +565,22 @@ pub fn diagnose(
         }
         if !with.is_empty() {
             assessed[a].0.identifiable = false;
+            let overlaps: Vec<String> = with
+                .iter()
+                .map(|e| {
+                    format!(
+                        "{e}: {:.3}",
+                        assessed[a]
+                            .0
+                            .sensitivity_overlap
+                            .get(e)
+                            .copied()
+                            .unwrap_or(f64::NAN)
+                    )
+                })
+                .collect();
+            let overlap_note = format!("; sensitivity overlap at off {}", overlaps.join(", "));
+            assessed[a].0.evidence.push_str(&overlap_note);
             let note = format!(
                 "; the data cannot tell it apart from {} (fitted or held-out SSE difference below \
                  chi2(1) quantile {:.1} x noise^2)",

@@ -35,6 +35,10 @@ pub struct RankedEffect {
     pub identifiable: bool,
     /// Effects whose fits the data cannot tell apart from this one.
     pub confounded_with: Vec<String>,
+    /// For every other candidate, the cosine of the smallest principal angle
+    /// between the two effects' sensitivity directions at "off" (base
+    /// directions removed): near 1, the two are locally indistinguishable.
+    pub sensitivity_overlap: BTreeMap<String, f64>,
     /// Whether the effect earns its parameters (significant likelihood ratio
     /// and held-out gain).
     pub earns: bool,

@@ -60,6 +60,57 @@ pub fn sensitivities(
     Ok(jac)
 }
 
+/// The columns of `jac` from `p` on, made orthogonal to the first `p`
+/// (the base parameters' sensitivities) by a thin QR of the latter: what an
+/// enrichment can change that refitting the base parameters cannot.
+pub fn projected_columns(jac: &DMatrix<f64>, p: usize) -> DMatrix<f64> {
+    let q = jac.ncols() - p;
+    let mut a = jac.columns(p, q).into_owned();
+    if p > 0 {
+        let qr = jac.columns(0, p).into_owned().qr();
+        let qm = qr.q();
+        let rm = qr.r();
+        let scale = rm.diagonal().amax().max(f64::MIN_POSITIVE);
+        for k in (0..p).filter(|&k| rm[(k, k)].abs() > 1e-10 * scale) {
+            let qk = qm.column(k);
+            for j in 0..q {
+                let c = qk.dot(&a.column(j));
+                a.column_mut(j).axpy(-c, &qk, 1.0);
+            }
+        }
+    }
+    a
+}
+
+/// Orthonormal basis of the column space of `a` (left singular vectors
+/// above 1e-8 of the largest singular value).
+fn column_basis(a: &DMatrix<f64>) -> DMatrix<f64> {
+    if a.ncols() == 0 || a.norm() == 0.0 {
+        return DMatrix::zeros(a.nrows(), 0);
+    }
+    let svd = a.clone().svd(true, false);
+    let u = svd.u.expect("u requested");
+    let smax = svd.singular_values.amax();
+    let keep: Vec<usize> = (0..svd.singular_values.len())
+        .filter(|&k| svd.singular_values[k] > 1e-8 * smax)
+        .collect();
+    DMatrix::from_fn(a.nrows(), keep.len(), |i, k| u[(i, keep[k])])
+}
+
+/// Cosine of the smallest principal angle between the column spaces of two
+/// effects' projected sensitivities ([`projected_columns`]): 1 when some
+/// change of one effect's parameters moves the prediction exactly as a
+/// change of the other's does (locally indistinguishable at "off"), 0 when
+/// they act on orthogonal directions (Björck & Golub 1973).
+pub fn sensitivity_overlap(a: &DMatrix<f64>, b: &DMatrix<f64>) -> f64 {
+    let (ua, ub) = (column_basis(a), column_basis(b));
+    if ua.ncols() == 0 || ub.ncols() == 0 {
+        return 0.0;
+    }
+    let m = ua.transpose() * ub;
+    m.svd(false, false).singular_values.amax().min(1.0)
+}
+
 /// Result of a score test.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ScoreTest {
@@ -94,24 +145,7 @@ pub fn score_test(
     let n = r.len();
     let q = jac.ncols() - p;
     let rv = nalgebra::DVector::from_column_slice(r);
-    // Orthonormal basis of the base columns (thin QR), dropping null columns.
-    let b = jac.columns(0, p).into_owned();
-    let mut a = jac.columns(p, q).into_owned();
-    if p > 0 {
-        let qr = b.clone().qr();
-        let qm = qr.q();
-        let rm = qr.r();
-        let keep: Vec<usize> = (0..p)
-            .filter(|&k| rm[(k, k)].abs() > 1e-10 * rm.diagonal().amax().max(f64::MIN_POSITIVE))
-            .collect();
-        for &k in &keep {
-            let qk = qm.column(k);
-            for j in 0..q {
-                let c = qk.dot(&a.column(j));
-                a.column_mut(j).axpy(-c, &qk, 1.0);
-            }
-        }
-    }
+    let a = projected_columns(jac, p);
     let mut active: Vec<usize> = (0..q).filter(|&j| a.column(j).norm() > 0.0).collect();
     let mut step = vec![0.0; q];
     loop {
