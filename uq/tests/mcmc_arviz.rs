@@ -20,7 +20,7 @@ fn diagnostics_match_arviz_to_1e_6() {
             .iter()
             .map(|c| c.iter().map(|&x| vec![x]).collect())
             .collect();
-        let s = &summarize(&Chains::from_nested(&nested), &[name.clone()])[0];
+        let s = &summarize(&Chains::from_nested(&nested), std::slice::from_ref(name))[0];
         let (lo, hi) = hdi(&flat, 0.94);
         let ours = [
             ("mean", s.mean),

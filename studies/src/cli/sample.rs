@@ -128,7 +128,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 .max(1e-12);
             DataSet {
                 name: t.name.clone(),
-                model: t.test.model(law.clone()),
+                model: t.test.model(law),
                 loading: t.loading.clone(),
                 observed: t.observed.clone(),
                 noise: NoiseModel {

@@ -135,7 +135,13 @@ impl CurveEmulator {
         n_runs: usize,
     ) -> Result<CurveEmulator, EmulatorError> {
         let d = model.space().len();
-        if lower.len() != d || upper.len() != d || lower.iter().zip(upper).any(|(l, u)| !(l < u)) {
+        if lower.len() != d
+            || upper.len() != d
+            || lower
+                .iter()
+                .zip(upper)
+                .any(|(l, u)| l.is_nan() || u.is_nan() || l >= u)
+        {
             return Err(EmulatorError::InvalidBox {
                 reason: format!("need {d} lower < upper pairs"),
             });
