@@ -17,9 +17,12 @@ use std::sync::Arc;
 /// Fewest samples the diagnosis works with.
 const MIN_SAMPLES: usize = 16;
 
-/// -2 log-likelihood of residuals `r` under AR(1) Gaussian errors with the
-/// lag-1 coefficient and innovation variance at their estimates (exact
-/// likelihood of a stationary AR(1), Box & Jenkins): e_0 = sqrt(1 - rho^2) r_0,
+/// -2 log-likelihood of residuals `r` under AR(1) Gaussian errors, the
+/// exact likelihood of a stationary AR(1) (Box & Jenkins) evaluated at the
+/// lag-1 sample autocorrelation rho (clipped to +-0.99, a moment estimate,
+/// not the maximum-likelihood one, so the AIC/BIC built on it are
+/// approximate; they only break ties in the ranking) and the innovation
+/// variance: e_0 = sqrt(1 - rho^2) r_0,
 /// e_i = r_i - rho r_{i-1}, -2 log L = n ln(2 pi s^2) + n - ln(1 - rho^2),
 /// s^2 = sum e^2 / n. A misfit that is smooth (rho near 1) is partly absorbed by
 /// the correlation, so an extra parameter must remove more than what the

@@ -13,10 +13,12 @@
 //! 3. **Attribute**: for every effect the base model offers
 //!    (`ForwardModel::effects`/`enrich`), a score test at the "off" point
 //!    ([`score`]), then a refit from several starts; compare by the
-//!    likelihood ratio against the noise, information criteria under AR(1)
-//!    errors, and the misfit on the held-out end of the record (fitted
-//!    without it); identifiability from the calibration report and
-//!    confounding between effects whose fits the data cannot tell apart.
+//!    likelihood ratio against the noise, blocked cross-validation (each of
+//!    K contiguous blocks predicted by a fit to the others; the last block,
+//!    the later segment of the history, is also reported on its own), and
+//!    approximate information criteria under AR(1) errors; identifiability
+//!    from the calibration report, the overlap of the effects' sensitivities,
+//!    and confounding between effects whose fits the data cannot tell apart.
 //! 4. **Verdict**: `none` when the base misfit is consistent with noise or no
 //!    effect earns its parameters; else the best effect that does.
 

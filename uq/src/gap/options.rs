@@ -9,9 +9,13 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct GapOptions {
-    /// Family-wise significance level of every test (misfit, runs,
-    /// autocorrelation, windows, likelihood ratio, held-out gain); each family
-    /// is Bonferroni-corrected for its number of tests.
+    /// Significance level of the tests. The windows are tested at
+    /// alpha / (2 x number of windows) and the likelihood ratios at
+    /// alpha / number of candidates (Bonferroni); the three whole-record tests
+    /// (misfit, runs, lag-1 autocorrelation) are each applied at alpha, so
+    /// "gap significant" has a family-wise level of about 3 alpha plus the
+    /// windows' alpha; the held-out gain must exceed the chi2(1) quantile at
+    /// alpha.
     pub alpha: f64,
     /// Number of contiguous blocks of the record for blocked cross-validation:
     /// each block is left out in turn, predicted by the model fitted to the
