@@ -1,0 +1,170 @@
+//! The `palpate` binary as a user meets it: good runs write their files, bad
+//! input gives a clear error naming the file, line or field (exit code 2),
+//! never a panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn palpate(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_palpate"))
+        .args(args)
+        .output()
+        .expect("run palpate")
+}
+
+fn treloar(name: &str) -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("data/treloar")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).to_string()
+}
+
+fn assert_clean_failure(o: &Output, needles: &[&str]) {
+    let e = stderr(o);
+    assert_eq!(o.status.code(), Some(2), "exit code; stderr: {e}");
+    assert!(!e.contains("panicked"), "panic: {e}");
+    for n in needles {
+        assert!(e.contains(n), "`{n}` not in: {e}");
+    }
+}
+
+#[test]
+fn calibrate_writes_json_with_every_parameter_by_name() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("fit.json");
+    let svg = dir.path().join("fit.svg");
+    let uni = format!("uniaxial={}", treloar("uniaxial.csv"));
+    let bi = format!("biaxial={}", treloar("biaxial.csv"));
+    let o = palpate(&[
+        "calibrate",
+        "--law",
+        "mooney-rivlin",
+        "--data",
+        &uni,
+        "--data",
+        &bi,
+        "--residual",
+        "relative",
+        "--json",
+        json.to_str().unwrap(),
+        "--plot",
+        svg.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    for p in ["C10", "C01"] {
+        assert!(v["params"][p]["value"].is_f64(), "{p}: {v}");
+        assert!(v["params"][p]["standard_error"].is_f64(), "{p}");
+    }
+    for k in ["r2", "rms", "iterations", "evaluations"] {
+        assert!(v[k].is_number(), "{k}");
+    }
+    assert!(v["drucker"]["uniaxial"]["upper"].is_f64());
+    assert!(std::fs::read_to_string(&svg).unwrap().starts_with("<svg"));
+}
+
+#[test]
+fn calibrate_c1_benchmark_record() {
+    let dir = tempfile::tempdir().unwrap();
+    // A noise-free C1 record of ecoflex-nh: F = 2 C10 (1/s^2 - s) A, s = 1 - d/9.
+    let area = std::f64::consts::PI * 19.0 * 19.0;
+    let mut csv = String::from("time_s,displacement_mm,force_N\n");
+    for i in 0..=40 {
+        let d = 0.05 * i as f64;
+        let s: f64 = 1.0 - d / 9.0;
+        let f = 2.0 * 1.101295e-3 * (1.0 / (s * s) - s) * area;
+        csv.push_str(&format!("{},{d},{f}\n", d / 0.4));
+    }
+    let file = dir.path().join("c1.csv");
+    std::fs::write(&file, csv).unwrap();
+    let json = dir.path().join("c1.json");
+    let o = palpate(&[
+        "calibrate",
+        "--benchmark",
+        "C1",
+        "--law",
+        "neo-hookean",
+        "--data",
+        file.to_str().unwrap(),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let c10 = v["params"]["C10"]["value"].as_f64().unwrap();
+    assert!((c10 / 1.101295e-3 - 1.0).abs() < 1e-6, "{c10}");
+}
+
+#[test]
+fn malformed_csv_names_file_line_and_column() {
+    let dir = tempfile::tempdir().unwrap();
+    let file = dir.path().join("bad.csv");
+    std::fs::write(&file, "# comment\nstretch,stress_MPa\n1,0\n1.5,oops\n").unwrap();
+    let arg = format!("uniaxial={}", file.display());
+    let o = palpate(&["calibrate", "--law", "neo-hookean", "--data", &arg]);
+    assert_clean_failure(&o, &["bad.csv:4", "stress_MPa", "oops"]);
+    std::fs::write(&file, "stretch,force_N\n1,0\n").unwrap();
+    let o = palpate(&["calibrate", "--law", "neo-hookean", "--data", &arg]);
+    assert_clean_failure(&o, &["bad.csv", "stress_MPa"]);
+}
+
+#[test]
+fn bad_options_are_named() {
+    let uni = format!("uniaxial={}", treloar("uniaxial.csv"));
+    assert_clean_failure(
+        &palpate(&["calibrate", "--law", "neo-hooke", "--data", &uni]),
+        &["--law", "neo-hooke"],
+    );
+    assert_clean_failure(
+        &palpate(&["calibrate", "--law", "neo-hookean", "--data", "shear=x.csv"]),
+        &["shear"],
+    );
+    assert_clean_failure(
+        &palpate(&[
+            "calibrate",
+            "--law",
+            "neo-hookean",
+            "--data",
+            &uni,
+            "--fix",
+            "C10=-1",
+        ]),
+        &["C10"],
+    );
+    assert_clean_failure(
+        &palpate(&[
+            "calibrate",
+            "--law",
+            "neo-hookean",
+            "--data",
+            "uniaxial=/no/such/file.csv",
+        ]),
+        &["/no/such/file.csv"],
+    );
+    assert_clean_failure(
+        &palpate(&[
+            "simulate",
+            "--benchmark",
+            "C1",
+            "--law",
+            "neo-hookean",
+            "--param",
+            "C10=-0.001",
+        ]),
+        &["C10"],
+    );
+}
+
+#[test]
+fn run_check_reports_misspelled_manifest_field_with_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let m: PathBuf = dir.path().join("s.toml");
+    std::fs::write(&m, "[study]\nname = \"x\"\nseeed = 3\nsteps = []\n").unwrap();
+    let o = palpate(&["run", "--check", m.to_str().unwrap()]);
+    assert_clean_failure(&o, &["s.toml", "line 3", "seeed"]);
+}
