@@ -6,16 +6,19 @@
 //! * [`Posterior`]: data sets + priors as a [`crate::mcmc::LogDensity`] in the
 //!   unbounded space, with the transforms' log-Jacobian.
 //! * [`fit_and_laplace`]: least-squares fit, Laplace approximation, chain start.
+//! * [`thermodynamic_integration`]: evidence by power posteriors.
 //! * [`predictive_band`]: posterior predictive bands.
 
+pub mod evidence;
 pub mod map_start;
 pub mod noise;
 pub mod posterior;
 pub mod predictive;
 pub mod prior;
 
+pub use evidence::{thermodynamic_integration, ThermodynamicEvidence};
 pub use map_start::{fit_and_laplace, PosteriorStart, StartError};
 pub use noise::{ar1_log_likelihood, gaussian_log_likelihood, Correlation, NoiseModel, NoiseSd};
-pub use posterior::{DataSet, LikelihoodError, Posterior};
+pub use posterior::{DataSet, LikelihoodError, Posterior, Tempered};
 pub use predictive::{predictive_band, PredictiveBand};
 pub use prior::Prior;

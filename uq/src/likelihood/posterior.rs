@@ -229,12 +229,24 @@ impl Posterior {
     /// Log prior + log-likelihood at physical parameters `x` (no Jacobian):
     /// the posterior density of x, up to the evidence.
     pub fn log_posterior_physical(&self, x: &[f64]) -> f64 {
-        let mut w = self.make_worker();
+        let mut w = self.make_worker(1.0);
         w.log_physical(x)
     }
 
-    fn make_worker(&self) -> PosteriorWorker<'_> {
+    /// The power posterior prior x likelihood^beta (in the unbounded space,
+    /// with the log-Jacobian), used by thermodynamic integration.
+    pub fn tempered(&self, beta: f64) -> Tempered<'_> {
+        Tempered { post: self, beta }
+    }
+
+    /// log-likelihood of all data sets at physical `x` (`-inf` if the model fails).
+    pub fn log_likelihood(&self, x: &[f64]) -> f64 {
+        self.make_worker(1.0).log_likelihood(x)
+    }
+
+    fn make_worker(&self, beta: f64) -> PosteriorWorker<'_> {
         PosteriorWorker {
+            beta,
             post: self,
             evaluators: self.datasets.iter().map(|d| d.model.evaluator()).collect(),
             pred: self
@@ -248,6 +260,7 @@ impl Posterior {
 }
 
 struct PosteriorWorker<'a> {
+    beta: f64,
     post: &'a Posterior,
     evaluators: Vec<Box<dyn Evaluator + 'a>>,
     pred: Vec<Vec<f64>>,
@@ -256,14 +269,25 @@ struct PosteriorWorker<'a> {
 
 impl PosteriorWorker<'_> {
     fn log_physical(&mut self, x: &[f64]) -> f64 {
-        let post = self.post;
-        let mut lp = 0.0;
-        for (p, &v) in post.priors.iter().zip(x) {
-            lp += p.log_density(v);
-        }
+        let lp = self.log_prior(x);
         if !lp.is_finite() {
             return f64::NEG_INFINITY;
         }
+        lp + self.beta * self.log_likelihood(x)
+    }
+
+    fn log_prior(&self, x: &[f64]) -> f64 {
+        self.post
+            .priors
+            .iter()
+            .zip(x)
+            .map(|(p, &v)| p.log_density(v))
+            .sum()
+    }
+
+    fn log_likelihood(&mut self, x: &[f64]) -> f64 {
+        let post = self.post;
+        let mut ll = 0.0;
         for s in 0..post.datasets.len() {
             let ds = &post.datasets[s];
             let pred = &mut self.pred[s];
@@ -280,12 +304,12 @@ impl PosteriorWorker<'_> {
             if sigma.is_nan() || sigma <= 0.0 || phi.is_nan() || phi.abs() >= 1.0 {
                 return f64::NEG_INFINITY;
             }
-            lp += match ds.noise.correlation {
+            ll += match ds.noise.correlation {
                 Correlation::Independent => gaussian_log_likelihood(pred, sigma),
                 _ => ar1_log_likelihood(pred, sigma, phi),
             };
         }
-        lp
+        ll
     }
 }
 
@@ -310,6 +334,21 @@ impl LogDensity for Posterior {
         self.space.len()
     }
     fn worker(&self) -> Box<dyn DensityWorker + '_> {
-        Box::new(self.make_worker())
+        Box::new(self.make_worker(1.0))
+    }
+}
+
+/// A power posterior p(x) L(x)^beta as a log-density in the unbounded space.
+pub struct Tempered<'a> {
+    post: &'a Posterior,
+    beta: f64,
+}
+
+impl LogDensity for Tempered<'_> {
+    fn dim(&self) -> usize {
+        self.post.space.len()
+    }
+    fn worker(&self) -> Box<dyn DensityWorker + '_> {
+        Box::new(self.post.make_worker(self.beta))
     }
 }
