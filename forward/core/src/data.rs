@@ -93,6 +93,99 @@ pub struct Table {
     pub comments: Vec<String>,
 }
 
+/// The text layer shared by every CSV reader of palpate: comment lines
+/// (`#`, kept), blank lines (skipped), one header line of unique column
+/// names, then rows with exactly one field per column (surrounding double
+/// quotes stripped). Fields stay strings; [`Table`] turns them into numbers,
+/// the ANOVA runs table keeps factor levels as names.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TextTable {
+    pub file: PathBuf,
+    pub names: Vec<String>,
+    /// `rows[i][k]`: row i, column k.
+    pub rows: Vec<Vec<String>>,
+    /// Source line (1-based, counting comments) of each row.
+    pub lines: Vec<usize>,
+    pub comments: Vec<String>,
+}
+
+impl TextTable {
+    /// Reads a file.
+    pub fn read(path: impl AsRef<Path>) -> Result<TextTable, DataError> {
+        let path = path.as_ref();
+        let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+            file: path.to_path_buf(),
+            source,
+        })?;
+        TextTable::parse(path, &text)
+    }
+
+    /// Parses text as if read from `file`.
+    pub fn parse(file: impl AsRef<Path>, text: &str) -> Result<TextTable, DataError> {
+        let file = file.as_ref().to_path_buf();
+        let mut names: Option<Vec<String>> = None;
+        let (mut rows, mut lines, mut comments) = (Vec::new(), Vec::new(), Vec::new());
+        for (i, raw) in text.lines().enumerate() {
+            let line = i + 1;
+            let s = raw.trim();
+            if s.is_empty() {
+                continue;
+            }
+            if let Some(c) = s.strip_prefix('#') {
+                comments.push(c.trim().to_string());
+                continue;
+            }
+            let fields: Vec<String> = s.split(',').map(|f| unquote(f).to_string()).collect();
+            match &names {
+                None => {
+                    for (k, name) in fields.iter().enumerate() {
+                        if fields[..k].contains(name) {
+                            return Err(DataError::DuplicateColumn {
+                                file,
+                                line,
+                                column: name.clone(),
+                            });
+                        }
+                    }
+                    names = Some(fields);
+                }
+                Some(n) => {
+                    if fields.len() != n.len() {
+                        return Err(DataError::FieldCount {
+                            file,
+                            line,
+                            expected: n.len(),
+                            found: fields.len(),
+                        });
+                    }
+                    rows.push(fields);
+                    lines.push(line);
+                }
+            }
+        }
+        let names = names.ok_or_else(|| DataError::NoHeader { file: file.clone() })?;
+        if rows.is_empty() {
+            return Err(DataError::Empty { file });
+        }
+        Ok(TextTable {
+            file,
+            names,
+            rows,
+            lines,
+            comments,
+        })
+    }
+}
+
+fn unquote(s: &str) -> &str {
+    let s = s.trim();
+    if s.len() >= 2 && s.starts_with('"') && s.ends_with('"') {
+        &s[1..s.len() - 1]
+    } else {
+        s
+    }
+}
+
 impl Table {
     /// Reads and checks a file.
     pub fn read(path: impl AsRef<Path>) -> Result<Table, DataError> {
@@ -106,88 +199,44 @@ impl Table {
 
     /// Parses text as if read from `file` (used by `read` and by tests).
     pub fn parse(file: impl AsRef<Path>, text: &str) -> Result<Table, DataError> {
-        let file = file.as_ref().to_path_buf();
-        let mut names: Option<Vec<String>> = None;
-        let mut columns: Vec<Vec<f64>> = Vec::new();
-        let mut lines = Vec::new();
-        let mut comments = Vec::new();
-        for (i, raw) in text.lines().enumerate() {
-            let line = i + 1;
-            let s = raw.trim();
-            if s.is_empty() {
-                continue;
-            }
-            if let Some(c) = s.strip_prefix('#') {
-                comments.push(c.trim().to_string());
-                continue;
-            }
-            let fields: Vec<&str> = s.split(',').map(str::trim).collect();
-            match &names {
-                None => {
-                    let n: Vec<String> = fields.iter().map(|f| f.to_string()).collect();
-                    for (k, name) in n.iter().enumerate() {
-                        if n[..k].contains(name) {
-                            return Err(DataError::DuplicateColumn {
-                                file,
+        let raw = TextTable::parse(file, text)?;
+        let mut columns: Vec<Vec<f64>> = vec![Vec::with_capacity(raw.rows.len()); raw.names.len()];
+        for (row, &line) in raw.rows.iter().zip(&raw.lines) {
+            for (k, f) in row.iter().enumerate() {
+                let v: f64 = f.parse().map_err(|_| DataError::NotNumeric {
+                    file: raw.file.clone(),
+                    line,
+                    column: raw.names[k].clone(),
+                    value: f.to_string(),
+                })?;
+                if !v.is_finite() {
+                    return Err(DataError::NotFinite {
+                        file: raw.file.clone(),
+                        line,
+                        column: raw.names[k].clone(),
+                    });
+                }
+                if raw.names[k] == Column::TIME {
+                    if let Some(&prev) = columns[k].last() {
+                        if v < prev {
+                            return Err(DataError::NonMonotonicTime {
+                                file: raw.file.clone(),
                                 line,
-                                column: name.clone(),
+                                prev,
+                                value: v,
                             });
                         }
                     }
-                    columns = vec![Vec::new(); n.len()];
-                    names = Some(n);
                 }
-                Some(n) => {
-                    if fields.len() != n.len() {
-                        return Err(DataError::FieldCount {
-                            file,
-                            line,
-                            expected: n.len(),
-                            found: fields.len(),
-                        });
-                    }
-                    for (k, f) in fields.iter().enumerate() {
-                        let v: f64 = f.parse().map_err(|_| DataError::NotNumeric {
-                            file: file.clone(),
-                            line,
-                            column: n[k].clone(),
-                            value: f.to_string(),
-                        })?;
-                        if !v.is_finite() {
-                            return Err(DataError::NotFinite {
-                                file,
-                                line,
-                                column: n[k].clone(),
-                            });
-                        }
-                        if n[k] == Column::TIME {
-                            if let Some(&prev) = columns[k].last() {
-                                if v < prev {
-                                    return Err(DataError::NonMonotonicTime {
-                                        file,
-                                        line,
-                                        prev,
-                                        value: v,
-                                    });
-                                }
-                            }
-                        }
-                        columns[k].push(v);
-                    }
-                    lines.push(line);
-                }
+                columns[k].push(v);
             }
-        }
-        let names = names.ok_or_else(|| DataError::NoHeader { file: file.clone() })?;
-        if lines.is_empty() {
-            return Err(DataError::Empty { file });
         }
         Ok(Table {
-            file,
-            names,
+            file: raw.file,
+            names: raw.names,
             columns,
-            lines,
-            comments,
+            lines: raw.lines,
+            comments: raw.comments,
         })
     }
 

@@ -22,7 +22,7 @@ pub mod loading;
 pub mod model;
 pub mod param;
 
-pub use data::{Column, DataError, Table};
+pub use data::{Column, DataError, Table, TextTable};
 pub use effect::Effect;
 pub use error::ForwardError;
 pub use loading::{Drive, Loading, Observable};

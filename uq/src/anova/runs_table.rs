@@ -1,40 +1,22 @@
 //! Reading a table with one row per run whose factor columns hold level
 //! names (strings) and whose response columns are numeric.
 //!
-//! palpate-core's `data::Table` reads numeric columns only, hence this small
-//! reader. Format: comma-separated, a header line, `#` comment lines and blank
-//! lines skipped, fields trimmed; a field may be wrapped in double quotes
-//! (which are removed) but may not contain a comma. Every error names the
-//! file, and where it applies the line and the column.
+//! The text layer (comments, header, field counts, quotes) is palpate-core's
+//! [`TextTable`]; this module keeps factor columns as level names and reads
+//! response columns as numbers. Every error names the file, and where it
+//! applies the line and the column.
 
 use super::FactorColumn;
+use palpate_core::TextTable;
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Why a runs table could not be read or a column used.
 #[derive(Debug, Error)]
 pub enum RunsTableError {
-    #[error("{file}: cannot read: {source}")]
-    Io {
-        file: PathBuf,
-        #[source]
-        source: std::io::Error,
-    },
-    #[error("{file}: no header line")]
-    NoHeader { file: PathBuf },
-    #[error("{file}:{line}: the header names column `{column}` twice")]
-    DuplicateColumn {
-        file: PathBuf,
-        line: usize,
-        column: String,
-    },
-    #[error("{file}:{line}: expected {expected} fields, found {found}")]
-    FieldCount {
-        file: PathBuf,
-        line: usize,
-        expected: usize,
-        found: usize,
-    },
+    /// The text layer (file, comments, header, field counts): palpate-core's reader.
+    #[error(transparent)]
+    Data(#[from] palpate_core::DataError),
     #[error("{file}: missing column `{column}` (header has: {header})")]
     MissingColumn {
         file: PathBuf,
@@ -60,8 +42,6 @@ pub enum RunsTableError {
         line: usize,
         column: String,
     },
-    #[error("{file}: no data rows")]
-    Empty { file: PathBuf },
 }
 
 /// A table of strings, one row per run.
@@ -76,86 +56,34 @@ pub struct RunsTable {
     pub comments: Vec<String>,
 }
 
-fn unquote(s: &str) -> &str {
-    let s = s.trim();
-    if s.len() >= 2 && s.starts_with('"') && s.ends_with('"') {
-        &s[1..s.len() - 1]
-    } else {
-        s
-    }
-}
-
 impl RunsTable {
     /// Reads and checks a file.
     pub fn read(path: impl AsRef<Path>) -> Result<RunsTable, RunsTableError> {
-        let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| RunsTableError::Io {
-            file: path.to_path_buf(),
-            source,
-        })?;
-        RunsTable::parse(path, &text)
+        RunsTable::from_text(TextTable::read(path)?)
     }
 
     /// Parses text as if read from `file`.
     pub fn parse(file: impl AsRef<Path>, text: &str) -> Result<RunsTable, RunsTableError> {
-        let file = file.as_ref().to_path_buf();
-        let mut names: Option<Vec<String>> = None;
-        let (mut rows, mut lines, mut comments) = (Vec::new(), Vec::new(), Vec::new());
-        for (i, raw) in text.lines().enumerate() {
-            let line = i + 1;
-            let s = raw.trim();
-            if s.is_empty() {
-                continue;
+        RunsTable::from_text(TextTable::parse(file, text)?)
+    }
+
+    /// Checks that no field is empty (a run without a level or a response).
+    fn from_text(t: TextTable) -> Result<RunsTable, RunsTableError> {
+        for (row, &line) in t.rows.iter().zip(&t.lines) {
+            if let Some(k) = row.iter().position(String::is_empty) {
+                return Err(RunsTableError::EmptyField {
+                    file: t.file,
+                    line,
+                    column: t.names[k].clone(),
+                });
             }
-            if let Some(c) = s.strip_prefix('#') {
-                comments.push(c.trim().to_string());
-                continue;
-            }
-            let fields: Vec<String> = s.split(',').map(|f| unquote(f).to_string()).collect();
-            match &names {
-                None => {
-                    for (k, n) in fields.iter().enumerate() {
-                        if fields[..k].contains(n) {
-                            return Err(RunsTableError::DuplicateColumn {
-                                file,
-                                line,
-                                column: n.clone(),
-                            });
-                        }
-                    }
-                    names = Some(fields);
-                }
-                Some(n) => {
-                    if fields.len() != n.len() {
-                        return Err(RunsTableError::FieldCount {
-                            file,
-                            line,
-                            expected: n.len(),
-                            found: fields.len(),
-                        });
-                    }
-                    if let Some(k) = fields.iter().position(String::is_empty) {
-                        return Err(RunsTableError::EmptyField {
-                            file,
-                            line,
-                            column: n[k].clone(),
-                        });
-                    }
-                    rows.push(fields);
-                    lines.push(line);
-                }
-            }
-        }
-        let names = names.ok_or_else(|| RunsTableError::NoHeader { file: file.clone() })?;
-        if rows.is_empty() {
-            return Err(RunsTableError::Empty { file });
         }
         Ok(RunsTable {
-            file,
-            names,
-            rows,
-            lines,
-            comments,
+            file: t.file,
+            names: t.names,
+            rows: t.rows,
+            lines: t.lines,
+            comments: t.comments,
         })
     }
 
