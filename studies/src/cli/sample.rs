@@ -256,8 +256,10 @@ fn report(
     start: &palpate_uq::likelihood::PosteriorStart,
 ) -> Value {
     let mut params = Map::new();
+    let x = run.chains.map(|z| post.space().from_unbounded(z));
     for (k, s) in summary.iter().enumerate() {
         let spec = &post.space().params[k];
+        let iat = palpate_uq::mcmc::diagnostics::integrated_autocorrelation_time(&x.param(k));
         params.insert(
             s.name.clone(),
             json!({
@@ -266,6 +268,7 @@ fn report(
                 "mean": s.mean, "sd": s.sd, "hdi_3": s.hdi_3, "hdi_97": s.hdi_97,
                 "rhat": s.rhat, "ess_bulk": s.ess_bulk, "ess_tail": s.ess_tail, "mcse_mean": s.mcse_mean,
                 "laplace_mean": lap_mean[k], "laplace_sd": lap_sd[k],
+                "autocorrelation_time": iat,
             }),
         );
     }
@@ -282,6 +285,7 @@ fn report(
         "evaluations": run.evaluations,
         "wall_time_s": run.wall_time_s,
         "acceptance_mean": run.acceptance.iter().sum::<f64>() / run.acceptance.len().max(1) as f64,
+        "acceptance": run.acceptance,
         "divergences": run.divergences,
         "step_size": run.step_size,
         "laplace": {
