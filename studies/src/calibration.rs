@@ -25,6 +25,8 @@ pub enum TestKind {
     Homogeneous(Mode),
     /// Benchmark C1: columns `displacement_mm`, `force_N` (and `time_s` when timed).
     C1,
+    /// Benchmark N1 (FE needle indentation, friction 0.8, coarse mesh): same columns as C1.
+    N1,
 }
 
 impl TestKind {
@@ -32,6 +34,9 @@ impl TestKind {
     pub fn parse(s: &str) -> anyhow::Result<TestKind> {
         if s.eq_ignore_ascii_case("c1") {
             return Ok(TestKind::C1);
+        }
+        if s.eq_ignore_ascii_case("n1") {
+            return Ok(TestKind::N1);
         }
         s.parse::<Mode>().map(TestKind::Homogeneous).map_err(|_| {
             anyhow::anyhow!("unknown test `{s}`; expected uniaxial, biaxial, planar or C1")
@@ -43,6 +48,11 @@ impl TestKind {
         match self {
             TestKind::Homogeneous(mode) => Arc::new(Homogeneous::new(law, mode)),
             TestKind::C1 => Arc::new(C1Compression::new(law)),
+            TestKind::N1 => {
+                let mut m = palpate_fe::N1Needle::new(law);
+                m.mesh = palpate_fe::MeshDensity::COARSE;
+                Arc::new(m)
+            }
         }
     }
 }
@@ -79,7 +89,7 @@ impl TestData {
                     table.column(Column::STRESS)?.to_vec(),
                 )
             }
-            TestKind::C1 => {
+            TestKind::C1 | TestKind::N1 => {
                 table.require(&[Column::DISPLACEMENT, Column::FORCE])?;
                 let d = table.column(Column::DISPLACEMENT)?.to_vec();
                 let loading = if table.has(Column::TIME) {

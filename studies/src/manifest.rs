@@ -60,7 +60,7 @@ pub struct StudyMeta {
 pub struct DataSpec {
     /// CSV file, relative to the manifest's directory.
     pub file: PathBuf,
-    /// `uniaxial`, `biaxial`, `planar` (stretch, stress_MPa) or `C1` (displacement_mm, force_N[, time_s]).
+    /// `uniaxial`, `biaxial`, `planar` (stretch, stress_MPa), `C1` or `N1` (displacement_mm, force_N[, time_s]).
     pub test: String,
 }
 
@@ -122,7 +122,7 @@ fn default_estimator() -> String {
 }
 
 /// The kinds of test a data set can record.
-pub const TESTS: [&str; 4] = ["uniaxial", "biaxial", "planar", "C1"];
+pub const TESTS: [&str; 5] = ["uniaxial", "biaxial", "planar", "C1", "N1"];
 
 impl Manifest {
     /// Reads and parses a manifest; TOML and unknown-field errors carry the
@@ -217,8 +217,8 @@ impl Manifest {
                                 "{where_}: {at}.data: unknown data set \"{s}\" (defined: {})",
                                 keys(&self.data)
                             ),
-                            Some(spec) if spec.test != "C1" => {
-                                anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 force record", spec.test)
+                            Some(spec) if spec.test != "C1" && spec.test != "N1" => {
+                                anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 or N1 force record", spec.test)
                             }
                             _ => {}
                         }

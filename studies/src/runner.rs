@@ -299,7 +299,6 @@ fn run_diagnose(
         .base
         .parse()
         .map_err(|e| anyhow::anyhow!("step `{}`: base: {e}", step.name))?;
-    let model = crate::cli::diagnose::base_model("C1", law)?;
     let mut cases = Vec::new();
     let _ = writeln!(
         report,
@@ -311,6 +310,8 @@ fn run_diagnose(
     for name in &step.data {
         observer.message(&format!("{}: diagnosing {name}", step.name));
         let d = &data[name];
+        let benchmark = if d.test == TestKind::N1 { "N1" } else { "C1" };
+        let model = crate::cli::diagnose::base_model(benchmark, law)?;
         let gap =
             palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &Default::default())
                 .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;

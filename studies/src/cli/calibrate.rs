@@ -30,7 +30,9 @@ pub struct Args {
     /// planar), or just FILE with --benchmark C1. Repeat to fit jointly.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
-    /// Fit a benchmark's force record instead of homogeneous stress data (C1).
+    /// Fit a benchmark's force record instead of homogeneous stress data: C1
+    /// (analytic, lubricated compression) or N1 (finite-element needle
+    /// indentation, friction 0.8, coarse mesh; each evaluation is a full FE run).
     #[arg(long, value_name = "ID")]
     pub benchmark: Option<String>,
     /// Residual: absolute (default), relative ((f-y)/y; zero-stress points
@@ -197,7 +199,10 @@ pub fn table(c: &Calibration) -> String {
 
 /// Data (markers) against the fitted law (lines), one colour per data set.
 pub fn fit_plot(c: &Calibration) -> Plot {
-    let homogeneous = c.predictions.iter().all(|p| p.data != "C1");
+    let homogeneous = c
+        .predictions
+        .iter()
+        .all(|p| p.data != "C1" && p.data != "N1");
     let (xl, yl) = if homogeneous {
         ("stretch", "nominal stress (MPa)")
     } else {

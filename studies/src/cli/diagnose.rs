@@ -26,7 +26,9 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// Benchmark the record comes from (C1).
+    /// Benchmark the record comes from: C1 (analytic compression, seconds) or
+    /// N1 (FE needle indentation; every candidate refit runs FE simulations,
+    /// so expect minutes to hours on 2 cores).
     #[arg(long, default_value = "C1")]
     pub benchmark: String,
     /// The record: CSV with displacement_mm, force_N and (for rate effects) time_s.
@@ -77,6 +79,7 @@ pub fn diagnose_file(
         .parse()
         .map_err(|e| anyhow::anyhow!("base law `{base}`: {e}"))?;
     let model = base_model(benchmark, law)?;
+    // C1 and N1 records share the columns displacement_mm, force_N[, time_s].
     let record = TestData::read("record", TestKind::C1, data)?;
     diagnose(model.as_ref(), &record.loading, &record.observed, options)
         .with_context(|| format!("diagnosing {}", data.display()))
