@@ -59,6 +59,16 @@ impl Prior {
         }
     }
 
+    /// d log p / dx (0 for `Flat` and `Uniform` inside their support).
+    pub fn d_log_density(&self, x: f64) -> f64 {
+        match *self {
+            Prior::Flat | Prior::Uniform { .. } => 0.0,
+            Prior::Normal { mean, sd } => -(x - mean) / (sd * sd),
+            Prior::LogNormal { mu, sigma } => -(x.ln() - mu) / (sigma * sigma * x) - 1.0 / x,
+            Prior::HalfNormal { sd } => -x / (sd * sd),
+        }
+    }
+
     /// Whether the prior integrates to one (needed for a meaningful evidence).
     pub fn is_proper(&self) -> bool {
         !matches!(self, Prior::Flat)
@@ -195,6 +205,35 @@ mod tests {
         ] {
             let i = integral(p, a, b);
             assert!((i - 1.0).abs() < 2e-4, "{p}: {i}");
+        }
+    }
+
+    #[test]
+    fn derivatives_match_finite_differences() {
+        for (p, x) in [
+            (Prior::Normal { mean: 1.0, sd: 0.5 }, 0.3),
+            (
+                Prior::LogNormal {
+                    mu: 0.2,
+                    sigma: 0.4,
+                },
+                1.7,
+            ),
+            (Prior::HalfNormal { sd: 2.0 }, 0.9),
+            (
+                Prior::Uniform {
+                    lower: 0.0,
+                    upper: 2.0,
+                },
+                1.0,
+            ),
+        ] {
+            let h = 1e-6;
+            let fd = (p.log_density(x + h) - p.log_density(x - h)) / (2.0 * h);
+            assert!(
+                (fd - p.d_log_density(x)).abs() < 1e-6 * fd.abs().max(1.0),
+                "{p}"
+            );
         }
     }
 

@@ -31,21 +31,32 @@ pub trait DensityWorker {
     /// log p(z) and its gradient, written into `grad`. Returns the number of
     /// log-density evaluations it cost together with the value.
     fn value_and_gradient(&mut self, z: &[f64], grad: &mut [f64]) -> (f64, u64) {
-        let f0 = self.log_density(z);
-        let mut zz = z.to_vec();
-        let mut evals = 1;
-        for k in 0..z.len() {
-            let h = 1e-5 * z[k].abs().max(1.0);
-            zz[k] = z[k] + h;
-            let fp = self.log_density(&zz);
-            zz[k] = z[k] - h;
-            let fm = self.log_density(&zz);
-            zz[k] = z[k];
-            evals += 2;
-            grad[k] = (fp - fm) / (2.0 * h);
-        }
-        (f0, evals)
+        fd_value_and_gradient(&mut |z| self.log_density(z), z, grad)
     }
+}
+
+/// Central finite-difference gradient of `f` (step 1e-5 max(1, |z_k|)):
+/// the default of [`DensityWorker::value_and_gradient`], for overrides that
+/// fall back to it. Returns the value and the evaluations spent (2 d + 1).
+pub fn fd_value_and_gradient(
+    f: &mut dyn FnMut(&[f64]) -> f64,
+    z: &[f64],
+    grad: &mut [f64],
+) -> (f64, u64) {
+    let f0 = f(z);
+    let mut zz = z.to_vec();
+    let mut evals = 1;
+    for k in 0..z.len() {
+        let h = 1e-5 * z[k].abs().max(1.0);
+        zz[k] = z[k] + h;
+        let fp = f(&zz);
+        zz[k] = z[k] - h;
+        let fm = f(&zz);
+        zz[k] = z[k];
+        evals += 2;
+        grad[k] = (fp - fm) / (2.0 * h);
+    }
+    (f0, evals)
 }
 
 /// A closure as a log-density of fixed dimension.

@@ -31,7 +31,7 @@ pub mod summary;
 
 pub use chains::{Chains, SampleRun};
 pub use demc::{sample_demc, DemcSettings};
-pub use density::{DensityWorker, FnDensity, GradFnDensity, LogDensity};
+pub use density::{fd_value_and_gradient, DensityWorker, FnDensity, GradFnDensity, LogDensity};
 pub use ensemble::{sample_ensemble, EnsembleSettings};
 pub use error::McmcError;
 pub use laplace::{laplace, Laplace};
