@@ -5,8 +5,15 @@
 //! positive in compression.
 //!
 //! The mesh is graded toward the indentation point ([`N1Needle::mesh`]); the
-//! contact surface is the whole top face. Effects: `friction` (the friction
-//! coefficient becomes a parameter).
+//! contact surface is the whole top face. Effects:
+//!
+//! * `friction` — the friction coefficient becomes a parameter (bounds 0..2).
+//! * `boundary_condition` — the base slides radially (`u_z = 0` only) instead
+//!   of being bonded. This is a discrete switch: the enriched model has the
+//!   same parameters as the base model, and a gap diagnosis compares the two
+//!   fits. (A continuous bonded-to-sliding blend would need a base spring
+//!   whose stiffness spans many decades, badly conditioned near "bonded";
+//!   the switch answers the same question.)
 
 use palpate_core::{
     Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
@@ -68,6 +75,10 @@ pub struct N1Needle {
     pub tool: ToolShape,
     pub base: Base,
     pub mesh: MeshDensity,
+    /// When set, this grading (radial from the axis and axial from the top)
+    /// replaces the one of `mesh` and `fine_zone`, e.g. for a contact zone
+    /// much smaller than the needle's (Hertz).
+    pub grading: Option<Grading>,
     /// Cylinder radius and height (mm).
     pub radius: f64,
     pub height: f64,
@@ -76,7 +87,12 @@ pub struct N1Needle {
     /// Contact penalty factor: `eps_N = penalty * mu0 / h_fine` (augmented, so
     /// the converged force does not depend on it).
     pub penalty: f64,
-    /// Accepted penetration after augmentation (mm).
+    /// Accepted penetration (mm). The multipliers are updated once per
+    /// converged increment (at commit), so the penetration of an increment
+    /// only comes from its own load change (< 2e-3 mm at 0.25 mm steps on the
+    /// coarse mesh); an extra augmentation loop runs only above this value.
+    /// Tightening it to 1e-4 mm changes the N1 force by < 0.1 % at 1.3x the
+    /// Newton iterations (`examples/bench_n1.rs`, docs/validation/fe.md).
     pub penetration_tol: f64,
     pub options: SolverOptions,
     friction_is_parameter: bool,
@@ -95,11 +111,12 @@ impl N1Needle {
             tool: ToolShape::n1_needle(),
             base: Base::Bonded,
             mesh: MeshDensity::MEDIUM,
+            grading: None,
             radius: 35.0,
             height: 80.0,
             fine_zone: 5.0,
             penalty: 100.0,
-            penetration_tol: 1e-4,
+            penetration_tol: 2e-3,
             options: SolverOptions {
                 max_step: 0.25,
                 first_step: 0.05,
@@ -111,8 +128,13 @@ impl N1Needle {
 
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
-        let g = self.mesh.grading(self.fine_zone);
+        let g = self.effective_grading();
         Mesh::graded_rectangle(self.radius, self.height, g, g)
+    }
+
+    fn effective_grading(&self) -> Grading {
+        self.grading
+            .unwrap_or_else(|| self.mesh.grading(self.fine_zone))
     }
 
     /// Runs one history with a progress observer; returns the solver too
@@ -186,7 +208,7 @@ impl Setup for N1Needle {
         )
     }
     fn prepare(&self, solver: &mut Solver, mu: f64, extra: &[f64]) {
-        let h = self.mesh.h_fine();
+        let h = self.effective_grading().h_fine;
         if let Some(cs) = solver.contact.as_mut() {
             cs.options.penalty_normal = self.penalty * mu / h;
             cs.options.penalty_tangent = self.penalty * mu / h;
@@ -201,8 +223,12 @@ impl Setup for N1Needle {
 
 impl ForwardModel for N1Needle {
     fn name(&self) -> String {
+        let base = match self.base {
+            Base::Bonded => "",
+            Base::Sliding => ", sliding base",
+        };
         format!(
-            "N1 FE needle indentation, {}, friction {}",
+            "N1 FE needle indentation, {}, friction {}{base}",
             self.law, self.friction
         )
     }
@@ -220,11 +246,14 @@ impl ForwardModel for N1Needle {
         })
     }
     fn effects(&self) -> Vec<Effect> {
-        if self.friction_is_parameter {
-            Vec::new()
-        } else {
-            vec![Effect::Friction]
+        let mut v = Vec::new();
+        if !self.friction_is_parameter {
+            v.push(Effect::Friction);
         }
+        if self.base == Base::Bonded {
+            v.push(Effect::BoundaryCondition);
+        }
+        v
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
@@ -238,6 +267,11 @@ impl ForwardModel for N1Needle {
                     2.0,
                     self.friction,
                 )]);
+                Ok(Box::new(m))
+            }
+            Effect::BoundaryCondition if self.base == Base::Bonded => {
+                let mut m = self.clone();
+                m.base = Base::Sliding;
                 Ok(Box::new(m))
             }
             _ => Err(ForwardError::InvalidConfig {

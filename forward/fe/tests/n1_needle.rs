@@ -3,16 +3,15 @@
 //! 10 mm, and the neo-Hookean curves agree with the CalculiX reference
 //! (../shared/reference/calculix/n1) within its stated uncertainty plus 2 %.
 //!
-//! CalculiX uses K = 1000 mu, so these runs do too (`Bulk::Ratio(1000)`).
+//! CalculiX uses K = 1000 mu; these runs use exact incompressibility
+//! (faster here), whose forces are at most ~0.1 % above K = 1000 mu.
 //! Uncertainty of the reference (README): mesh 0.3 %, increments 0.1 %,
 //! K 0.1 %, penalty contact 0.4-0.8 % low -> 1.3 %; tolerance 3.3 %.
 
 use std::path::Path;
 
-use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_core::{Drive, Effect, ForwardModel, Loading, Table};
 use palpate_fe::{Bulk, MeshDensity, N1Needle};
-
-// Exact incompressibility is used (faster here than K = 1000 mu); its forces are at most ~0.1 % above K = 1000 mu (README).
 
 const NH: [f64; 1] = [1101.295e-6];
 const RP2: [f64; 2] = [686.428e-6, 1929.606e-6];
@@ -116,4 +115,53 @@ fn reduced_polynomial_friction_08_reaches_10mm() {
 #[test]
 fn reduced_polynomial_frictionless_reaches_10mm() {
     compare("reduced-polynomial:2", &RP2, 0.0, None, &[5.0]);
+}
+
+/// STYLE.md 12: the element loop runs in parallel but reduces in element
+/// order, so the forces do not depend on the thread count.
+#[test]
+fn forces_are_bit_identical_on_one_and_two_threads() {
+    let m = model("neo-hookean", 0.8);
+    let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.25, 0.5, 0.75]);
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| m.predict(&NH, &loading).unwrap())
+    };
+    let (one, two) = (on(1), on(2));
+    assert!(one.iter().all(|f| *f > 0.0));
+    for (a, b) in one.iter().zip(&two) {
+        assert_eq!(a.to_bits(), b.to_bits(), "{one:?} vs {two:?}");
+    }
+}
+
+/// GAP.md `boundary_condition`: the enriched model slides on its base
+/// (u_z = 0 only), keeps the parameters, and is a little softer than the
+/// bonded one (the base is 80 mm below a 2 mm indentation, so the change is
+/// small but not zero).
+#[test]
+fn boundary_condition_effect_gives_a_sliding_base() {
+    let m = model("neo-hookean", 0.8);
+    let effects = m.effects();
+    assert!(effects.contains(&Effect::Friction) && effects.contains(&Effect::BoundaryCondition));
+    let sliding = m.enrich(Effect::BoundaryCondition).unwrap();
+    assert_eq!(sliding.space().len(), m.space().len());
+    assert!(
+        sliding.name().contains("sliding base"),
+        "{}",
+        sliding.name()
+    );
+    assert!(!sliding.effects().contains(&Effect::BoundaryCondition));
+    assert!(sliding.enrich(Effect::BoundaryCondition).is_err());
+    let loading = Loading::quasi_static(Drive::DisplacementMm, vec![1.0, 2.0]);
+    let bonded = m.predict(&NH, &loading).unwrap();
+    let slid = sliding.predict(&NH, &loading).unwrap();
+    for (b, s) in bonded.iter().zip(&slid) {
+        assert!(s < b && (b - s) / b < 0.01, "bonded {b} sliding {s}");
+    }
+    // both effects compose: friction as a parameter on the sliding model
+    let both = sliding.enrich(Effect::Friction).unwrap();
+    assert_eq!(both.space().len(), m.space().len() + 1);
 }
