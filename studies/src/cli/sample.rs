@@ -8,7 +8,8 @@ use crate::plot::{grid_svg, Band, Plot, Series, Style};
 use anyhow::Context;
 use palpate_material::Law;
 use palpate_uq::likelihood::{
-    fit_and_laplace, predictive_band, Correlation, DataSet, NoiseModel, NoiseSd, Posterior, Prior,
+    fit_and_laplace, predictive_band, thermodynamic_integration, Correlation, DataSet, NoiseModel,
+    NoiseSd, Posterior, Prior,
 };
 use palpate_uq::mcmc::{
     correlation, summarize, Chains, DemcSettings, EnsembleSettings, NutsSettings, SampleRun,
@@ -52,7 +53,7 @@ pub struct Args {
     #[arg(long)]
     pub tune: Option<usize>,
     /// Parallel units: NUTS chains (4), ensembles (2) or DE-MCz populations (2).
-    #[arg(long)]
+    #[arg(long = "parallel")]
     pub chains: Option<usize>,
     /// Seed of the random streams (results are identical for a seed whatever the thread count).
     #[arg(long, default_value_t = 0)]
@@ -69,9 +70,14 @@ pub struct Args {
     /// Write the summary as JSON (params by name: mean, sd, hdi_3, hdi_97, rhat, ess_bulk, ess_tail, mcse_mean).
     #[arg(long, value_name = "OUT.json")]
     pub json: Option<PathBuf>,
-    /// Write every draw (physical units) as CSV: chain,draw,<params>.
-    #[arg(long, value_name = "OUT.csv")]
-    pub chains_csv: Option<PathBuf>,
+    /// Write every draw (physical units): OUT.csv with columns chain,draw,<params>,
+    /// or OUT.json with names, n_chains, n_draws and values (chain-major).
+    #[arg(long = "chains", value_name = "OUT.csv|OUT.json")]
+    pub chains_out: Option<PathBuf>,
+    /// Also estimate the evidence by thermodynamic integration (20 rungs of
+    /// DE-MCz; needs --prior on every law parameter).
+    #[arg(long)]
+    pub evidence: bool,
     /// Write corner.svg and predictive_<data>.svg into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
@@ -164,6 +170,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .map_err(|e| anyhow::anyhow!("--prior {p}: {e}"))?;
     }
     let post = Posterior::new(sets, priors)?;
+    anyhow::ensure!(
+        !args.evidence || post.priors_proper(),
+        "--evidence needs a proper prior on every parameter (give --prior NAME=SPEC for each law parameter)"
+    );
     let names = post.names();
 
     eprintln!("least-squares fit and Laplace approximation ...");
@@ -224,17 +234,48 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("warning: max R-hat = {worst:.4} >= 1.01: run longer (--draws) before trusting the summary");
     }
 
+    let ti = if args.evidence {
+        eprintln!("thermodynamic integration (20 rungs) ...");
+        let s = Sampler::Demc(DemcSettings {
+            tune: 500,
+            draws: 1500,
+            ..Default::default()
+        });
+        let ti = thermodynamic_integration(&post, &start.laplace.mode, 20, &s, args.seed)?;
+        println!(
+            "log evidence: thermodynamic integration {:.3}, Laplace {:.3}",
+            ti.log_evidence, start.laplace.log_evidence
+        );
+        Some(ti)
+    } else {
+        None
+    };
     if let Some(path) = &args.json {
-        write_json(
-            path,
-            &report(
-                &args, &post, &run, &summary, &corr, &lap_mean, &lap_sd, &start,
-            ),
-        )?;
+        let mut v = report(
+            &args, &post, &run, &summary, &corr, &lap_mean, &lap_sd, &start,
+        );
+        if let Some(ti) = &ti {
+            v["thermodynamic_integration"] = json!({
+                "log_evidence": ti.log_evidence,
+                "rungs": ti.betas.len() - 1,
+                "evaluations": ti.evaluations,
+            });
+        }
+        write_json(path, &v)?;
         eprintln!("wrote {}", path.display());
     }
-    if let Some(path) = &args.chains_csv {
-        write_atomic(path, x.to_csv(&names).as_bytes())?;
+    if let Some(path) = &args.chains_out {
+        if path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("json"))
+        {
+            write_json(
+                path,
+                &json!({ "names": names, "n_chains": x.n_chains, "n_draws": x.n_draws, "values": x.values }),
+            )?;
+        } else {
+            write_atomic(path, x.to_csv(&names).as_bytes())?;
+        }
         eprintln!("wrote {}", path.display());
     }
     if let Some(dir) = &args.plot {
@@ -407,7 +448,8 @@ mod tests {
             ar1: false,
             prior: vec!["C10=lognormal:-7.3,1".into()],
             json: Some(json_path.clone()),
-            chains_csv: Some(dir.path().join("chains.csv")),
+            chains_out: Some(dir.path().join("chains.csv")),
+            evidence: false,
             plot: Some(dir.path().join("figs")),
         };
         run(args).unwrap();
@@ -451,12 +493,20 @@ mod tests {
             ar1: false,
             prior: vec![prior.into()],
             json: None,
-            chains_csv: None,
+            chains_out: None,
+            evidence: false,
             plot: None,
         };
         let e = sampler_from(&args("gibbs", "")).unwrap_err().to_string();
         assert!(e.contains("gibbs"), "{e}");
         let e = run(args("nuts", "C10=flat")).unwrap_err().to_string();
         assert!(e.contains("x.csv"), "{e}");
+        let data =
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv");
+        let mut a = args("nuts", "C10=flat");
+        a.data = vec![data.display().to_string()];
+        a.evidence = true;
+        let e = run(a).unwrap_err().to_string();
+        assert!(e.contains("--evidence needs a proper prior"), "{e}");
     }
 }
