@@ -4,7 +4,9 @@
 
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Drive, ForwardModel, Loading, Table};
-use palpate_uq::likelihood::{fit_and_laplace, Correlation, DataSet, NoiseModel, NoiseSd, Posterior, Prior};
+use palpate_uq::likelihood::{
+    fit_and_laplace, Correlation, DataSet, NoiseModel, NoiseSd, Posterior, Prior,
+};
 use palpate_uq::mcmc::{chain_rng, summarize, DemcSettings, Sampler};
 use rand::Rng;
 use std::path::Path;
@@ -18,12 +20,18 @@ fn sample(post: &Posterior, seed: u64) -> Vec<palpate_uq::mcmc::ParamSummary> {
     })
     .run(post, &st.start, seed, None)
     .unwrap();
-    summarize(&run.chains.map(|z| post.space().from_unbounded(z)), &post.names())
+    summarize(
+        &run.chains.map(|z| post.space().from_unbounded(z)),
+        &post.names(),
+    )
 }
 
 #[test]
 fn inferred_sigma_and_ar1_coefficient_are_recovered() {
-    let model: Arc<dyn ForwardModel> = Arc::new(Homogeneous::new("neo-hookean".parse().unwrap(), Mode::Uniaxial));
+    let model: Arc<dyn ForwardModel> = Arc::new(Homogeneous::new(
+        "neo-hookean".parse().unwrap(),
+        Mode::Uniaxial,
+    ));
     let stretch: Vec<f64> = (0..300).map(|i| 1.0 + i as f64 / 299.0).collect();
     let loading = Loading::quasi_static(Drive::Stretch, stretch);
     let truth = [0.2];
@@ -35,7 +43,10 @@ fn inferred_sigma_and_ar1_coefficient_are_recovered() {
         .iter()
         .map(|c| {
             let y = c + e;
-            e = phi * e + sigma * (1.0 - phi * phi).sqrt() * rng.sample::<f64, _>(rand_distr::StandardNormal);
+            e = phi * e
+                + sigma
+                    * (1.0 - phi * phi).sqrt()
+                    * rng.sample::<f64, _>(rand_distr::StandardNormal);
             y
         })
         .collect();
@@ -52,24 +63,45 @@ fn inferred_sigma_and_ar1_coefficient_are_recovered() {
         };
         Posterior::new(vec![ds], vec![Prior::Flat]).unwrap()
     };
-    let ar1 = make(Correlation::Ar1Inferred(Prior::Uniform { lower: -1.0, upper: 1.0 }));
+    let ar1 = make(Correlation::Ar1Inferred(Prior::Uniform {
+        lower: -1.0,
+        upper: 1.0,
+    }));
     assert_eq!(ar1.names(), vec!["C10", "sigma", "phi"]);
     let s = sample(&ar1, 1);
     for (p, t) in s.iter().zip([truth[0], sigma, phi]) {
-        eprintln!("{}: {:.5} +- {:.5} (truth {t:.5}), rhat {:.4}", p.name, p.mean, p.sd, p.rhat);
-        assert!((p.mean - t).abs() < 3.0 * p.sd, "{}: {} +- {} vs {t}", p.name, p.mean, p.sd);
+        eprintln!(
+            "{}: {:.5} +- {:.5} (truth {t:.5}), rhat {:.4}",
+            p.name, p.mean, p.sd, p.rhat
+        );
+        assert!(
+            (p.mean - t).abs() < 3.0 * p.sd,
+            "{}: {} +- {} vs {t}",
+            p.name,
+            p.mean,
+            p.sd
+        );
         assert!(p.rhat < 1.01);
     }
     // Ignoring the correlation makes the C10 interval too narrow.
     let indep = sample(&make(Correlation::Independent), 2);
-    eprintln!("C10 sd: AR(1) {:.3e}, independent {:.3e}", s[0].sd, indep[0].sd);
+    eprintln!(
+        "C10 sd: AR(1) {:.3e}, independent {:.3e}",
+        s[0].sd, indep[0].sd
+    );
     assert!(indep[0].sd < 0.6 * s[0].sd);
 }
 
 #[test]
 fn laplace_evidence_prefers_the_generating_law() {
-    let t = Table::read(Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv")).unwrap();
-    let loading = Loading::quasi_static(Drive::DisplacementMm, t.column("displacement_mm").unwrap().to_vec());
+    let t = Table::read(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv"),
+    )
+    .unwrap();
+    let loading = Loading::quasi_static(
+        Drive::DisplacementMm,
+        t.column("displacement_mm").unwrap().to_vec(),
+    );
     let observed = t.column("force_N").unwrap().to_vec();
     let evidence = |law: &str, priors: Vec<Prior>| {
         let ds = DataSet {
@@ -88,7 +120,16 @@ fn laplace_evidence_prefers_the_generating_law() {
         sigma: 1.0,
     };
     let nh = evidence("neo-hookean", vec![c10]);
-    let rp2 = evidence("reduced-polynomial:2", vec![c10, Prior::Normal { mean: 0.0, sd: 5e-3 }]);
+    let rp2 = evidence(
+        "reduced-polynomial:2",
+        vec![
+            c10,
+            Prior::Normal {
+                mean: 0.0,
+                sd: 5e-3,
+            },
+        ],
+    );
     eprintln!("log evidence: neo-Hookean {nh:.2}, reduced polynomial N=2 {rp2:.2}");
     assert!(rp2 - nh > 10.0, "{rp2} vs {nh}");
 }
