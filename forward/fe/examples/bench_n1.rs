@@ -20,6 +20,11 @@ const C10: f64 = 1101.295e-6;
 fn run(level: usize, threads: usize) -> (Vec<f64>, palpate_fe::RunStats, usize, usize, f64) {
     let mut m = N1Needle::new("neo-hookean".parse().expect("law"));
     m.mesh = MeshDensity { level };
+    if let Ok(v) = std::env::var("FE_GROWTH") {
+        let mut g = m.mesh.grading(m.fine_zone);
+        g.growth = v.parse().unwrap();
+        m.grading = Some(g);
+    }
     if let Ok(v) = std::env::var("FE_K") {
         m.bulk = palpate_fe::Bulk::Ratio(v.parse().unwrap());
     }
