@@ -60,6 +60,7 @@ ndim, nwalkers, burn, steps = 2, 32, 1000, 12000
 rng = np.random.default_rng(1)
 p0 = np.array([6.86428e-4, 1.929606e-3]) * (1.0 + 1e-3 * rng.standard_normal((nwalkers, ndim)))
 sampler = emcee.EnsembleSampler(nwalkers, ndim, log_prob)
+sampler.random_state = np.random.RandomState(42).get_state()  # reproducible moves
 t0 = time.perf_counter()
 sampler.run_mcmc(p0, burn + steps, progress=False)
 wall = time.perf_counter() - t0

@@ -70,6 +70,20 @@ fn main() {
             "one log-density evaluation (200-point C1 curve, one thread): {:.2} us (checksum {acc:.3e})",
             1e6 * t1.elapsed().as_secs_f64() / n as f64
         );
+        let ds = &post.datasets()[0];
+        let mut ev = ds.model.evaluator();
+        let mut out = vec![0.0; ds.loading.len()];
+        let theta = post.space().from_unbounded(&start.start.center);
+        let t2 = std::time::Instant::now();
+        for i in 0..n {
+            let th = [theta[0] * (1.0 + 1e-9 * i as f64), theta[1]];
+            ev.predict_into(&th, &ds.loading, &mut out).unwrap();
+            acc += out[1];
+        }
+        println!(
+            "of which the forward model alone: {:.2} us (checksum {acc:.3e})",
+            1e6 * t2.elapsed().as_secs_f64() / n as f64
+        );
     }
     let samplers = [
         Sampler::Ensemble(EnsembleSettings {
