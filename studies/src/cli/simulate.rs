@@ -155,7 +155,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let n1 = args.benchmark.eq_ignore_ascii_case("n1");
     let depth = args.depth.unwrap_or(if n1 { 10.0 } else { 2.0 });
     let step = args.step.unwrap_or(if n1 { 0.25 } else { 0.1 });
-    if !(depth > 0.0 && depth.is_finite()) || !(step > 0.0 && step.is_finite()) {
+    if !(depth > 0.0 && depth.is_finite() && step > 0.0 && step.is_finite()) {
         bail!("--depth and --step must be positive (got {depth} and {step})");
     }
     if !(args.friction >= 0.0 && args.friction.is_finite()) {
@@ -178,7 +178,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ));
     };
     let (title, result) = if n1 {
-        let mut m = N1Needle::new(law.clone());
+        let mut m = N1Needle::new(law);
         m.friction = args.friction;
         m.bulk = bulk;
         m.mesh = MeshDensity { level };
@@ -192,7 +192,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         )
     } else {
         let mut m = C1Fe::new(
-            law.clone(),
+            law,
             if args.bonded {
                 Platens::Bonded
             } else {
@@ -240,7 +240,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         write_curve(path, &drive, &sim.forces)?;
     }
     if let Some(path) = &args.vtu {
-        let mat = LawMaterial::new(law.clone(), theta.clone()).map_err(|e| anyhow!("{e}"))?;
+        let mat = LawMaterial::new(law, theta.clone()).map_err(|e| anyhow!("{e}"))?;
         write_atomic(path, palpate_fe::vtu::to_vtu(&solver, &mat).as_bytes())?;
     }
     if let Some(path) = &args.plot {
