@@ -244,17 +244,11 @@ impl Plot {
         // Grid and ticks.
         let xticks = match &self.x_categories {
             Some(c) => (0..c.len()).map(|i| (i as f64, c[i].clone())).collect(),
-            None => ticks(x0, x1)
-                .into_iter()
-                .map(|t| (t, tick_label(t)))
-                .collect::<Vec<_>>(),
+            None => labelled(ticks(x0, x1)),
         };
         let yticks = match &self.y_categories {
             Some(c) => (0..c.len()).map(|i| (i as f64, c[i].clone())).collect(),
-            None => ticks(y0, y1)
-                .into_iter()
-                .map(|t| (t, tick_label(t)))
-                .collect::<Vec<_>>(),
+            None => labelled(ticks(y0, y1)),
         };
         for (t, l) in &xticks {
             let x = sx(*t);
@@ -536,17 +530,32 @@ pub fn ticks(lo: f64, hi: f64) -> Vec<f64> {
     (first..=last).map(|k| k as f64 * step).collect()
 }
 
-fn tick_label(t: f64) -> String {
-    if t == 0.0 {
-        return "0".into();
-    }
-    let a = t.abs();
-    if !(1e-3..1e5).contains(&a) {
-        format!("{t:.1e}")
+/// Tick labels with just enough digits to tell neighbouring ticks apart:
+/// fixed-point for magnitudes in [1e-3, 1e5), scientific otherwise.
+fn labelled(t: Vec<f64>) -> Vec<(f64, String)> {
+    let step = if t.len() > 1 {
+        (t[1] - t[0]).abs()
     } else {
-        let s = format!("{t:.4}");
-        s.trim_end_matches('0').trim_end_matches('.').to_string()
-    }
+        t.first().map_or(1.0, |v| v.abs().max(1e-300))
+    };
+    let big = t.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let scientific = big > 0.0 && !(1e-3..1e5).contains(&big);
+    t.into_iter()
+        .map(|v| {
+            let label = if v == 0.0 {
+                "0".to_string()
+            } else if scientific {
+                // Significant digits needed so that one step changes the mantissa.
+                let digits =
+                    ((v.abs().log10().floor() - step.log10().floor()).max(0.0) as usize).min(12);
+                format!("{v:.digits$e}")
+            } else {
+                let decimals = (-step.log10().floor()).max(0.0) as usize;
+                format!("{v:.decimals$}")
+            };
+            (v, label)
+        })
+        .collect()
 }
 
 /// Coordinates with two decimals: enough for the screen, stable across runs.
@@ -577,6 +586,26 @@ mod tests {
             t.len() >= 3 && t[0] >= 0.013 && *t.last().unwrap() <= 0.087,
             "{t:?}"
         );
+    }
+
+    #[test]
+    fn tick_labels_are_distinct() {
+        for (lo, hi) in [
+            (0.0019, 0.00212),
+            (6.5e-4, 7.1e-4),
+            (0.0, 10.0),
+            (0.95, 1.02),
+            (1e5, 3e5),
+        ] {
+            let l: Vec<String> = labelled(ticks(lo, hi))
+                .into_iter()
+                .map(|(_, s)| s)
+                .collect();
+            let mut u = l.clone();
+            u.dedup();
+            assert_eq!(u.len(), l.len(), "{lo}..{hi}: {l:?}");
+        }
+        assert_eq!(labelled(ticks(0.0, 10.0)).last().unwrap().1, "10");
     }
 
     #[test]
