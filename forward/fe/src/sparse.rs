@@ -4,7 +4,9 @@
 //! and reused for every numeric factorisation.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
-use faer::sparse::linalg::lu::{factorize_symbolic_lu, LuSymbolicParams, NumericLu, SymbolicLu};
+use faer::sparse::linalg::lu::{
+    factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
+};
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Par};
@@ -104,6 +106,8 @@ pub struct SparseLu {
     solve_scratch: MemBuffer,
     /// Number of numeric factorisations done.
     pub factorisations: usize,
+    /// Whether `numeric` holds valid factors.
+    factored: bool,
 }
 
 impl SparseLu {
@@ -137,15 +141,23 @@ impl SparseLu {
             factor_scratch,
             solve_scratch,
             factorisations: 0,
+            factored: false,
         })
     }
 
     /// Factorises the matrix with values `values` (in pattern order) and
     /// overwrites `rhs` with the solution.
     pub fn solve(&mut self, values: &[f64], rhs: &mut [f64]) -> Result<(), FeError> {
+        self.factorize(values)?;
+        self.solve_factored(rhs)
+    }
+
+    /// Numeric factorisation of the matrix with values `values`; the factors
+    /// are kept for [`SparseLu::solve_factored`].
+    pub fn factorize(&mut self, values: &[f64]) -> Result<(), FeError> {
+        self.factored = false;
         let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), values);
-        let lu = self
-            .symbolic_lu
+        self.symbolic_lu
             .factorize_numeric_lu(
                 &mut self.numeric,
                 mat,
@@ -157,7 +169,19 @@ impl SparseLu {
                 reason: format!("{e:?}"),
             })?;
         self.factorisations += 1;
-        lu.solve_in_place_with_conj(
+        self.factored = true;
+        Ok(())
+    }
+
+    /// Overwrites `rhs` with the solution for the last factorised matrix
+    /// (a chord step of a modified Newton method when the matrix changed since).
+    pub fn solve_factored(&mut self, rhs: &mut [f64]) -> Result<(), FeError> {
+        if !self.factored {
+            return Err(FeError::Factorisation {
+                reason: "no factorisation to solve with".into(),
+            });
+        }
+        LuRef::new_unchecked(&self.symbolic_lu, &self.numeric).solve_in_place_with_conj(
             Conj::No,
             faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
             Par::Seq,

@@ -21,7 +21,6 @@ fn model(law: &str, friction: f64) -> N1Needle {
     m.friction = friction;
     m.mesh = MeshDensity::COARSE;
     m.bulk = Bulk::Exact;
-    m.options.max_step = 0.5;
     m
 }
 
