@@ -229,13 +229,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Err(e) => bail!("{title}: {e}"),
     };
     eprintln!(
-        "{title}: {} elements, {} unknowns, {} increments, {} Newton iterations, F({depth} mm) = {:.6} N",
+        "{title}: {} elements, {} unknowns, {} increments, {} Newton iterations ({} factorisations), F({depth} mm) = {:.6} N",
         solver.mesh.elements.len(),
         solver.equations(),
         sim.stats.increments,
         sim.stats.iterations,
+        sim.stats.factorisations,
         sim.forces.last().copied().unwrap_or(0.0)
     );
+    if sim.stats.loose > 0 {
+        eprintln!(
+            "warning: {} increments were accepted at the looser stagnation tolerance (SolverOptions::stagnation_tolerance), not the full one",
+            sim.stats.loose
+        );
+    }
     if let Some(path) = &args.csv {
         write_curve(path, &drive, &sim.forces)?;
     }
