@@ -1,6 +1,7 @@
 //! Fitting an objective: local runs from one or several starts, then the
 //! statistics at the best optimum.
 
+use crate::boundary_polish::boundary_polish;
 use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
 use crate::{
@@ -154,7 +155,32 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
         solver: options.method.name(),
         reason: "no start produced a finite SSE".into(),
     })?;
-    let mut report = statistics(objective, &outcome.z, &options.fd)?;
+    // Optima on a finite bound sit at infinity in the transformed space;
+    // try them exactly (see `boundary_polish`). A parameter put on its bound
+    // is reported with `at_bound` set (also in `identifiability.at_bound`),
+    // not `fixed`, and, like any parameter on a bound, without a standard
+    // error; it is not among `free` nor in the correlation matrix.
+    let (outcome, mut report) =
+        match boundary_polish(objective, &options.method, &options.fd, &outcome) {
+            Some(polished) => {
+                evaluations += polished.evaluations;
+                jacobians += polished.jacobians;
+                let mut report = statistics(&polished.objective, &polished.outcome.z, &options.fd)?;
+                for &(k, side) in &polished.held {
+                    report.parameters[k].fixed = false;
+                    report.parameters[k].at_bound = Some(side);
+                    let name = report.parameters[k].name.clone();
+                    if !report.identifiability.at_bound.contains(&name) {
+                        report.identifiability.at_bound.push(name);
+                    }
+                }
+                (polished.outcome, report)
+            }
+            None => {
+                let report = statistics(objective, &outcome.z, &options.fd)?;
+                (outcome, report)
+            }
+        };
     report.method = options.method.name().to_string();
     report.iterations = outcome.iterations;
     report.evaluations += evaluations;

@@ -17,6 +17,7 @@
 //! println!("{}", serde_json::to_string_pretty(&report)?);
 //! ```
 
+pub mod boundary_polish;
 pub mod covariance;
 pub mod dataset;
 pub mod error;
@@ -32,6 +33,7 @@ pub mod run;
 pub mod sensitivities;
 pub mod termination;
 
+pub use boundary_polish::{near_bound, POLISH_RELATIVE_DISTANCE};
 pub use covariance::{
     covariance, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION, MAX_CORRELATION,
 };

@@ -136,23 +136,31 @@ impl LevenbergMarquardt {
         worst
     }
 
-    /// Solves `[J; sqrt(mu) D] h ~ [-r; 0]` by SVD.
+    /// Solves `[J; sqrt(mu) D] h ~ [-r; 0]` by SVD, in the scaled unknowns
+    /// `y = D h`: `[J D^-1; sqrt(mu) I] y ~ [-r; 0]`, `h = D^-1 y`. Same
+    /// step in exact arithmetic, but the matrix has unit-scale columns, so
+    /// a parameter whose column is 1e17 times another's (Ogden
+    /// `mu_i l^alpha_i` with `alpha_i = 20` next to `mu_j l^-9`) does not
+    /// drown the small singular values in round-off, which stalled LM on
+    /// such fits (xtol met by a step that was noise).
     fn damped_step(&self, r: &[f64]) -> Option<Vec<f64>> {
         let (m, q) = self.jacobian.shape();
         let mut a = DMatrix::zeros(m + q, q);
         a.view_mut((0, 0), (m, q)).copy_from(&self.jacobian);
+        for (j, d) in self.scale.iter().enumerate() {
+            a.column_mut(j).scale_mut(d.recip());
+        }
         let root_mu = self.mu.sqrt();
         for j in 0..q {
-            a[(m + j, j)] = root_mu * self.scale[j];
+            a[(m + j, j)] = root_mu;
         }
         let mut b = DVector::zeros(m + q);
         for (bi, ri) in b.iter_mut().zip(r) {
             *bi = -ri;
         }
-        let h = a.svd(true, true).solve(&b, f64::MIN_POSITIVE).ok()?;
-        h.iter()
-            .all(|v| v.is_finite())
-            .then(|| h.iter().copied().collect())
+        let y = a.svd(true, true).solve(&b, f64::MIN_POSITIVE).ok()?;
+        let h: Vec<f64> = y.iter().zip(&self.scale).map(|(v, d)| v / d).collect();
+        h.iter().all(|v| v.is_finite()).then_some(h)
     }
 
     fn check_converged(&mut self, r: &[f64], sse: f64) {

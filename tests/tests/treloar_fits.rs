@@ -11,7 +11,7 @@
 
 use palpate_analytic::{Homogeneous, Mode};
 use palpate_core::{Drive, Loading, Table};
-use palpate_inverse::{fit, DataSet, FitOptions, FitReport, Objective, ResidualKind};
+use palpate_inverse::{fit, BoundSide, DataSet, FitOptions, FitReport, Objective, ResidualKind};
 use palpate_material::Law;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
@@ -137,19 +137,16 @@ fn check(law: &str) {
                 },
             );
         }
-        // Known limitation: when the reference optimum sits on a bound
-        // (Ogden alpha = +-20) or on the law's admissibility limit
-        // (Mooney-Rivlin C10 + C01 = 0, not a box bound of the parameter
-        // space), LM in the transformed space only creeps towards it; there
-        // we require the SSE within 2 % above the reference (never below).
+        // Known limitation: when the reference optimum sits on the law's
+        // admissibility limit (Mooney-Rivlin C10 + C01 = 0, not a box bound
+        // of the parameter space), LM meets it as failed evaluations and
+        // only creeps towards it; there we require the SSE within 2 % above
+        // the reference (never below). Optima on a box bound (Ogden
+        // alpha2 = 20) are reached by the boundary polish and held to the
+        // 4-digit criterion like the rest.
         let p = &case["params"];
-        let on_boundary = p
-            .as_object()
-            .unwrap()
-            .iter()
-            .any(|(k, v)| k.starts_with("alpha") && v.as_f64().unwrap().abs() > 19.999)
-            || (law == "mooney_rivlin"
-                && (p["C10"].as_f64().unwrap() + p["C01"].as_f64().unwrap()).abs() < 1e-9);
+        let on_boundary = law == "mooney_rivlin"
+            && (p["C10"].as_f64().unwrap() + p["C01"].as_f64().unwrap()).abs() < 1e-9;
         let tolerance = if on_boundary { 2e-2 } else { 5e-5 };
         assert!(
             r.sse >= sse_ref * (1.0 - 5e-5) && r.sse - sse_ref <= tolerance * sse_ref,
@@ -191,15 +188,28 @@ fn arruda_boyce_matches_scipy() {
 }
 
 #[test]
-fn ogden3_matches_scipy_and_is_not_identifiable_on_uniaxial_data_alone() {
+fn ogden3_matches_scipy_with_alpha2_on_its_bound_and_is_not_identifiable_otherwise() {
     check("ogden3");
     let reference = reference();
-    let case = reference["fits"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .find(|c| c["law"] == "ogden3" && c["data"] == "uniaxial" && c["residual"] == "absolute")
-        .unwrap();
-    let r = best_fit(case);
+    let case = |residual: &str| {
+        reference["fits"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["law"] == "ogden3" && c["data"] == "uniaxial" && c["residual"] == residual)
+            .unwrap()
+            .clone()
+    };
+    // Absolute residuals: the optimum has alpha2 on its upper bound (20),
+    // reported as such; with it there, the other five are identifiable
+    // (checked against scipy by `check`).
+    let r = best_fit(&case("absolute"));
+    let alpha2 = r.parameters.iter().find(|p| p.name == "alpha2").unwrap();
+    assert_eq!(alpha2.value, 20.0);
+    assert_eq!(alpha2.at_bound, Some(BoundSide::Upper));
+    assert!(r.identifiability.identifiable, "{:?}", r.identifiability);
+    // Relative residuals: an interior optimum with a vanishing term
+    // (mu2 ~ 2e-9), reported not identifiable.
+    let r = best_fit(&case("relative"));
     assert!(!r.identifiability.identifiable, "{:?}", r.identifiability);
 }
