@@ -57,14 +57,20 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
-/// The base forward model of a benchmark.
+/// The base forward model of a benchmark: C1 (analytic, lubricated
+/// platens) or N1 (axisymmetric FE needle indentation with a frictionless
+/// needle on the coarse mesh, so that `friction` and `boundary_condition`
+/// are effects to find).
 pub fn base_model(benchmark: &str, law: Law) -> anyhow::Result<Box<dyn ForwardModel>> {
     if benchmark.eq_ignore_ascii_case("c1") {
         Ok(Box::new(palpate_analytic::C1Compression::new(law)))
+    } else if benchmark.eq_ignore_ascii_case("n1") {
+        let mut m = palpate_fe::N1Needle::new(law);
+        m.friction = 0.0;
+        m.mesh = palpate_fe::MeshDensity::COARSE;
+        Ok(Box::new(m))
     } else {
-        anyhow::bail!(
-            "--benchmark {benchmark}: the gap diagnosis supports C1 (N1 follows with the FE model)"
-        )
+        anyhow::bail!("--benchmark {benchmark}: the gap diagnosis supports C1 (analytic) and N1 (finite elements)")
     }
 }
 
