@@ -4,6 +4,7 @@
 use crate::boundary_polish::boundary_polish;
 use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
+use crate::wall_slide::wall_slide;
 use crate::{
     covariance, jacobian_unbounded, sum_of_squares, BoundSide, FdOptions, FitReport, InverseError,
     Method, Objective, ParameterEstimate, SetReport, SharedObserver,
@@ -155,6 +156,19 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
         solver: options.method.name(),
         reason: "no start produced a finite SSE".into(),
     })?;
+    // A run that ended against an admissibility limit (a failed trial step)
+    // continues along it (see `wall_slide`).
+    let outcome = match outcome.blocked {
+        true => match wall_slide(objective, &options.fd, &outcome) {
+            Some(slid) => {
+                evaluations += slid.evaluations;
+                jacobians += slid.jacobians;
+                slid
+            }
+            None => outcome,
+        },
+        false => outcome,
+    };
     // Optima on a finite bound sit at infinity in the transformed space;
     // try them exactly (see `boundary_polish`). A parameter put on its bound
     // is reported with `at_bound` set (also in `identifiability.at_bound`),

@@ -32,6 +32,7 @@ pub mod residual;
 pub mod run;
 pub mod sensitivities;
 pub mod termination;
+pub mod wall_slide;
 
 pub use boundary_polish::{near_bound, POLISH_RELATIVE_DISTANCE};
 pub use covariance::{

@@ -82,6 +82,8 @@ pub struct LevenbergMarquardt {
     scale: Vec<f64>,
     jacobian: DMatrix<f64>,
     termination: Option<Termination>,
+    /// The last trial since the last accepted step failed to evaluate.
+    blocked: bool,
 }
 
 impl LevenbergMarquardt {
@@ -94,12 +96,20 @@ impl LevenbergMarquardt {
             scale: Vec::new(),
             jacobian: DMatrix::zeros(0, 0),
             termination: None,
+            blocked: false,
         }
     }
 
     /// Why the solver stopped, when it stopped by its own criteria.
     pub fn termination(&self) -> Option<&Termination> {
         self.termination.as_ref()
+    }
+
+    /// Whether the last trial step (after the last accepted one) failed to
+    /// evaluate, e.g. left the law's admissible domain: the run ended against
+    /// an admissibility limit that is not a box bound.
+    pub fn blocked(&self) -> bool {
+        self.blocked
     }
 
     /// The Jacobian at the last accepted point.
@@ -260,6 +270,7 @@ where
                 let sse_new: f64 = r_new.iter().map(|v| v * v).sum();
                 sse_new.is_finite().then_some((r_new, sse_new))
             });
+            self.blocked = trial.is_none();
             let (rho, accepted) = match trial {
                 Some((r_new, sse_new)) if pred > 0.0 => {
                     ((sse - sse_new) / pred, Some((r_new, sse_new)))

@@ -72,6 +72,8 @@ pub(crate) struct RunOutcome {
     pub evaluations: usize,
     pub jacobians: usize,
     pub termination: Termination,
+    /// Levenberg-Marquardt only: the last trial failed to evaluate.
+    pub blocked: bool,
 }
 
 fn argmin_termination(reason: Option<&TerminationReason>) -> Termination {
@@ -113,6 +115,7 @@ pub(crate) fn run(
                 evaluations: p.evaluations(),
                 jacobians: p.jacobians(),
                 termination,
+                blocked: result.solver.blocked(),
             })
         }
         Method::Bfgs(options) => {
@@ -158,6 +161,7 @@ pub(crate) fn run(
                 evaluations: p.evaluations(),
                 jacobians: p.jacobians(),
                 termination: argmin_termination(result.state.get_termination_reason()),
+                blocked: false,
             })
         }
         Method::Lbfgs { memory, options } => {
@@ -180,6 +184,7 @@ pub(crate) fn run(
                 evaluations: p.evaluations(),
                 jacobians: p.jacobians(),
                 termination: argmin_termination(result.state.get_termination_reason()),
+                blocked: false,
             })
         }
     }

@@ -137,24 +137,17 @@ fn check(law: &str) {
                 },
             );
         }
-        // Known limitation: when the reference optimum sits on the law's
-        // admissibility limit (Mooney-Rivlin C10 + C01 = 0, not a box bound
-        // of the parameter space), LM meets it as failed evaluations and
-        // only creeps towards it; there we require the SSE within 2 % above
-        // the reference (never below). Optima on a box bound (Ogden
-        // alpha2 = 20) are reached by the boundary polish and held to the
-        // 4-digit criterion like the rest.
-        let p = &case["params"];
-        let on_boundary = law == "mooney_rivlin"
-            && (p["C10"].as_f64().unwrap() + p["C01"].as_f64().unwrap()).abs() < 1e-9;
-        let tolerance = if on_boundary { 2e-2 } else { 5e-5 };
+        // Optima on a box bound (Ogden alpha2 = 20) are reached by the
+        // boundary polish, optima on a law's admissibility limit
+        // (Mooney-Rivlin C10 + C01 = 0) by the wall slide: every case is
+        // held to 4 significant digits (and never below the reference).
         assert!(
-            r.sse >= sse_ref * (1.0 - 5e-5) && r.sse - sse_ref <= tolerance * sse_ref,
-            "{label}: SSE {} vs scipy {sse_ref} (boundary optimum: {on_boundary})",
+            (r.sse - sse_ref).abs() <= 5e-5 * sse_ref,
+            "{label}: SSE {} vs scipy {sse_ref}",
             r.sse
         );
         assert_eq!(r.n_residuals as u64, case["n"].as_u64().unwrap(), "{label}");
-        if r.identifiability.identifiable && !on_boundary {
+        if r.identifiability.identifiable {
             for (name, v) in case["params"].as_object().unwrap() {
                 let v = v.as_f64().unwrap();
                 let got = r.value(name).unwrap();
