@@ -38,7 +38,7 @@ use nalgebra::{DMatrix, DVector};
 const MAX_SLIDES: usize = 200;
 /// Bisection steps for the largest admissible fraction (2^-40 ~ 1e-12).
 const BISECTIONS: usize = 40;
-/// Halvings of the tangent step at most.
+/// Halvings of the tangent step (and of a wall fraction's bracket) at most.
 const MAX_HALVINGS: usize = 40;
 /// Stop when one slide lowers the SSE by less than this (relative).
 const MIN_GAIN: f64 = 1e-13;
@@ -72,7 +72,19 @@ impl Walker<'_> {
         if self.admissible(&at(hi)) {
             return None;
         }
+        // Bracket by halving first, so the bisection below is accurate
+        // relative to the fraction itself, however close the wall is (the
+        // slide approaches it geometrically; an absolute 2^-40 would leave
+        // the normal of step 2 to round-off near the wall).
         let (mut lo, mut hi) = (0.0, hi);
+        for _ in 0..MAX_HALVINGS {
+            let half = 0.5 * hi;
+            if self.admissible(&at(half)) {
+                lo = half;
+                break;
+            }
+            hi = half;
+        }
         for _ in 0..BISECTIONS {
             let mid = 0.5 * (lo + hi);
             if self.admissible(&at(mid)) {

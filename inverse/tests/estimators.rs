@@ -577,3 +577,58 @@ fn multistart_escapes_a_local_minimum_and_the_observer_sees_progress() {
     let seen = seen.lock().unwrap();
     assert!(seen.len() >= 8 && seen.iter().any(|&(k, _)| k == 7));
 }
+
+#[test]
+fn an_optimum_on_an_admissibility_limit_is_reached_along_it() {
+    // A line whose law rejects a + b <= 0 (not a box bound); the data's
+    // unconstrained fit (a = -1, b = 0.5) is inadmissible, so the optimum
+    // lies on a + b = 0: the model is b (x - 1), with the closed-form
+    // least-squares b* = sum (x - 1) y / sum (x - 1)^2.
+    let walled: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "walled line",
+        space: ParamSpace::new(vec![p("a", -INF, INF, 1.0), p("b", -INF, INF, 1.0)]),
+        law: |t, x| {
+            if t[0] + t[1] > 0.0 {
+                Ok(t[0] + t[1] * x)
+            } else {
+                Err(ForwardError::InvalidParameter {
+                    name: "a + b".into(),
+                    value: t[0] + t[1],
+                    reason: "must be > 0".into(),
+                })
+            }
+        },
+    });
+    let x = times(11, 4.0);
+    let y: Vec<f64> = x
+        .iter()
+        .enumerate()
+        .map(|(i, v)| -1.0 + 0.5 * v + if i % 2 == 0 { 0.05 } else { -0.05 })
+        .collect();
+    let b_star = x.iter().zip(&y).map(|(v, w)| (v - 1.0) * w).sum::<f64>()
+        / x.iter().map(|v| (v - 1.0).powi(2)).sum::<f64>();
+    let sse_star: f64 = x
+        .iter()
+        .zip(&y)
+        .map(|(v, w)| (b_star * (v - 1.0) - w).powi(2))
+        .sum();
+    let s = DataSet::new(
+        "line",
+        walled,
+        Loading::quasi_static(Drive::DisplacementMm, x),
+        y,
+    );
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    let (a, b) = (r.value("a").unwrap(), r.value("b").unwrap());
+    assert!(a + b > 0.0 && a + b < 1e-8, "a + b = {}", a + b);
+    assert!(
+        (b - b_star).abs() < 1e-6 * b_star.abs(),
+        "b = {b} vs {b_star}"
+    );
+    assert!(
+        r.sse >= sse_star * (1.0 - 1e-12) && r.sse <= sse_star * (1.0 + 1e-8),
+        "SSE {} vs {sse_star}",
+        r.sse
+    );
+}
