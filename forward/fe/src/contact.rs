@@ -52,6 +52,20 @@ pub struct ContactOptions {
     pub penalty_tangent: f64,
     /// Accepted penetration (mm) after augmentation.
     pub penetration_tol: f64,
+    /// Where the contact conditions are enforced.
+    pub points: ContactPoints,
+}
+
+/// Where the contact conditions are enforced on the body's surface.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum ContactPoints {
+    /// At the surface nodes, with their tributary areas (node-to-surface).
+    #[default]
+    Nodes,
+    /// At the two Gauss points of every surface edge, the force shared by
+    /// the edge's nodes through the shape functions (a surface-to-rigid
+    /// integration: edges cannot cut through a curved tool between nodes).
+    EdgeGauss,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -68,10 +82,30 @@ struct NodeHistory {
     gap: f64,
 }
 
-/// Contribution of one node: force on the body and `d force / d x`.
+/// A contact point on the surface: `x = w0 x[n0] + w1 x[n1]` with
+/// reference area `area` (360 degrees).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ContactPoint {
+    pub nodes: [usize; 2],
+    pub weights: [f64; 2],
+    pub area: f64,
+}
+
+impl ContactPoint {
+    fn position(&self, x: &[[f64; 2]]) -> [f64; 2] {
+        let [a, b] = self.nodes;
+        let [wa, wb] = self.weights;
+        [wa * x[a][0] + wb * x[b][0], wa * x[a][1] + wb * x[b][1]]
+    }
+}
+
+/// Contribution of one contact point: force on the body at the point and
+/// `d force / d x_point`; node `nodes[k]` receives `weights[k] * force` and
+/// the stiffness block `(k, l)` is `weights[k] weights[l] stiffness`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct NodeContact {
-    pub node: usize,
+    pub nodes: [usize; 2],
+    pub weights: [f64; 2],
     pub force: [f64; 2],
     pub stiffness: [[f64; 2]; 2],
 }
@@ -81,9 +115,8 @@ pub struct NodeContact {
 pub struct ContactSet {
     pub name: String,
     pub tool: RigidTool,
-    pub nodes: Vec<usize>,
-    /// Tributary areas (mm^2) of `nodes`.
-    pub areas: Vec<f64>,
+    /// Contact points (surface nodes or edge Gauss points).
+    pub points: Vec<ContactPoint>,
     pub options: ContactOptions,
     committed: Vec<NodeHistory>,
     trial: Vec<NodeHistory>,
@@ -106,27 +139,51 @@ impl ContactSet {
                 field: format!("tool `{name}`"),
                 reason,
             })?;
-        let mut area = std::collections::BTreeMap::<usize, f64>::new();
-        for &[a, b] in mesh.edge_set(edges)? {
-            let (pa, pb) = (mesh.nodes[a], mesh.nodes[b]);
-            let len = ((pa[0] - pb[0]).powi(2) + (pa[1] - pb[1]).powi(2)).sqrt();
-            // integral of N_a times the volume factor along the edge (linear in r)
-            let (fa, fb) = (kin.volume_factor(pa[0]), kin.volume_factor(pb[0]));
-            *area.entry(a).or_default() += len * (2.0 * fa + fb) / 6.0;
-            *area.entry(b).or_default() += len * (fa + 2.0 * fb) / 6.0;
+        let mut points = Vec::new();
+        match options.points {
+            ContactPoints::Nodes => {
+                let mut area = std::collections::BTreeMap::<usize, f64>::new();
+                for &[a, b] in mesh.edge_set(edges)? {
+                    let (pa, pb) = (mesh.nodes[a], mesh.nodes[b]);
+                    let len = ((pa[0] - pb[0]).powi(2) + (pa[1] - pb[1]).powi(2)).sqrt();
+                    // integral of N_a times the volume factor along the edge (linear in r)
+                    let (fa, fb) = (kin.volume_factor(pa[0]), kin.volume_factor(pb[0]));
+                    *area.entry(a).or_default() += len * (2.0 * fa + fb) / 6.0;
+                    *area.entry(b).or_default() += len * (fa + 2.0 * fb) / 6.0;
+                }
+                points.extend(area.into_iter().map(|(n, a)| ContactPoint {
+                    nodes: [n, n],
+                    weights: [1.0, 0.0],
+                    area: a,
+                }));
+            }
+            ContactPoints::EdgeGauss => {
+                let g = 1.0 / 3f64.sqrt();
+                for &[a, b] in mesh.edge_set(edges)? {
+                    let (pa, pb) = (mesh.nodes[a], mesh.nodes[b]);
+                    let len = ((pa[0] - pb[0]).powi(2) + (pa[1] - pb[1]).powi(2)).sqrt();
+                    for xi in [-g, g] {
+                        let w = [0.5 * (1.0 - xi), 0.5 * (1.0 + xi)];
+                        let r = w[0] * pa[0] + w[1] * pb[0];
+                        points.push(ContactPoint {
+                            nodes: [a, b],
+                            weights: w,
+                            area: 0.5 * len * kin.volume_factor(r),
+                        });
+                    }
+                }
+            }
         }
-        let nodes: Vec<usize> = area.keys().copied().collect();
-        let areas: Vec<f64> = area.values().copied().collect();
-        let mut hist = vec![NodeHistory::default(); nodes.len()];
-        for (h, &n) in hist.iter_mut().zip(&nodes) {
-            h.pos = mesh.nodes[n];
-            let g = tool.shape.project(tool.local(mesh.nodes[n], 0.0)).gap;
+        let mut hist = vec![NodeHistory::default(); points.len()];
+        for (h, p) in hist.iter_mut().zip(&points) {
+            h.pos = p.position(&mesh.nodes);
+            let g = tool.shape.project(tool.local(h.pos, 0.0)).gap;
             if g < -1e-9 {
                 return Err(FeError::ToolStartsInside {
                     tool: name.into(),
-                    node: n,
-                    r: mesh.nodes[n][0],
-                    z: mesh.nodes[n][1],
+                    node: p.nodes[0],
+                    r: h.pos[0],
+                    z: h.pos[1],
                     gap: g,
                 });
             }
@@ -134,8 +191,7 @@ impl ContactSet {
         Ok(ContactSet {
             name: name.into(),
             tool,
-            nodes,
-            areas,
+            points,
             options,
             trial: hist.clone(),
             committed: hist,
@@ -145,9 +201,9 @@ impl ContactSet {
 
     /// Forgets all history (a fresh loading history starts).
     pub fn reset(&mut self, mesh: &Mesh) {
-        for (h, &n) in self.committed.iter_mut().zip(&self.nodes) {
+        for (h, p) in self.committed.iter_mut().zip(&self.points) {
             *h = NodeHistory {
-                pos: mesh.nodes[n],
+                pos: p.position(&mesh.nodes),
                 ..Default::default()
             };
         }
@@ -161,10 +217,13 @@ impl ContactSet {
     pub fn evaluate(&mut self, x: &[[f64; 2]], travel: f64, out: &mut Vec<NodeContact>) {
         out.clear();
         let o = self.options;
-        for (k, &n) in self.nodes.iter().enumerate() {
-            let a = self.areas[k];
+        for (k, p) in self.points.iter().enumerate() {
+            let a = p.area;
             let c = self.committed[k];
-            let pr = self.tool.shape.project(self.tool.local(x[n], travel));
+            let pr = self
+                .tool
+                .shape
+                .project(self.tool.local(p.position(x), travel));
             let (eps_n, eps_t) = (o.penalty_normal * a, o.penalty_tangent * a);
             let tn = c.lambda - eps_n * pr.gap;
             let mut t = NodeHistory {
@@ -176,7 +235,8 @@ impl ContactSet {
             if tn <= 0.0 {
                 self.trial[k] = t;
                 out.push(NodeContact {
-                    node: n,
+                    nodes: p.nodes,
+                    weights: p.weights,
                     ..Default::default()
                 });
                 continue;
@@ -221,7 +281,8 @@ impl ContactSet {
             }
             self.trial[k] = t;
             out.push(NodeContact {
-                node: n,
+                nodes: p.nodes,
+                weights: p.weights,
                 force: f,
                 stiffness: kmat,
             });
@@ -246,9 +307,9 @@ impl ContactSet {
 
     /// Accepts the trial state at tool travel `travel` with nodal positions `x`.
     pub fn commit(&mut self, x: &[[f64; 2]], travel: f64) {
-        for (k, &n) in self.nodes.iter().enumerate() {
+        for (k, p) in self.points.iter().enumerate() {
             self.committed[k] = NodeHistory {
-                pos: x[n],
+                pos: p.position(x),
                 lambda: self.trial[k].normal_force,
                 ..self.trial[k]
             };
@@ -276,7 +337,7 @@ mod tests {
     use super::*;
     use crate::mesh::Grading;
 
-    fn set(friction: f64) -> (Mesh, ContactSet) {
+    fn set_with(friction: f64, points: ContactPoints) -> (Mesh, ContactSet) {
         let m =
             Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2))
                 .unwrap();
@@ -290,6 +351,7 @@ mod tests {
             penalty_normal: 10.0,
             penalty_tangent: 5.0,
             penetration_tol: 1e-6,
+            points,
         };
         let c = ContactSet::new("sphere", tool, &m, "top", Kinematics::Axisymmetric, opts).unwrap();
         (m, c)
@@ -297,9 +359,11 @@ mod tests {
 
     #[test]
     fn tributary_areas_sum_to_the_top_face() {
-        let (_, c) = set(0.0);
-        let total: f64 = c.areas.iter().sum();
-        assert!((total - std::f64::consts::PI * 16.0).abs() < 1e-12);
+        for points in [ContactPoints::Nodes, ContactPoints::EdgeGauss] {
+            let (_, c) = set_with(0.0, points);
+            let total: f64 = c.points.iter().map(|p| p.area).sum();
+            assert!((total - std::f64::consts::PI * 16.0).abs() < 1e-12);
+        }
     }
 
     #[test]
@@ -317,6 +381,7 @@ mod tests {
             penalty_normal: 1.0,
             penalty_tangent: 1.0,
             penetration_tol: 1e-6,
+            points: ContactPoints::Nodes,
         };
         let e =
             ContactSet::new("platen", tool, &m, "top", Kinematics::Axisymmetric, opts).unwrap_err();
@@ -326,8 +391,11 @@ mod tests {
 
     #[test]
     fn stiffness_matches_finite_differences_in_stick_and_slip() {
-        for friction in [0.0, 0.3, 100.0] {
-            let (m, mut c) = set(friction);
+        for (friction, points) in [0.0, 0.3, 100.0]
+            .into_iter()
+            .flat_map(|f| [(f, ContactPoints::Nodes), (f, ContactPoints::EdgeGauss)])
+        {
+            let (m, mut c) = set_with(friction, points);
             // move nodes sideways so that some slip and some stick
             let mut x = m.nodes.clone();
             c.commit(&x, 0.0);
@@ -342,19 +410,20 @@ mod tests {
             let h = 1e-7;
             let (mut p, mut q) = (Vec::new(), Vec::new());
             for (k, nc) in base.iter().enumerate() {
+                // d force / d x_node = weight * d force / d x_point
+                let (node, w) = (nc.nodes[0], nc.weights[0]);
                 for j in 0..2 {
                     let (mut xp, mut xm) = (x.clone(), x.clone());
-                    xp[nc.node][j] += h;
-                    xm[nc.node][j] -= h;
+                    xp[node][j] += h;
+                    xm[node][j] -= h;
                     c.evaluate(&xp, travel, &mut p);
                     c.evaluate(&xm, travel, &mut q);
                     for i in 0..2 {
                         let fd = (p[k].force[i] - q[k].force[i]) / (2.0 * h);
-                        let an = nc.stiffness[i][j];
+                        let an = w * nc.stiffness[i][j];
                         assert!(
                             (fd - an).abs() < 1e-5 * (1.0 + an.abs()),
-                            "mu {friction} node {} {i}{j}: {an} vs {fd}",
-                            nc.node
+                            "mu {friction} {points:?} node {node} {i}{j}: {an} vs {fd}"
                         );
                     }
                 }

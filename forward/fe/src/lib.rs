@@ -38,6 +38,7 @@ pub mod tool;
 pub mod vtu;
 
 pub use c1::{C1Fe, Platens};
+pub use contact::ContactPoints;
 pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};

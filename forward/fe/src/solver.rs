@@ -367,17 +367,31 @@ impl Solver {
             reaction = ContactSet::reaction(&self.contacts, cs.tool.direction);
             for nc in &self.contacts {
                 scale2 += nc.force[0].powi(2) + nc.force[1].powi(2);
-                for i in 0..2 {
-                    self.fint[2 * nc.node + i] -= nc.force[i];
-                }
-                if tangent {
-                    // the node's own 2x2 block is in the pattern of any element holding it
+                for (a, &na) in nc.nodes.iter().enumerate() {
+                    let wa = nc.weights[a];
+                    if wa == 0.0 {
+                        continue;
+                    }
                     for i in 0..2 {
-                        for j in 0..2 {
-                            let (ri, cj) = (self.eq[2 * nc.node + i], self.eq[2 * nc.node + j]);
-                            if ri != NONE && cj != NONE {
-                                if let Some(s) = self.pattern.slot(ri, cj) {
-                                    self.values[s] -= nc.stiffness[i][j];
+                        self.fint[2 * na + i] -= wa * nc.force[i];
+                    }
+                    if !tangent {
+                        continue;
+                    }
+                    // the two nodes of a contact point share an element, so
+                    // their blocks are in the pattern
+                    for (b, &nb) in nc.nodes.iter().enumerate() {
+                        let wab = wa * nc.weights[b];
+                        if wab == 0.0 {
+                            continue;
+                        }
+                        for i in 0..2 {
+                            for j in 0..2 {
+                                let (ri, cj) = (self.eq[2 * na + i], self.eq[2 * nb + j]);
+                                if ri != NONE && cj != NONE {
+                                    if let Some(s) = self.pattern.slot(ri, cj) {
+                                        self.values[s] -= wab * nc.stiffness[i][j];
+                                    }
                                 }
                             }
                         }
