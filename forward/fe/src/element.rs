@@ -21,7 +21,7 @@
 
 use nalgebra::Matrix3;
 
-use crate::kinematics::{jacobian_derivs, Kinematics, F_COMPONENTS};
+use crate::kinematics::{jacobian_derivs, Kinematics};
 use crate::material::PointMaterial;
 use crate::quadrature::gauss_2x2;
 use crate::FeError;
@@ -205,8 +205,7 @@ pub fn quad4(
         if !(j > 0.0) || !(f[0] * f[3] - f[1] * f[2] > 0.0) {
             return Err(FeError::InvertedElement { element, det_f: j });
         }
-        let (p9, a9) = mat.iso_stress_tangent(&full_f(&f));
-        let p5: [f64; 5] = std::array::from_fn(|k| p9[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
+        let (p5, a5) = mat.iso_stress_tangent_2d(&full_f(&f), tangent);
         if p5.iter().any(|v| !v.is_finite()) {
             return Err(FeError::NonFiniteStress { element });
         }
@@ -225,12 +224,6 @@ pub fn quad4(
         if tangent {
             // B^T A B and B^T H_J B, using the sparsity of B (each column has
             // at most three non-zero rows).
-            let mut a5 = [[0.0; 5]; 5];
-            for k in 0..5 {
-                for l in 0..5 {
-                    a5[k][l] = a9[(F_COMPONENTS[k], F_COMPONENTS[l])];
-                }
-            }
             let mut ab = [[0.0; 8]; 5]; // A B and H B
             let mut hb = [[0.0; 8]; 5];
             for k in 0..5 {
