@@ -117,6 +117,9 @@ struct SimulationResponse {
     /// ecoflex-nh and ecoflex-rp2 materials of BENCHMARKS.md.
     #[serde(default)]
     params: BTreeMap<String, BTreeMap<String, f64>>,
+    /// Score only the reference samples up to this depth (mm); default: the
+    /// whole reference curve.
+    max_depth_mm: Option<f64>,
     /// Defaults for settings that are not factors.
     law: Option<String>,
     friction: Option<f64>,
@@ -415,8 +418,29 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
         );
     }
     let reference = Table::read(base.join(&spec.reference))?;
-    let x = reference.column("displacement_mm")?.to_vec();
-    let y = reference.column("force_N")?.to_vec();
+    let depth = spec.max_depth_mm.unwrap_or(f64::INFINITY);
+    if depth.is_nan() || depth <= 0.0 {
+        anyhow::bail!("response.simulation.max_depth_mm = {depth}: must be positive");
+    }
+    let keep: Vec<usize> = (0..reference.len())
+        .filter(|&i| {
+            reference
+                .column("displacement_mm")
+                .map(|x| x[i] <= depth)
+                .unwrap_or(false)
+        })
+        .collect();
+    let x: Vec<f64> = keep
+        .iter()
+        .map(|&i| reference.column("displacement_mm").map(|c| c[i]))
+        .collect::<Result<_, _>>()?;
+    let y: Vec<f64> = keep
+        .iter()
+        .map(|&i| reference.column("force_N").map(|c| c[i]))
+        .collect::<Result<_, _>>()?;
+    if x.len() < 3 {
+        anyhow::bail!("response.simulation: fewer than 3 reference samples up to {depth} mm");
+    }
     let loading = Loading::quasi_static(Drive::DisplacementMm, x);
     let setting = |run: &palpate_uq::doe::Run, factor: &str| -> Option<String> {
         d.factors
