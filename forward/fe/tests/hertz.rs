@@ -29,7 +29,7 @@ fn hertz(d: f64) -> f64 {
 
 /// Relative differences FE - Hertz at `depths` on a mesh graded from
 /// `h_fine` over `fine_length`.
-fn deviations(h_fine: f64, fine_length: f64, depths: &[f64]) -> Vec<f64> {
+fn deviations(h_fine: f64, fine_length: f64, depths: &[f64], augment: bool) -> Vec<f64> {
     let mut m = N1Needle::new("neo-hookean".parse().unwrap());
     m.tool = ToolShape::Sphere { radius: R };
     m.friction = 0.0;
@@ -39,8 +39,13 @@ fn deviations(h_fine: f64, fine_length: f64, depths: &[f64]) -> Vec<f64> {
         growth: 1.3,
     });
     m.options.first_step = depths[0] / 2.0;
-    // the default 2e-3 mm would be 4 % of the smallest depth
-    m.penetration_tol = 1e-6;
+    if augment {
+        // augment every increment to 1e-6 mm (the sphere has no cap/cone
+        // junction to chatter at); without it the multipliers lag one
+        // increment, which shifts the deviations below by < 0.15 %
+        m.penetration_tol = 1e-6;
+        m.options.max_augmentations = 20;
+    }
     let f = m
         .predict(
             &[C10],
@@ -57,7 +62,7 @@ fn deviations(h_fine: f64, fine_length: f64, depths: &[f64]) -> Vec<f64> {
 #[test]
 fn sphere_force_follows_hertz_with_a_finite_strain_deviation() {
     let depths = [0.05, 0.1, 0.15, 0.2, 0.25];
-    let dev = deviations(0.04, 1.2, &depths);
+    let dev = deviations(0.04, 1.2, &depths, false);
     let msg = format!("{depths:?}: {dev:?}");
     // within 3 % up to 0.06 R, within 4 % up to 0.1 R
     for (d, r) in depths.iter().zip(&dev) {
@@ -74,7 +79,7 @@ fn sphere_force_follows_hertz_with_a_finite_strain_deviation() {
 #[ignore]
 fn sphere_force_tends_to_hertz_at_small_depth() {
     let depths = [0.005, 0.01, 0.02, 0.04];
-    let dev = deviations(0.008, 0.4, &depths);
+    let dev = deviations(0.008, 0.4, &depths, true);
     assert!(dev[0].abs() < 0.005, "{depths:?}: {dev:?}");
     assert!(dev.iter().all(|r| r.abs() < 0.012), "{depths:?}: {dev:?}");
 }
