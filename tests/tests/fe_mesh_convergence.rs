@@ -1,8 +1,7 @@
 //! N1 mesh convergence on a cheap pair (palpate-fe, BENCHMARKS.md N1,
 //! neo-Hookean `ecoflex-nh`, friction 0.8): the coarse (level 1, 864
 //! elements) and medium (level 2, 3286 elements) meshes agree within 0.5 %
-//! at 2 mm (at 1 mm, with only 3 coarse elements in contact, they differ by
-//! 0.7 %), and both agree with the CalculiX reference within its error budget
+//! at 2 mm (0.36 %), and both agree with the CalculiX reference within its error budget
 //! (../shared/reference/calculix/README.md: mesh 0.3 %, penalty contact
 //! 0.4-0.8 % low). The full study on three meshes to 10 mm (observed order,
 //! extrapolated force) is `forward/fe/examples/convergence_n1.rs`, numbers in
