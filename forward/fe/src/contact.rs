@@ -1,14 +1,19 @@
-//! Node-to-rigid-surface contact with Coulomb friction.
+//! Contact of a body's surface with a rigid analytic tool, with Coulomb
+//! friction, enforced at contact points: the surface nodes (tributary areas)
+//! or the two Gauss points of every surface edge (the force shared by the
+//! edge's nodes through the shape functions, so straight edges cannot cut
+//! through a curved tool between nodes).
 //!
 //! Normal: augmented Lagrangian (Alart & Curnier 1991; Simo & Laursen 1992),
-//! `t_N = max(0, lambda + eps_N A (-g))` with the multiplier `lambda` updated
-//! between Newton solves until the penetration is below a tolerance, so the
-//! force does not depend on the penalty `eps_N`.
+//! `t_N = max(0, lambda + eps_N A (-g))`. The multiplier `lambda` takes the
+//! converged normal force at every commit (one Uzawa update per increment),
+//! and [`ContactSet::augment`] can update it between Newton solves of one
+//! increment until the penetration is below a tolerance.
 //! Tangential: elastic-predictor / plastic-corrector return map
 //! (Wriggers, *Computational Contact Mechanics*, 2006, 5.2.3): trial
 //! `t_T = -eps_T A (xi - xi_stick)`; slip when `|t_T| > mu t_N`, then
 //! `t_T = -mu t_N sign(xi - xi_stick)` and the stick point moves.
-//! `A` is the node's tributary area (360 degrees), `xi` the arc length of its
+//! `A` is the point's area (360 degrees), `xi` the arc length of its
 //! closest point on the tool profile; the tangent `d f / d x` is exact and
 //! unsymmetric in slip.
 //!

@@ -7,10 +7,14 @@
 //! * [`mesh`] — structured graded quadrilateral meshes with named sets.
 //! * [`kinematics`] — the kinematic idealisation (an enum owned by the element).
 //! * [`element`] — the Q1/P0 (Simo-Taylor-Pister) mixed element.
-//! * [`tool`] / [`contact`] — analytic rigid tools and node-to-surface
-//!   augmented-Lagrangian Coulomb contact with trial/commit history.
-//! * [`solver`] — Newton-Raphson with line search and automatic increments
-//!   on a faer sparse LU that keeps its symbolic factorisation.
+//! * [`tool`] / [`contact`] — analytic rigid tools and augmented-Lagrangian
+//!   Coulomb contact at surface nodes or edge Gauss points, with
+//!   trial/commit history.
+//! * [`material`] — the pointwise material seen by the element, with a
+//!   five-component fast path for the laws written in invariants.
+//! * [`solver`] — Newton-Raphson (modified: the LU is reused while it
+//!   contracts the residual) with line search and automatic increments on a
+//!   faer sparse LU that keeps its symbolic factorisation.
 //! * [`n1`], [`c1`] — the forward models.
 
 // Index loops mirror the index notation of the equations; negated comparisons
