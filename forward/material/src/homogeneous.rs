@@ -18,11 +18,25 @@ fn nominal(law: &Law, p: &[f64], lam: [f64; 3], free: usize) -> f64 {
     if !(lam[0] > 0.0 && lam[0].is_finite()) {
         return f64::NAN;
     }
+    // Laws written in invariants: sigma_a - sigma_b = 2 (l_a^2 - l_b^2)(W1 + l_c^2 W2) for an
+    // incompressible principal state (c the third direction), from
+    // l_i dW/dl_i = 2 W1 l_i^2 + 2 W2 (l_i^2 I1 - l_i^4) with I2 = (I1^2 - sum l^4)/2.
+    // Only first derivatives are needed, so the principal Hessian is not built (this path is
+    // the whole cost of the analytic forward models). Ogden keeps the principal path.
+    if p.len() == law.param_count() {
+        let (i1, i2) = crate::invariants::invariants(lam);
+        if let Some(d) = law.invariant_derivs(p, i1, i2) {
+            let third = 3 - free;
+            return 2.0
+                * (lam[0] * lam[0] - lam[free] * lam[free])
+                * (d.w1 + lam[third] * lam[third] * d.w2)
+                / lam[0];
+        }
+    }
     let d = law.isochoric_principal(p, lam);
     (lam[0] * d.dw[0] - lam[free] * d.dw[free]) / lam[0]
 }
 
-/// Uniaxial tension/compression: `l1 = s`, `l2 = l3 = s^-1/2`, lateral stress free.
 pub fn uniaxial(law: &Law, p: &[f64], stretch: f64) -> f64 {
     let t = 1.0 / stretch.sqrt();
     nominal(law, p, [stretch, t, t], 2)
