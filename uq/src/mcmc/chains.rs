@@ -114,3 +114,48 @@ pub struct SampleRun {
     /// NUTS only: adapted step size per chain.
     pub step_size: Vec<f64>,
 }
+
+/// What one group of chains that run together returns (a DE-MCz population,
+/// an ensemble of walkers): draws `[chain][draw][dim]` in the standardised
+/// space, their log-densities, accepted proposals per chain, evaluations.
+pub(crate) struct GroupOut {
+    pub chains: Vec<Vec<Vec<f64>>>,
+    pub logp: Vec<Vec<f64>>,
+    pub accepted: Vec<usize>,
+    pub evaluations: u64,
+}
+
+impl SampleRun {
+    /// Concatenates the groups' chains in group order (fixed, so the result
+    /// does not depend on the thread count), maps the draws back from the
+    /// standardised space, and turns accepted counts into rates over
+    /// `iterations` post-warm-up proposals per chain.
+    pub(crate) fn from_groups(
+        sampler: &str,
+        groups: Vec<GroupOut>,
+        iterations: usize,
+        std: &super::standardized::Standardized<'_>,
+        started: std::time::Instant,
+    ) -> SampleRun {
+        let mut all = Vec::new();
+        let mut logp = Vec::new();
+        let mut acceptance = Vec::new();
+        let mut evaluations = 0;
+        for g in groups {
+            acceptance.extend(g.accepted.iter().map(|&a| a as f64 / iterations as f64));
+            all.extend(g.chains);
+            logp.extend(g.logp);
+            evaluations += g.evaluations;
+        }
+        SampleRun {
+            sampler: sampler.into(),
+            chains: Chains::from_nested(&all).map(|y| std.to_original(y)),
+            log_density: logp,
+            acceptance,
+            evaluations,
+            wall_time_s: started.elapsed().as_secs_f64(),
+            divergences: Vec::new(),
+            step_size: Vec::new(),
+        }
+    }
+}

@@ -20,7 +20,7 @@
 //! Independent populations run in parallel (rayon), each with its own random
 //! stream; every chain of every population is reported.
 
-use super::chains::{Chains, SampleRun};
+use super::chains::{GroupOut, SampleRun};
 use super::density::{Counted, LogDensity};
 use super::error::McmcError;
 use super::rng::{chain_rng, std_normal, uniform};
@@ -63,13 +63,6 @@ impl Default for DemcSettings {
     }
 }
 
-struct PopOut {
-    chains: Vec<Vec<Vec<f64>>>,
-    logp: Vec<Vec<f64>>,
-    accepted: Vec<usize>,
-    evaluations: u64,
-}
-
 fn run_population(
     density: &dyn LogDensity,
     start: &Start,
@@ -77,7 +70,7 @@ fn run_population(
     seed: u64,
     pop: usize,
     progress: Option<&(dyn Fn(u64) + Sync)>,
-) -> Result<PopOut, McmcError> {
+) -> Result<GroupOut, McmcError> {
     let d = density.dim();
     let mut rng = chain_rng(seed, pop);
     let mut w = Counted::new(density.worker());
@@ -150,7 +143,7 @@ fn run_population(
             }
         }
     }
-    Ok(PopOut {
+    Ok(GroupOut {
         chains,
         logp,
         accepted,
@@ -184,32 +177,15 @@ pub fn sample_demc(
         });
     }
     let t0 = std::time::Instant::now();
-    let outs: Vec<PopOut> = (0..settings.populations)
+    let outs: Vec<GroupOut> = (0..settings.populations)
         .into_par_iter()
         .map(|p| run_population(density, start, settings, seed, p, progress))
         .collect::<Result<_, _>>()?;
-    let mut all = Vec::new();
-    let mut logp = Vec::new();
-    let mut acceptance = Vec::new();
-    let mut evaluations = 0;
-    for o in outs {
-        acceptance.extend(
-            o.accepted
-                .iter()
-                .map(|&a| a as f64 / (settings.draws * settings.thin) as f64),
-        );
-        all.extend(o.chains);
-        logp.extend(o.logp);
-        evaluations += o.evaluations;
-    }
-    Ok(SampleRun {
-        sampler: "demc".into(),
-        chains: Chains::from_nested(&all).map(|y| std.to_original(y)),
-        log_density: logp,
-        acceptance,
-        evaluations,
-        wall_time_s: t0.elapsed().as_secs_f64(),
-        divergences: Vec::new(),
-        step_size: Vec::new(),
-    })
+    Ok(SampleRun::from_groups(
+        "demc",
+        outs,
+        settings.draws * settings.thin,
+        &std,
+        t0,
+    ))
 }

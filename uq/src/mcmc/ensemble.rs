@@ -12,7 +12,7 @@
 //! random stream; every walker is reported as a chain, as ArviZ does with
 //! emcee output.
 
-use super::chains::{Chains, SampleRun};
+use super::chains::{GroupOut, SampleRun};
 use super::density::{Counted, LogDensity};
 use super::error::McmcError;
 use super::rng::{chain_rng, uniform};
@@ -63,13 +63,6 @@ impl EnsembleSettings {
     }
 }
 
-struct EnsembleOut {
-    chains: Vec<Vec<Vec<f64>>>,
-    logp: Vec<Vec<f64>>,
-    accepted: Vec<usize>,
-    evaluations: u64,
-}
-
 fn run_one(
     density: &dyn LogDensity,
     start: &Start,
@@ -77,7 +70,7 @@ fn run_one(
     seed: u64,
     e: usize,
     progress: Option<&(dyn Fn(u64) + Sync)>,
-) -> Result<EnsembleOut, McmcError> {
+) -> Result<GroupOut, McmcError> {
     let d = density.dim();
     let nw = s.walkers_for(d);
     let mut rng = chain_rng(seed, e);
@@ -131,7 +124,7 @@ fn run_one(
             }
         }
     }
-    Ok(EnsembleOut {
+    Ok(GroupOut {
         chains,
         logp,
         accepted,
@@ -167,32 +160,15 @@ pub fn sample_ensemble(
         });
     }
     let t0 = std::time::Instant::now();
-    let outs: Vec<EnsembleOut> = (0..settings.ensembles)
+    let outs: Vec<GroupOut> = (0..settings.ensembles)
         .into_par_iter()
         .map(|e| run_one(density, start, settings, seed, e, progress))
         .collect::<Result<_, _>>()?;
-    let mut all = Vec::new();
-    let mut logp = Vec::new();
-    let mut acceptance = Vec::new();
-    let mut evaluations = 0;
-    for o in outs {
-        acceptance.extend(
-            o.accepted
-                .iter()
-                .map(|&a| a as f64 / (settings.draws * settings.thin) as f64),
-        );
-        all.extend(o.chains);
-        logp.extend(o.logp);
-        evaluations += o.evaluations;
-    }
-    Ok(SampleRun {
-        sampler: "ensemble".into(),
-        chains: Chains::from_nested(&all).map(|y| std.to_original(y)),
-        log_density: logp,
-        acceptance,
-        evaluations,
-        wall_time_s: t0.elapsed().as_secs_f64(),
-        divergences: Vec::new(),
-        step_size: Vec::new(),
-    })
+    Ok(SampleRun::from_groups(
+        "ensemble",
+        outs,
+        settings.draws * settings.thin,
+        &std,
+        t0,
+    ))
 }
