@@ -7,35 +7,17 @@
 //! applies the line and the column.
 
 use super::FactorColumn;
-use palpate_core::TextTable;
+use palpate_core::{DataError, TextTable};
 use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 /// Why a runs table could not be read or a column used.
 #[derive(Debug, Error)]
 pub enum RunsTableError {
-    /// The text layer (file, comments, header, field counts): palpate-core's reader.
+    /// The text layer (file, comments, header, field counts) and numeric
+    /// columns: palpate-core's errors, naming file, line and column.
     #[error(transparent)]
     Data(#[from] palpate_core::DataError),
-    #[error("{file}: missing column `{column}` (header has: {header})")]
-    MissingColumn {
-        file: PathBuf,
-        column: String,
-        header: String,
-    },
-    #[error("{file}:{line}: column `{column}`: `{value}` is not a number")]
-    NotNumeric {
-        file: PathBuf,
-        line: usize,
-        column: String,
-        value: String,
-    },
-    #[error("{file}:{line}: column `{column}`: value is NaN or infinite")]
-    NotFinite {
-        file: PathBuf,
-        line: usize,
-        column: String,
-    },
     #[error("{file}:{line}: column `{column}` is empty")]
     EmptyField {
         file: PathBuf,
@@ -101,11 +83,12 @@ impl RunsTable {
         self.names
             .iter()
             .position(|n| n == column)
-            .ok_or_else(|| RunsTableError::MissingColumn {
+            .ok_or_else(|| DataError::MissingColumn {
                 file: self.file.clone(),
                 column: column.to_string(),
                 header: self.names.join(","),
             })
+            .map_err(RunsTableError::from)
     }
 
     /// The column as strings.
@@ -126,7 +109,7 @@ impl RunsTable {
             .iter()
             .zip(&self.lines)
             .map(|(r, &line)| {
-                let v: f64 = r[k].parse().map_err(|_| RunsTableError::NotNumeric {
+                let v: f64 = r[k].parse().map_err(|_| DataError::NotNumeric {
                     file: self.file.clone(),
                     line,
                     column: column.to_string(),
@@ -135,14 +118,15 @@ impl RunsTable {
                 if v.is_finite() {
                     Ok(v)
                 } else {
-                    Err(RunsTableError::NotFinite {
+                    Err(DataError::NotFinite {
                         file: self.file.clone(),
                         line,
                         column: column.to_string(),
                     })
                 }
             })
-            .collect()
+            .collect::<Result<_, DataError>>()
+            .map_err(RunsTableError::from)
     }
 }
 
