@@ -1,52 +1,145 @@
-//! Benchmark: N1 (BENCHMARKS.md) neo-Hookean `ecoflex-nh`, friction 0.8,
-//! bonded base, exact incompressibility, needle to 10 mm with the force every
-//! 0.25 mm, on 1 and 2 threads; prints elements, unknowns, increments, Newton
-//! iterations, wall time and the force at 2, 5 and 10 mm. With `--ccx` it
-//! also runs CalculiX (`ccx` on the PATH) on the reference deck
-//! `../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp` in a temporary
-//! directory and times it.
+//! Benchmark (issue 3): N1 (BENCHMARKS.md) neo-Hookean `ecoflex-nh`,
+//! friction 0.8, bonded base, exact incompressibility, needle to 10 mm with
+//! the force every 0.25 mm, on 1 and 2 threads, against CalculiX on the
+//! reference deck `../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp`.
+//!
+//! Meshes: the benchmark mesh ([`MeshDensity::BENCH_GRADING`], the cheapest
+//! found as accurate as level 2) with the default 0.25 mm increments and
+//! with 0.125 mm increments (the increment error is ~0.1 % at 10 mm), and,
+//! for context, levels 1 and 2 (or the levels given as arguments). Each row
+//! prints elements, unknowns, increments, Newton iterations,
+//! factorisations, wall and CPU seconds (user + system of the whole process
+//! during the run, `/proc/self/stat`), assembly and factorise-and-solve wall
+//! seconds, the forces at 2, 5 and 10 mm, their distance from the force of
+//! level 5 ([`LEVEL5`]) and the distance at 10 mm from the Richardson
+//! extrapolation of levels 3, 4, 5 ([`EXTRAPOLATED_10MM`]). The CalculiX line quotes the run recorded in
+//! docs/validation/fe.md; `--ccx` reruns it (`ccx` on the PATH, one thread,
+//! ~10 min) and measures its wall and CPU time (the child's user + system).
 //!
 //! `cargo run --release -p palpate-fe --example bench_n1 -- [level ...] [--ccx]`
-//! (default levels 1 2).
 
 use std::path::Path;
 use std::time::Instant;
 
 use palpate_core::{Drive, Loading};
-use palpate_fe::{MeshDensity, N1Needle};
+use palpate_fe::mesh::Grading;
+use palpate_fe::{MeshDensity, N1Needle, RunStats};
 
 const C10: f64 = 1101.295e-6;
+const AT: [f64; 3] = [2.0, 5.0, 10.0];
+/// Force of level 5 (20615 elements, the finest mesh run) at 2, 5 and 10 mm
+/// (N): `convergence_n1 5`.
+const LEVEL5: [f64; 3] = [0.045322, 0.155379, 0.394378];
+/// Richardson extrapolation of levels 3, 4, 5 at 10 mm (observed order
+/// 1.46; other level triples give 0.3932-0.3938 N), all with 0.25 mm
+/// increments. docs/validation/fe.md, "N1 speed".
+const EXTRAPOLATED_10MM: f64 = 0.393700;
+/// CalculiX 2.20 n6 (480 CAX8R, K = 1000 mu, penalty contact, one thread),
+/// run once on this machine (docs/validation/fe.md): forces at 2, 5, 10 mm,
+/// unknowns, wall and user CPU seconds, and the README's wall time.
+const CCX_FORCES: [f64; 3] = [0.045461, 0.155403, 0.394390];
+const CCX_UNKNOWNS: usize = 3078;
+const CCX_WALL: f64 = 627.7;
+const CCX_CPU: f64 = 287.8;
+const CCX_README_WALL: f64 = 586.0;
 
-fn run(level: usize, threads: usize) -> (Vec<f64>, palpate_fe::RunStats, usize, usize, f64) {
+/// User + system CPU seconds of this process (`self`: fields 14, 15 of
+/// `/proc/self/stat`) or of its waited-for children (fields 16, 17), in
+/// clock ticks of 1/100 s (Linux USER_HZ). NaN off Linux.
+fn cpu_seconds(children: bool) -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit(')').next().unwrap_or("");
+    // after ")" only field 3 (state) is not numeric: field k is index k - 4
+    let f: Vec<f64> = after
+        .split_whitespace()
+        .filter_map(|s| s.parse().ok())
+        .collect();
+    let k = if children { 12 } else { 10 };
+    f.get(k)
+        .zip(f.get(k + 1))
+        .map_or(f64::NAN, |(u, s)| (u + s) / 100.0)
+}
+
+/// One mesh of the table.
+#[derive(Clone, Copy)]
+enum MeshChoice {
+    Level(usize),
+    Graded(&'static str, Grading),
+}
+
+/// One row of the table: a mesh and the largest increment (mm; `None`: the
+/// model's default, 0.25).
+#[derive(Clone, Copy)]
+struct Case {
+    mesh: MeshChoice,
+    max_step: Option<f64>,
+}
+
+impl Case {
+    fn label(&self) -> String {
+        let mesh = match self.mesh {
+            MeshChoice::Level(l) => format!("level {l}"),
+            MeshChoice::Graded(name, g) => {
+                format!("{name} ({}/{}/{})", g.h_fine, g.fine_length, g.growth)
+            }
+        };
+        match self.max_step {
+            Some(s) => format!("{mesh}, {s} mm steps"),
+            None => mesh,
+        }
+    }
+}
+
+struct Run {
+    forces: [f64; 3],
+    stats: RunStats,
+    elements: usize,
+    unknowns: usize,
+    wall: f64,
+    cpu: f64,
+    all_forces: Vec<f64>,
+}
+
+fn run(case: Case, threads: usize) -> Run {
     let mut m = N1Needle::new("neo-hookean".parse().expect("law"));
-    m.mesh = MeshDensity { level };
+    match case.mesh {
+        MeshChoice::Level(level) => m.mesh = MeshDensity { level },
+        MeshChoice::Graded(_, g) => m.grading = Some(g),
+    }
+    if let Some(s) = case.max_step {
+        m.options.max_step = s;
+    }
     let drive: Vec<f64> = (1..=40).map(|k| 0.25 * k as f64).collect();
     let loading = Loading::quasi_static(Drive::DisplacementMm, drive);
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .expect("thread pool");
-    let t = Instant::now();
+    let (t, c) = (Instant::now(), cpu_seconds(false));
     let (sim, solver) = pool
         .install(|| m.simulate(&[C10], &loading, None))
-        .unwrap_or_else(|e| panic!("level {level}: {e}"));
-    let wall = t.elapsed().as_secs_f64();
-    (
-        sim.forces,
-        sim.stats,
-        solver.mesh.elements.len(),
-        solver.equations(),
+        .unwrap_or_else(|e| panic!("{}: {e}", case.label()));
+    let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(false) - c);
+    let at = |d: f64| sim.forces[(d / 0.25).round() as usize - 1];
+    Run {
+        forces: [at(AT[0]), at(AT[1]), at(AT[2])],
+        stats: sim.stats,
+        elements: solver.mesh.elements.len(),
+        unknowns: solver.equations(),
         wall,
-    )
+        cpu,
+        all_forces: sim.forces,
+    }
 }
 
-fn calculix() -> Option<f64> {
+/// Reruns CalculiX on the reference deck: (wall, CPU) seconds.
+fn calculix() -> Option<(f64, f64)> {
     let deck = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp");
     let dir = std::env::temp_dir().join(format!("palpate_bench_ccx_{}", std::process::id()));
     std::fs::create_dir_all(&dir).ok()?;
     std::fs::copy(&deck, dir.join("n1.inp")).ok()?;
-    let t = Instant::now();
+    let (t, c) = (Instant::now(), cpu_seconds(true));
     let status = std::process::Command::new("ccx")
         .arg("-i")
         .arg("n1")
@@ -55,9 +148,23 @@ fn calculix() -> Option<f64> {
         .stdout(std::process::Stdio::null())
         .status()
         .ok()?;
-    let wall = t.elapsed().as_secs_f64();
+    let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(true) - c);
     std::fs::remove_dir_all(&dir).ok();
-    status.success().then_some(wall)
+    status.success().then_some((wall, cpu))
+}
+
+fn pct(a: f64, b: f64) -> f64 {
+    100.0 * (a - b) / b
+}
+
+fn distances(f: [f64; 3]) -> String {
+    format!(
+        "{:+.2} / {:+.2} / {:+.2} | {:+.2}",
+        pct(f[0], LEVEL5[0]),
+        pct(f[1], LEVEL5[1]),
+        pct(f[2], LEVEL5[2]),
+        pct(f[2], EXTRAPOLATED_10MM)
+    )
 }
 
 fn main() {
@@ -67,33 +174,91 @@ fn main() {
     if levels.is_empty() {
         levels = vec![1, 2];
     }
+    let bench = MeshChoice::Graded("bench", MeshDensity::BENCH_GRADING);
+    let mut cases = vec![
+        Case {
+            mesh: bench,
+            max_step: None,
+        },
+        Case {
+            mesh: bench,
+            max_step: Some(0.125),
+        },
+    ];
+    cases.extend(levels.iter().map(|&l| Case {
+        mesh: MeshChoice::Level(l),
+        max_step: None,
+    }));
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
-    println!("N1 ecoflex-nh, friction 0.8, exact incompressibility, 0..10 mm every 0.25 mm; machine cores: {cores}");
-    println!("| level | elements | unknowns | threads | increments | Newton iterations | factorisations | wall (s) | F(2) N | F(5) N | F(10) N | assembly (s) | solve (s) | loose |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
-    for &level in &levels {
+    println!(
+        "N1 ecoflex-nh, friction 0.8, exact incompressibility, 0..10 mm every 0.25 mm; machine cores: {cores}; \
+         CPU = user + system of the run; distances from level 5 {LEVEL5:?} N and at 10 mm from {EXTRAPOLATED_10MM} N (levels 3-4-5 extrapolated)"
+    );
+    println!("| mesh (h/zone/growth) | elements | unknowns | threads | increments | Newton iterations | factorisations | wall (s) | CPU (s) | assembly (s) | solve (s) | F(2) N | F(5) N | F(10) N | vs level 5 at 2/5/10 mm (%) | vs extrapolated at 10 mm (%) | loose |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let mut bench_runs: Vec<(String, usize, Run)> = Vec::new();
+    for &case in &cases {
         let mut first: Option<Vec<f64>> = None;
         for threads in [1, 2] {
-            let (f, s, ne, neq, wall) = run(level, threads);
+            let r = run(case, threads);
+            let s = &r.stats;
             println!(
-                "| {level} | {ne} | {neq} | {threads} | {} | {} | {} | {wall:.2} | {:.6} | {:.6} | {:.6} | {:.2} | {:.2} | {} |",
-                s.increments, s.iterations, s.factorisations, f[7], f[19], f[39], s.assembly_seconds, s.solve_seconds, s.loose
+                "| {} | {} | {} | {threads} | {} | {} | {} | {:.2} | {:.2} | {:.2} | {:.2} | {:.6} | {:.6} | {:.6} | {} | {} |",
+                case.label(),
+                r.elements,
+                r.unknowns,
+                s.increments,
+                s.iterations,
+                s.factorisations,
+                r.wall,
+                r.cpu,
+                s.assembly_seconds,
+                s.solve_seconds,
+                r.forces[0],
+                r.forces[1],
+                r.forces[2],
+                distances(r.forces),
+                s.loose
             );
             match &first {
-                None => first = Some(f),
+                None => first = Some(r.all_forces.clone()),
                 Some(g) => assert!(
-                    g.iter().zip(&f).all(|(a, b)| a.to_bits() == b.to_bits()),
+                    g.iter()
+                        .zip(&r.all_forces)
+                        .all(|(a, b)| a.to_bits() == b.to_bits()),
                     "forces differ between 1 and 2 threads"
                 ),
             }
+            if let MeshChoice::Graded(..) = case.mesh {
+                bench_runs.push((case.label(), threads, r));
+            }
         }
     }
+    println!(
+        "| CalculiX 2.20 n6 (480 CAX8R, K = 1000 mu, penalty contact; recorded) | 480 | {CCX_UNKNOWNS} | 1 | - | ~900 (README) | - | {CCX_WALL:.1} (README {CCX_README_WALL:.0}) | {CCX_CPU:.1} | - | - | {:.6} | {:.6} | {:.6} | {} | - |",
+        CCX_FORCES[0],
+        CCX_FORCES[1],
+        CCX_FORCES[2],
+        distances(CCX_FORCES)
+    );
+    let mut ccx = (CCX_WALL, CCX_CPU);
     if with_ccx {
         match calculix() {
-            Some(wall) => println!(
-                "| CalculiX n6 (480 CAX8R, K = 1000 mu, penalty contact) | 480 | 3078 | 1 | - | - | - | {wall:.1} | 0.045461 | 0.155403 | 0.394390 | - | - | - |"
-            ),
+            Some((wall, cpu)) => {
+                println!(
+                    "| CalculiX 2.20 n6 (rerun now) | 480 | {CCX_UNKNOWNS} | 1 | - | - | - | {wall:.1} | {cpu:.1} | - | - | - | - | - | - | - | - |"
+                );
+                ccx = (wall, cpu);
+            }
             None => println!("CalculiX: `ccx` not found or failed"),
         }
+    }
+    for (label, threads, r) in &bench_runs {
+        println!(
+            "speed-up of {label} on {threads} thread(s) against CalculiX: {:.0}x wall ({:.0}x against the README's {CCX_README_WALL:.0} s), {:.0}x CPU",
+            ccx.0 / r.wall,
+            CCX_README_WALL / r.wall,
+            ccx.1 / r.cpu
+        );
     }
 }

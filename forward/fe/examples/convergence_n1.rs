@@ -2,32 +2,130 @@
 //! friction 0.8, bonded base, exact incompressibility, force at 2, 5 and
 //! 10 mm on mesh levels 1, 2, 3 (element size 0.4 / level mm under the
 //! needle). Prints the forces, the differences between successive meshes,
-//! the observed order p from the three meshes (solving
+//! the observed order p from each three successive levels (solving
 //! `(F1 - F2) / (F2 - F3) = (h1^p - h2^p) / (h2^p - h3^p)`) and the
 //! Richardson-extrapolated force `F3 - (F2 - F3) h3^p / (h2^p - h3^p)`.
 //!
-//! `cargo run --release -p palpate-fe --example convergence_n1 -- [levels...]`
+//! Besides levels, an argument `h/zone/growth` (e.g. `0.2/3/1.1`) runs a
+//! custom grading ([`palpate_fe::mesh::Grading`]: fine element size, fine
+//! zone, outward growth), and every row prints its distance from the force
+//! of level 5 ([`LEVEL5`], 20615 elements, the finest run; its own distance
+//! from the converged force is in docs/validation/fe.md, "N1 speed"). Each
+//! run is on one thread; the CPU column is the process user + system time
+//! of the run (`/proc/self/stat`).
+//!
+//! `--max-step=S` (mm, default 0.25) and `--penalty=P` (default 100) change
+//! the increment size and the contact penalty factor, to separate their
+//! errors from the mesh's.
+//!
+//! `cargo run --release -p palpate-fe --example convergence_n1 -- [level | h/zone/growth ...] [--max-step=S] [--penalty=P]`
 
-use palpate_core::{Drive, ForwardModel, Loading};
+use palpate_core::{Drive, Loading};
+use palpate_fe::mesh::Grading;
 use palpate_fe::{MeshDensity, N1Needle};
 
 const C10: f64 = 1101.295e-6;
 const AT: [f64; 3] = [2.0, 5.0, 10.0];
+/// Force of level 5 at 2, 5 and 10 mm (N): `convergence_n1 5` (222 s CPU).
+const LEVEL5: [f64; 3] = [0.045322, 0.155379, 0.394378];
 
-fn forces(level: usize) -> (Vec<f64>, usize, f64) {
-    let mut m = N1Needle::new("neo-hookean".parse().expect("law"));
-    m.mesh = MeshDensity { level };
-    let drive: Vec<f64> = (1..=40).map(|k| 0.25 * k as f64).collect();
-    let t = std::time::Instant::now();
-    let f = m
-        .predict(&[C10], &Loading::quasi_static(Drive::DisplacementMm, drive))
-        .unwrap_or_else(|e| panic!("level {level}: {e}"));
-    let elements = m.build_mesh().map(|m| m.elements.len()).unwrap_or(0);
-    let picked = AT
-        .iter()
-        .map(|d| f[(d / 0.25).round() as usize - 1])
+/// A mesh to run: a standard level or a custom grading.
+#[derive(Clone, Copy)]
+enum Case {
+    Level(usize),
+    Graded(Grading),
+}
+
+impl Case {
+    fn parse(arg: &str) -> Option<Case> {
+        if let Ok(level) = arg.parse() {
+            return Some(Case::Level(level));
+        }
+        let v: Vec<f64> = arg.split('/').filter_map(|s| s.parse().ok()).collect();
+        (v.len() == 3).then(|| {
+            Case::Graded(Grading {
+                h_fine: v[0],
+                fine_length: v[1],
+                growth: v[2],
+            })
+        })
+    }
+    fn label(&self) -> String {
+        match self {
+            Case::Level(l) => format!("level {l}"),
+            Case::Graded(g) => format!("{}/{}/{}", g.h_fine, g.fine_length, g.growth),
+        }
+    }
+    fn h_fine(&self) -> f64 {
+        match self {
+            Case::Level(l) => MeshDensity { level: *l }.h_fine(),
+            Case::Graded(g) => g.h_fine,
+        }
+    }
+}
+
+/// User + system CPU seconds of this process so far (Linux `/proc/self/stat`,
+/// fields 14 and 15 in clock ticks of 1/100 s).
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit(')').next().unwrap_or("");
+    let f: Vec<f64> = after
+        .split_whitespace()
+        .filter_map(|s| s.parse().ok())
         .collect();
-    (picked, elements, t.elapsed().as_secs_f64())
+    // after the ")" field 3 (state) is not numeric, so utime/stime are 11, 12
+    f.get(10)
+        .zip(f.get(11))
+        .map_or(f64::NAN, |(u, s)| (u + s) / 100.0)
+}
+
+struct Row {
+    forces: [f64; 3],
+    elements: usize,
+    unknowns: usize,
+    wall: f64,
+    cpu: f64,
+}
+
+/// Solver knobs that are not the mesh.
+#[derive(Clone, Copy)]
+struct Knobs {
+    max_step: Option<f64>,
+    penalty: Option<f64>,
+}
+
+fn forces(case: Case, knobs: Knobs) -> Row {
+    let mut m = N1Needle::new("neo-hookean".parse().expect("law"));
+    if let Some(s) = knobs.max_step {
+        m.options.max_step = s;
+    }
+    if let Some(p) = knobs.penalty {
+        m.penalty = p;
+    }
+    match case {
+        Case::Level(level) => m.mesh = MeshDensity { level },
+        Case::Graded(g) => m.grading = Some(g),
+    }
+    let drive: Vec<f64> = (1..=40).map(|k| 0.25 * k as f64).collect();
+    let loading = Loading::quasi_static(Drive::DisplacementMm, drive);
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("thread pool");
+    let (t, c) = (std::time::Instant::now(), cpu_seconds());
+    let (sim, solver) = pool
+        .install(|| m.simulate(&[C10], &loading, None))
+        .unwrap_or_else(|e| panic!("{}: {e}", case.label()));
+    let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - c);
+    let f = &sim.forces;
+    let at = |d: f64| f[(d / 0.25).round() as usize - 1];
+    Row {
+        forces: [at(AT[0]), at(AT[1]), at(AT[2])],
+        elements: solver.mesh.elements.len(),
+        unknowns: solver.equations(),
+        wall,
+        cpu,
+    }
 }
 
 /// Observed order from three meshes (bisection on p in [0.2, 6]).
@@ -49,29 +147,54 @@ fn order(h: [f64; 3], f: [f64; 3]) -> Option<f64> {
     Some(0.5 * (lo + hi))
 }
 
+fn pct(a: f64, b: f64) -> f64 {
+    100.0 * (a - b) / b
+}
+
 fn main() {
-    let mut levels: Vec<usize> = std::env::args()
-        .skip(1)
-        .filter_map(|a| a.parse().ok())
-        .collect();
-    if levels.is_empty() {
-        levels = vec![1, 2, 3];
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let flag = |name: &str| -> Option<f64> {
+        args.iter()
+            .find_map(|a| a.strip_prefix(name))
+            .and_then(|v| v.parse().ok())
+    };
+    let knobs = Knobs {
+        max_step: flag("--max-step="),
+        penalty: flag("--penalty="),
+    };
+    let mut cases: Vec<Case> = args.iter().filter_map(|a| Case::parse(a)).collect();
+    if cases.is_empty() {
+        cases = vec![Case::Level(1), Case::Level(2), Case::Level(3)];
     }
-    println!("| level | h (mm) | elements | F(2) N | F(5) N | F(10) N | wall (s) |");
-    println!("|---|---|---|---|---|---|---|");
-    let mut rows = Vec::new();
-    for &l in &levels {
-        let (f, ne, wall) = forces(l);
-        let h = MeshDensity { level: l }.h_fine();
+    println!("Distances from the force of level 5 {LEVEL5:?} N; one thread per run.");
+    println!("| mesh (h/zone/growth) | h (mm) | elements | unknowns | F(2) N | F(5) N | F(10) N | vs level 5 at 2/5/10 mm (%) | wall (s) | CPU (s) |");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
+    let mut levels = Vec::new();
+    for case in cases {
+        let r = forces(case, knobs);
+        let f = r.forces;
         println!(
-            "| {l} | {h:.4} | {ne} | {:.6} | {:.6} | {:.6} | {wall:.1} |",
-            f[0], f[1], f[2]
+            "| {} | {:.4} | {} | {} | {:.6} | {:.6} | {:.6} | {:+.3} / {:+.3} / {:+.3} | {:.1} | {:.1} |",
+            case.label(),
+            case.h_fine(),
+            r.elements,
+            r.unknowns,
+            f[0],
+            f[1],
+            f[2],
+            pct(f[0], LEVEL5[0]),
+            pct(f[1], LEVEL5[1]),
+            pct(f[2], LEVEL5[2]),
+            r.wall,
+            r.cpu
         );
-        rows.push((h, f));
+        if let Case::Level(_) = case {
+            levels.push((case.h_fine(), f));
+        }
     }
-    for w in rows.windows(2) {
+    for w in levels.windows(2) {
         let rel: Vec<String> = (0..3)
-            .map(|k| format!("{:+.3} %", 100.0 * (w[1].1[k] - w[0].1[k]) / w[1].1[k]))
+            .map(|k| format!("{:+.3} %", pct(w[1].1[k], w[0].1[k])))
             .collect();
         println!(
             "h {:.4} -> {:.4}: change at 2/5/10 mm {}",
@@ -80,7 +203,7 @@ fn main() {
             rel.join(" / ")
         );
     }
-    for w in rows.windows(3) {
+    for w in levels.windows(3) {
         let h = [w[0].0, w[1].0, w[2].0];
         for (k, d) in AT.iter().enumerate() {
             let f = [w[0].1[k], w[1].1[k], w[2].1[k]];
@@ -88,8 +211,9 @@ fn main() {
                 Some(p) => {
                     let ext = f[2] - (f[1] - f[2]) * h[2].powf(p) / (h[1].powf(p) - h[2].powf(p));
                     println!(
-                        "at {d} mm: observed order {p:.2}, extrapolated {ext:.6} N (finest {:+.3} % from it)",
-                        100.0 * (f[2] - ext) / ext
+                        "h {:.4}/{:.4}/{:.4} at {d} mm: observed order {p:.2}, extrapolated {ext:.6} N (finest {:+.3} % from it)",
+                        h[0], h[1], h[2],
+                        pct(f[2], ext)
                     );
                 }
                 None => println!("at {d} mm: not monotone, no order"),
