@@ -8,8 +8,9 @@
 //!   = (16/3) mu sqrt(R) d^{3/2},  mu = 2 C10
 //! ```
 //!
-//! and for the exact sphere instead of its paraboloid (Sneddon 1965,
-//! *Int. J. Eng. Sci.* 3, 47, eq. 6.13-6.14; Johnson 1985 sec. 5.2):
+//! and for the exact sphere instead of its paraboloid (Sneddon 1965, "The
+//! relation between load and penetration in the axisymmetric Boussinesq
+//! problem for a punch of arbitrary profile", *Int. J. Eng. Sci.* 3, 47):
 //!
 //! ```text
 //! d = (a / 2) ln((R + a) / (R - a)),
@@ -19,10 +20,11 @@
 //! Both are small-strain half-space solutions. The FE force at d = 0.1 R is
 //! 3.7 % below Hertz, 2.7 % below Sneddon; docs/validation/fe.md ("Hertz")
 //! splits this into the sphere shape (-1.0 %), the finite cylinder (-1.0 %,
-//! measured by enlarging it) and finite-strain neo-Hookean behaviour
-//! (-1.7 %), and an independent CalculiX model of the same problem
-//! (docs/validation/hertz/) gives the same force within its own
-//! uncertainty.
+//! measured by enlarging it) and finite deformation (-1.7 %, growing like
+//! a / R), and an independent CalculiX model of the same problem
+//! (docs/validation/hertz/) is 4.0 % below Hertz: ours is 0.2-0.4 % above
+//! it, within its own uncertainty. The 3 % target of issue 3 holds against
+//! Sneddon to 0.1 R and against Hertz to 0.06 R only.
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -37,14 +39,15 @@ const MU: f64 = 2.0 * C10;
 const R: f64 = 2.5;
 /// Depths of the default run (0.02 R .. 0.1 R).
 const DEPTHS: [f64; 5] = [0.05, 0.1, 0.15, 0.2, 0.25];
-/// The CalculiX curve compared with (docs/validation/hertz/: neo-Hookean,
-/// K = 1000 mu, 0.1 mm CAX8R under the sphere, penalty 100 MPa/mm).
-const CCX_REFERENCE: &str = "ccx_nh_k1000_n10_p100.csv";
-/// Its uncertainty (docs/validation/fe.md, "Hertz"): mesh (0.1 mm against
-/// 0.05 mm CAX8R: <= 0.6 %, contact-discretisation ripple +-0.3 %),
-/// penalty (10 against 100 MPa/mm: <= 0.2 % at 0.05 mm, so <= 0.03 % at
-/// 100), K = 1000 mu against exact incompressibility (0.1 %).
-const CCX_TOLERANCE: f64 = 0.01;
+/// The CalculiX curve compared with (docs/validation/hertz/nh_n20_d6.inp:
+/// neo-Hookean, K = 1000 mu, 0.05 mm CAX8R under the sphere, face-to-face
+/// penalty contact 100 MPa/mm).
+const CCX_REFERENCE: &str = "ccx_nh_k1000_n20_p100.csv";
+/// Its uncertainty (docs/validation/fe.md, "Hertz"): mesh (0.1 against
+/// 0.05 mm CAX8R: 0.6 % at 0.05 mm, <= 0.2 % from 0.1 mm), contact ripple
+/// (+-0.2 %), penalty (10 against 100 MPa/mm: <= 0.2 % at 0.05 mm, so
+/// <= 0.03 % at 100), K = 1000 mu against exact incompressibility (0.1 %).
+const CCX_TOLERANCE: f64 = 0.0075;
 
 /// Hertz (paraboloid) force of an incompressible half-space, E* = 4 mu.
 fn hertz(d: f64) -> f64 {
