@@ -10,9 +10,8 @@
 //! prints elements, unknowns, increments, Newton iterations,
 //! factorisations, wall and CPU seconds (user + system of the whole process
 //! during the run, `/proc/self/stat`), assembly and factorise-and-solve wall
-//! seconds, the forces at 2, 5 and 10 mm, their distance from the force of
-//! level 5 ([`LEVEL5`]) and the distance at 10 mm from the Richardson
-//! extrapolation of levels 3, 4, 5 ([`EXTRAPOLATED_10MM`]). The CalculiX line quotes the run recorded in
+//! seconds, the forces at 2, 5 and 10 mm and their distance from the best
+//! estimate of the converged force ([`CONVERGED`]). The CalculiX line quotes the run recorded in
 //! docs/validation/fe.md; `--ccx` reruns it (`ccx` on the PATH, one thread,
 //! ~10 min) and measures its wall and CPU time (the child's user + system).
 //!
@@ -27,13 +26,12 @@ use palpate_fe::{MeshDensity, N1Needle, RunStats};
 
 const C10: f64 = 1101.295e-6;
 const AT: [f64; 3] = [2.0, 5.0, 10.0];
-/// Force of level 5 (20615 elements, the finest mesh run) at 2, 5 and 10 mm
-/// (N): `convergence_n1 5`.
-const LEVEL5: [f64; 3] = [0.045322, 0.155379, 0.394378];
-/// Richardson extrapolation of levels 3, 4, 5 at 10 mm (observed order
-/// 1.46; other level triples give 0.3932-0.3938 N), all with 0.25 mm
-/// increments. docs/validation/fe.md, "N1 speed".
-const EXTRAPOLATED_10MM: f64 = 0.393700;
+/// Best estimate of the converged force (mesh and increments) at 2, 5 and
+/// 10 mm (N): Richardson extrapolation of levels 2, 3 and 5 run with
+/// 0.125 mm increments (`convergence_n1 2 3 5 --max-step=0.125`; order 1.2
+/// at 10 mm, orders 1 to 1.5 at 2 and 5 mm, the middle value taken), about
+/// +-0.1 % uncertain at 5 and 10 mm. docs/validation/fe.md, "N1 speed".
+const CONVERGED: [f64; 3] = [0.045312, 0.155020, 0.393390];
 /// CalculiX 2.20 n6 (480 CAX8R, K = 1000 mu, penalty contact, one thread),
 /// run once on this machine (docs/validation/fe.md): forces at 2, 5, 10 mm,
 /// unknowns, wall and user CPU seconds, and the README's wall time.
@@ -159,11 +157,10 @@ fn pct(a: f64, b: f64) -> f64 {
 
 fn distances(f: [f64; 3]) -> String {
     format!(
-        "{:+.2} / {:+.2} / {:+.2} | {:+.2}",
-        pct(f[0], LEVEL5[0]),
-        pct(f[1], LEVEL5[1]),
-        pct(f[2], LEVEL5[2]),
-        pct(f[2], EXTRAPOLATED_10MM)
+        "{:+.2} / {:+.2} / {:+.2}",
+        pct(f[0], CONVERGED[0]),
+        pct(f[1], CONVERGED[1]),
+        pct(f[2], CONVERGED[2])
     )
 }
 
@@ -192,10 +189,10 @@ fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!(
         "N1 ecoflex-nh, friction 0.8, exact incompressibility, 0..10 mm every 0.25 mm; machine cores: {cores}; \
-         CPU = user + system of the run; distances from level 5 {LEVEL5:?} N and at 10 mm from {EXTRAPOLATED_10MM} N (levels 3-4-5 extrapolated)"
+         CPU = user + system of the run; vs converged = distance from {CONVERGED:?} N"
     );
-    println!("| mesh (h/zone/growth) | elements | unknowns | threads | increments | Newton iterations | factorisations | wall (s) | CPU (s) | assembly (s) | solve (s) | F(2) N | F(5) N | F(10) N | vs level 5 at 2/5/10 mm (%) | vs extrapolated at 10 mm (%) | loose |");
-    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    println!("| mesh (h/zone/growth) | elements | unknowns | threads | increments | Newton iterations | factorisations | wall (s) | CPU (s) | assembly (s) | solve (s) | F(2) N | F(5) N | F(10) N | vs converged at 2/5/10 mm (%) | loose |");
+    println!("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     let mut bench_runs: Vec<(String, usize, Run)> = Vec::new();
     for &case in &cases {
         let mut first: Option<Vec<f64>> = None;
@@ -246,7 +243,7 @@ fn main() {
         match calculix() {
             Some((wall, cpu)) => {
                 println!(
-                    "| CalculiX 2.20 n6 (rerun now) | 480 | {CCX_UNKNOWNS} | 1 | - | - | - | {wall:.1} | {cpu:.1} | - | - | - | - | - | - | - | - |"
+                    "| CalculiX 2.20 n6 (rerun now) | 480 | {CCX_UNKNOWNS} | 1 | - | - | - | {wall:.1} | {cpu:.1} | - | - | - | - | - | - | - |"
                 );
                 ccx = (wall, cpu);
             }
