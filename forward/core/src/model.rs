@@ -68,6 +68,16 @@ pub trait ForwardModel: Send + Sync {
         v
     }
 
+    /// Whether one prediction is expensive (a nonlinear finite-element
+    /// solve taking seconds rather than microseconds). Estimators may then
+    /// choose cheaper strategies, e.g. the gap diagnosis cross-validates by
+    /// a linearised refit instead of one refit per left-out block. A
+    /// property of the model, not a timing, so that results do not depend on
+    /// the machine. Default: `false`.
+    fn expensive(&self) -> bool {
+        false
+    }
+
     /// Predictions for one parameter vector (convenience: makes an evaluator).
     fn predict(&self, theta: &[f64], loading: &Loading) -> Result<Vec<f64>, ForwardError> {
         let mut out = vec![0.0; loading.len()];

@@ -143,4 +143,8 @@ impl ForwardModel for C1Fe {
             solver: None,
         })
     }
+    /// A nonlinear FE solve per prediction.
+    fn expensive(&self) -> bool {
+        true
+    }
 }

@@ -273,6 +273,10 @@ impl ForwardModel for N1Needle {
             solver: None,
         })
     }
+    /// A nonlinear FE solve per prediction (seconds).
+    fn expensive(&self) -> bool {
+        true
+    }
     fn effects(&self) -> Vec<Effect> {
         let mut v = Vec::new();
         if !self.friction_is_parameter {

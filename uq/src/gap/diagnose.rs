@@ -3,7 +3,9 @@
 use super::fit::{fit_from_starts, Fitted};
 use super::noise::difference_noise_sd;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
-use super::score::{projected_columns, score_test, sensitivities, sensitivity_overlap};
+use super::score::{
+    projected_columns, score_test, sensitivities, sensitivities_of, sensitivity_overlap,
+};
 use super::structure::{
     chi2_isf, chi2_sf, default_window, discrepancy_band, lag1, significant_windows, whiteness,
 };
@@ -160,6 +162,76 @@ fn time_constant_starts(
         .collect()
 }
 
+/// A start for the new parameters of an enrichment whose "off" value sits on
+/// a bound of a finite range (e.g. friction 0 in [0, 2]): a tenth of the
+/// range inside it. The fits run in an unbounded transform (logit) in which
+/// a bound lies at infinity, so a fit started at "off" barely moves, and the
+/// Gauss-Newton step from "off" is only as good as the local sensitivity of
+/// an effect that may be strongly nonlinear (friction saturates as the
+/// contact sticks). `None` when no new parameter is on such a bound.
+fn off_bound_start(rich: &dyn ForwardModel, p: usize, off: &[f64]) -> Option<Vec<f64>> {
+    let specs = &rich.space().params;
+    let mut s = off.to_vec();
+    let mut moved = false;
+    for j in p..specs.len() {
+        let (lo, hi) = (specs[j].lower, specs[j].upper);
+        let range = hi - lo;
+        if !range.is_finite() || range <= 0.0 {
+            continue;
+        }
+        if off[j] <= lo {
+            s[j] = lo + 0.1 * range;
+            moved = true;
+        } else if off[j] >= hi {
+            s[j] = hi - 0.1 * range;
+            moved = true;
+        }
+    }
+    moved.then_some(s)
+}
+
+/// For an expensive model: the starts ordered by the misfit each reaches
+/// with its moduli (parameters in MPa) scaled by the least-squares factor
+/// a = <f, y> / <f, f> (one prediction per start; exact for laws whose energy
+/// is linear in the moduli under a prescribed displacement), scaled so. The
+/// refit then runs from the first and falls back on the next only when that
+/// fit fails. A start whose prediction fails goes last, unscaled.
+fn screen_starts(
+    model: &dyn ForwardModel,
+    loading: &Loading,
+    observed: &[f64],
+    starts: Vec<Vec<f64>>,
+) -> Vec<Vec<f64>> {
+    let specs = &model.space().params;
+    let mut scored: Vec<(f64, Vec<f64>)> = starts
+        .into_par_iter()
+        .map(|s| {
+            let Ok(f) = model.predict(&s, loading) else {
+                return (f64::INFINITY, s);
+            };
+            let ff: f64 = f.iter().map(|v| v * v).sum();
+            let fy: f64 = f.iter().zip(observed).map(|(a, b)| a * b).sum();
+            let a = fy / ff;
+            if !(a.is_finite() && a > 0.0) {
+                return (f64::INFINITY, s);
+            }
+            let misfit: f64 = f
+                .iter()
+                .zip(observed)
+                .map(|(v, y)| (y - a * v).powi(2))
+                .sum();
+            let scaled = specs
+                .iter()
+                .zip(&s)
+                .map(|(spec, v)| if spec.unit == "MPa" { v * a } else { *v })
+                .collect();
+            (misfit, scaled)
+        })
+        .collect();
+    scored.sort_by(|x, y| x.0.total_cmp(&y.0));
+    scored.into_iter().map(|(_, s)| s).collect()
+}
+
 /// Contiguous blocks [first, end) of `n` samples.
 fn blocks(n: usize, folds: usize) -> Vec<(usize, usize)> {
     (0..folds)
@@ -183,15 +255,128 @@ fn cross_validate(
     let mut out = vec![0.0; n];
     for &(a, b) in folds {
         let keep: Vec<usize> = (0..a).chain(b..n).collect();
-        let mut fitted =
-            fit_from_starts(model, loading, observed, Some(&keep), &starts[..1], fixed);
+        let mut fitted = fit_from_starts(
+            model,
+            loading,
+            observed,
+            Some(&keep),
+            &starts[..1],
+            fixed,
+            false,
+        );
         if fitted.is_err() && starts.len() > 1 {
-            fitted = fit_from_starts(model, loading, observed, Some(&keep), &starts[1..], fixed);
+            fitted = fit_from_starts(
+                model,
+                loading,
+                observed,
+                Some(&keep),
+                &starts[1..],
+                fixed,
+                false,
+            );
         }
         let fitted = fitted?;
         out[a..b].copy_from_slice(&fitted.predicted[a..b]);
     }
     Ok(out)
+}
+
+/// Linearised blocked cross-validation
+/// ([`CrossValidation::Linearised`](super::CrossValidation::Linearised)):
+/// with the sensitivities J of the free parameters at the full-record
+/// optimum (predictions f, residuals r = y - f), each block B is predicted by
+/// one Gauss-Newton step fitted to the other samples K,
+///
+/// ```text
+/// delta_B = argmin || r_K - J_K delta ||,   prediction_B = f_B + J_B delta_B,
+/// ```
+///
+/// the first-order approximation of the refit without B (approximate
+/// cross-validation: Beirami et al. 2017, "On optimal generalizability in
+/// parametric learning"; Stephenson & Broderick 2020). Columns are scaled to
+/// unit norm and solved by SVD (singular values below 1e-10 of the largest
+/// dropped); a step that would cross a parameter's bound drops that
+/// parameter from the step (it stays at its optimum), as a bounded refit would.
+fn cross_validate_linearised(
+    model: &dyn ForwardModel,
+    loading: &Loading,
+    observed: &[f64],
+    folds: &[(usize, usize)],
+    fitted: &Fitted,
+    fixed: &[(String, f64)],
+) -> Result<Vec<f64>, GapError> {
+    let n = observed.len();
+    let specs = &model.space().params;
+    let free: Vec<bool> = specs
+        .iter()
+        .map(|s| !fixed.iter().any(|(name, _)| *name == s.name))
+        .collect();
+    let jac = sensitivities_of(model, &fitted.theta, loading, &free)?;
+    let r = residuals(observed, &fitted.predicted);
+    let mut out = fitted.predicted.clone();
+    for &(a, b) in folds {
+        let keep: Vec<usize> = (0..a).chain(b..n).collect();
+        let mut active: Vec<usize> = (0..specs.len())
+            .filter(|&j| free[j] && jac.column(j).norm() > 0.0)
+            .collect();
+        let delta = loop {
+            if active.is_empty() {
+                break Vec::new();
+            }
+            let norms: Vec<f64> = active.iter().map(|&j| jac.column(j).norm()).collect();
+            let m = DMatrix::from_fn(keep.len(), active.len(), |i, k| {
+                jac[(keep[i], active[k])] / norms[k]
+            });
+            let rhs = nalgebra::DVector::from_iterator(keep.len(), keep.iter().map(|&i| r[i]));
+            let svd = m.svd(true, true);
+            let tol = 1e-10 * svd.singular_values.amax();
+            let scaled = svd
+                .solve(&rhs, tol)
+                .map_err(|reason| GapError::InvalidOption {
+                    option: "cross_validation",
+                    reason: format!("linearised refit failed: {reason}"),
+                })?;
+            let d: Vec<f64> = scaled.iter().zip(&norms).map(|(x, s)| x / s).collect();
+            let crossing = active.iter().zip(&d).position(|(&j, dj)| {
+                let x = fitted.theta[j] + dj;
+                x < specs[j].lower || x > specs[j].upper
+            });
+            match crossing {
+                Some(k) => {
+                    active.remove(k);
+                }
+                None => break d,
+            }
+        };
+        for (i, o) in out.iter_mut().enumerate().take(b).skip(a) {
+            *o += active
+                .iter()
+                .zip(&delta)
+                .map(|(&j, dj)| jac[(i, j)] * dj)
+                .sum::<f64>();
+        }
+    }
+    Ok(out)
+}
+
+/// Blocked cross-validation by the strategy the options and the model's
+/// cost select.
+#[allow(clippy::too_many_arguments)]
+fn cross_validate_by(
+    linearised: bool,
+    model: &Arc<dyn ForwardModel>,
+    loading: &Loading,
+    observed: &[f64],
+    folds: &[(usize, usize)],
+    fitted: &Fitted,
+    starts: &[Vec<f64>],
+    fixed: &[(String, f64)],
+) -> Result<Vec<f64>, GapError> {
+    if linearised {
+        cross_validate_linearised(model.as_ref(), loading, observed, folds, fitted, fixed)
+    } else {
+        cross_validate(model, loading, observed, folds, starts, fixed)
+    }
 }
 
 /// Prony terms (`g<i>`, `tau<i>_s`) of a parameter map relabelled by
@@ -232,6 +417,10 @@ struct Context<'a> {
     candidates: usize,
     alpha: f64,
     rel_var_sd2: f64,
+    /// Blocked cross-validation by one linearised step per block.
+    linearised: bool,
+    /// The model is expensive: fewer starts per refit.
+    expensive: bool,
 }
 
 /// A candidate's ranking entry, its full-record fit and its projected
@@ -259,21 +448,62 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
             gn[j] = x;
         }
     }
-    let mut starts = vec![gn, off.clone()];
     let duration = ctx
         .loading
         .time
         .as_ref()
         .map(|t| t[t.len() - 1] - t[0])
         .unwrap_or(0.0);
-    starts.extend(time_constant_starts(rich.as_ref(), p, &off, duration));
-    let full = fit_from_starts(&rich, ctx.loading, ctx.observed, None, &starts, &[])?;
-    let cv_starts = vec![full.theta.clone(), starts[0].clone(), starts[1].clone()];
-    let cv = cross_validate(
+    let grid = time_constant_starts(rich.as_ref(), p, &off, duration);
+    let mut starts = vec![gn];
+    if grid.is_empty() {
+        starts.extend(off_bound_start(rich.as_ref(), p, &off));
+    }
+    starts.push(off.clone());
+    starts.extend(grid);
+    let mut unique: Vec<Vec<f64>> = Vec::new();
+    for st in starts {
+        if !unique.contains(&st) {
+            unique.push(st);
+        }
+    }
+    let mut starts = unique;
+    if ctx.expensive {
+        starts = screen_starts(rich.as_ref(), ctx.loading, ctx.observed, starts);
+    }
+    let full = if ctx.expensive {
+        // From the best screened start; the next ones only if it fails.
+        let mut outcome = Err(GapError::InvalidOption {
+            option: "starts",
+            reason: "no starting point".into(),
+        });
+        for start in &starts {
+            outcome = fit_from_starts(
+                &rich,
+                ctx.loading,
+                ctx.observed,
+                None,
+                std::slice::from_ref(start),
+                &[],
+                true,
+            );
+            if outcome.is_ok() {
+                break;
+            }
+        }
+        outcome?
+    } else {
+        fit_from_starts(&rich, ctx.loading, ctx.observed, None, &starts, &[], false)?
+    };
+    let mut cv_starts = vec![full.theta.clone()];
+    cv_starts.extend(starts.iter().take(2).cloned());
+    let cv = cross_validate_by(
+        ctx.linearised,
         &rich,
         ctx.loading,
         ctx.observed,
         &ctx.folds,
+        &full,
         &cv_starts,
         &[],
     )?;
@@ -281,7 +511,10 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
     let r_after = residuals(ctx.observed, &full.predicted);
     let sigma2 = ctx.sigma * ctx.sigma;
     let lr = (ctx.base_full.sse - full.sse) / sigma2;
-    let lr_p = chi2_sf(lr, q as f64);
+    // A discrete switch (q = 0, e.g. bonded -> sliding base) is a
+    // non-nested alternative: charged as one parameter.
+    let lr_dof = q.max(1);
+    let lr_p = chi2_sf(lr, lr_dof as f64);
     let h_before = residuals(ctx.observed, &ctx.base_cv);
     let h_after = residuals(ctx.observed, &cv);
     let later = ctx.folds[ctx.folds.len() - 1].0;
@@ -289,8 +522,8 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
     let dev_base = ar1_deviance(&ctx.base_residual);
     let dev_rich = ar1_deviance(&r_after);
     let nf = n as f64;
-    let delta_aic = dev_rich - dev_base + 2.0 * q as f64;
-    let delta_bic = dev_rich - dev_base + q as f64 * nf.ln();
+    let delta_aic = dev_rich - dev_base + 2.0 * lr_dof as f64;
+    let delta_bic = dev_rich - dev_base + lr_dof as f64 * nf.ln();
     let lr_level = ctx.alpha / ctx.candidates.max(1) as f64;
     let gain_threshold = chi2_isf(ctx.alpha, 1.0);
     let earns = lr_p < lr_level && heldout_gain > gain_threshold;
@@ -333,7 +566,7 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
         .fold(0.0, f64::max);
     let after = whiteness(&r_after, specs.len(), ctx.sigma, ctx.rel_var_sd2);
     let evidence = format!(
-        "score test {:.1} on {} dof (p = {:.1e}); refit: likelihood ratio {:.1} on {q} parameters (p = {:.1e}, \
+        "score test {:.1} on {} dof (p = {:.1e}); refit: likelihood ratio {:.1} on {lr_dof} parameter(s) (p = {:.1e}, \
          needs < {:.1e}); blocked cross-validation gain {:.1} (needs > {:.1}), held-out RMS {:.3e} -> {:.3e} \
          (later segment {:.3e} -> {:.3e}); dAIC {:.1}, dBIC {:.1} \
          under AR(1) errors; residual RMS/noise {:.2} -> {:.2}, runs p {:.1e} -> {:.1e}; {}",
@@ -434,11 +667,29 @@ pub fn diagnose(
         .iter()
         .map(|s| proxy.embed(s))
         .collect();
-    let base_full = fit_from_starts(&proxy, loading, observed, None, &starts, &fixed)?;
+    let expensive = base.expensive();
+    let linearised = options.cross_validation.linearised(expensive);
+    // An expensive model is fitted from the first start only, the others
+    // being fallbacks when that fit fails.
+    let mut base_fit = fit_from_starts(
+        &proxy,
+        loading,
+        observed,
+        None,
+        if expensive { &starts[..1] } else { &starts },
+        &fixed,
+        expensive,
+    );
+    if base_fit.is_err() && expensive && starts.len() > 1 {
+        base_fit = fit_from_starts(&proxy, loading, observed, None, &starts[1..], &fixed, true);
+    }
+    let base_full = base_fit?;
     let base_theta = base_full.theta[..p].to_vec();
     let mut cv_starts = vec![base_full.theta.clone()];
     cv_starts.extend(starts.iter().cloned());
-    let base_cv = cross_validate(&proxy, loading, observed, &folds, &cv_starts, &fixed)?;
+    let base_cv = cross_validate_by(
+        linearised, &proxy, loading, observed, &folds, &base_full, &cv_starts, &fixed,
+    )?;
     let base_residual = residuals(observed, &base_full.predicted);
 
     // Where: whole-record tests and windows.
@@ -508,6 +759,8 @@ pub fn diagnose(
         candidates: enriched.len(),
         alpha: options.alpha,
         rel_var_sd2: noise.rel_var_sd2,
+        linearised,
+        expensive,
     };
     // Candidates are independent: assessed in parallel, collected in order.
     let outcomes: Vec<(Effect, Assessment)> = enriched

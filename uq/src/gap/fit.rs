@@ -7,7 +7,7 @@ use palpate_core::{
     Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
 use palpate_inverse::{
-    fit, DataSet, FitOptions, FitReport, LmOptions, Method, Objective, ResidualKind,
+    fit, DataSet, FdOptions, FitOptions, FitReport, LmOptions, Method, Objective, ResidualKind,
 };
 use std::sync::Arc;
 
@@ -82,14 +82,28 @@ impl ForwardModel for Masked {
 /// the statistics resolve (a likelihood ratio of 1 is a relative SSE change
 /// of about 1/n), and a budget that stops the fits of degenerate
 /// enrichments (e.g. a Prony term drifting to tau -> 0 in noise) early.
-fn gap_lm_options() -> LmOptions {
-    LmOptions {
-        ftol: 1e-10,
-        xtol: 1e-9,
-        gtol: 1e-10,
-        max_evaluations: 1500,
-        max_iterations: 200,
-        ..LmOptions::default()
+/// For an expensive model (finite elements, seconds per prediction) the
+/// budget is smaller and the tolerances looser: the statistics resolve a
+/// likelihood-ratio change of about 1, i.e. a relative SSE change of ~1/n.
+fn gap_lm_options(expensive: bool) -> LmOptions {
+    if expensive {
+        LmOptions {
+            ftol: 1e-7,
+            xtol: 1e-6,
+            gtol: 1e-8,
+            max_evaluations: 200,
+            max_iterations: 30,
+            ..LmOptions::default()
+        }
+    } else {
+        LmOptions {
+            ftol: 1e-10,
+            xtol: 1e-9,
+            gtol: 1e-10,
+            max_evaluations: 1500,
+            max_iterations: 200,
+            ..LmOptions::default()
+        }
     }
 }
 
@@ -121,7 +135,8 @@ pub(crate) fn interior(spec: &ParamSpec, x: f64) -> f64 {
 
 /// Fits `model` to the samples `keep` of the record (all when `None`) from
 /// each start (moved inside the bounds; parameters in `fixed` held at their
-/// values) and keeps the lowest SSE. Starts whose fit fails are skipped; the
+/// values) and keeps the lowest SSE; `expensive` selects the smaller budget
+/// of [`gap_lm_options`]. Starts whose fit fails are skipped; the
 /// error of the first is returned when all fail. Predictions cover the whole
 /// record.
 pub(crate) fn fit_from_starts(
@@ -131,6 +146,7 @@ pub(crate) fn fit_from_starts(
     keep: Option<&[usize]>,
     starts: &[Vec<f64>],
     fixed: &[(String, f64)],
+    expensive: bool,
 ) -> Result<Fitted, GapError> {
     let set = match keep {
         None => DataSet::new("data", model.clone(), loading.clone(), observed.to_vec()),
@@ -171,11 +187,20 @@ pub(crate) fn fit_from_starts(
                 },
             )
             .collect();
-        let options = FitOptions {
+        let mut options = FitOptions {
             start: Some(start),
-            method: Method::LevenbergMarquardt(gap_lm_options()),
+            method: Method::LevenbergMarquardt(gap_lm_options(expensive)),
             ..FitOptions::default()
         };
+        if expensive {
+            // Forward differences (one prediction per column instead of
+            // two) with a step above the nonlinear solver's tolerance.
+            options.fd = FdOptions {
+                relative_step: 1e-5,
+                central: false,
+                parallel: true,
+            };
+        }
         match fit(&objective, &options) {
             Ok(report) => {
                 if report.sse.is_finite() && best.as_ref().is_none_or(|b| report.sse < b.sse) {

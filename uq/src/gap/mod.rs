@@ -34,7 +34,7 @@ pub mod structure;
 pub use diagnose::diagnose;
 pub use error::GapError;
 pub use noise::{difference_noise_sd, NoiseEstimate};
-pub use options::GapOptions;
+pub use options::{CrossValidation, GapOptions};
 pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
 pub use score::{score_test, sensitivities, ScoreTest};
 pub use structure::{discrepancy_band, significant_windows, whiteness, GapWindow, WhitenessTests};

@@ -28,6 +28,37 @@ pub struct GapOptions {
     /// Level of the test that two effects' fits differ (below it they are
     /// reported as confounded).
     pub confound_alpha: f64,
+    /// How each left-out block is refitted in the blocked cross-validation.
+    pub cross_validation: CrossValidation,
+}
+
+/// Refit strategy of the blocked cross-validation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CrossValidation {
+    /// `linearised` for models that declare themselves expensive
+    /// (`ForwardModel::expensive`, e.g. finite elements), `refit` otherwise.
+    #[default]
+    Auto,
+    /// A Levenberg-Marquardt refit per left-out block (exact).
+    Refit,
+    /// One Gauss-Newton step per left-out block from the full-record optimum,
+    /// with the sensitivities at that optimum: no model evaluation beyond
+    /// the one Jacobian (approximate cross-validation; Beirami et al. 2017,
+    /// Stephenson & Broderick 2020). Accurate when leaving a block out moves
+    /// the parameters little compared with the curvature of the model.
+    Linearised,
+}
+
+impl CrossValidation {
+    /// Whether the linearised form applies to a model of this cost.
+    pub fn linearised(self, expensive: bool) -> bool {
+        match self {
+            CrossValidation::Auto => expensive,
+            CrossValidation::Refit => false,
+            CrossValidation::Linearised => true,
+        }
+    }
 }
 
 impl Default for GapOptions {
@@ -38,6 +69,7 @@ impl Default for GapOptions {
             window: None,
             effects: None,
             confound_alpha: 0.01,
+            cross_validation: CrossValidation::Auto,
         }
     }
 }
