@@ -2,6 +2,7 @@
 
 use super::fit::{fit_from_starts, Fitted};
 use super::noise::difference_noise_sd;
+use super::profile::profile_interval;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
 use super::score::{
     projected_columns, score_test, sensitivities, sensitivities_of, sensitivity_overlap,
@@ -425,7 +426,7 @@ struct Context<'a> {
 
 /// A candidate's ranking entry, its full-record fit and its projected
 /// sensitivities at "off", or why it failed.
-type Assessment = Result<(RankedEffect, Fitted, DMatrix<f64>), GapError>;
+type Assessment = Result<(RankedEffect, Fitted, DMatrix<f64>, Arc<dyn ForwardModel>), GapError>;
 
 /// Score test, refits and comparison of one enrichment.
 fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Assessment {
@@ -616,8 +617,10 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
         after,
         max_correlation,
         identifiability: ident.reason.clone(),
+        profile: Vec::new(),
     };
-    Ok((ranked, full, projected_columns(&jac, p)))
+    let projected = projected_columns(&jac, p);
+    Ok((ranked, full, projected, rich))
 }
 
 /// Diagnoses the gap between `base` and `observed` (one value per sample of
@@ -867,6 +870,34 @@ pub fn diagnose(
             assessed.insert(0, moved);
         }
     }
+    // Identifiability of the leading effect's parameters by their profile
+    // likelihood (its other parameters refitted at each point).
+    if let Some(first) = assessed.first_mut() {
+        if first.0.earns {
+            let (ranked, fitted, _, model) = first;
+            let names = model.space().names();
+            let own: Vec<usize> = (p..names.len()).collect();
+            ranked.profile = own
+                .par_iter()
+                .map(|&j| {
+                    profile_interval(
+                        model,
+                        loading,
+                        observed,
+                        &fitted.theta,
+                        fitted.sse,
+                        sigma,
+                        j,
+                        expensive,
+                    )
+                })
+                .collect();
+            if !ranked.profile.is_empty() {
+                let text: Vec<String> = ranked.profile.iter().map(|i| i.describe()).collect();
+                ranked.evidence.push_str(&format!("; {}", text.join(", ")));
+            }
+        }
+    }
     let best_earning = assessed.iter().find(|a| a.0.earns);
     let (verdict, confounded, explanation) = match (gap_significant, best_earning) {
         (false, _) => (
@@ -1041,6 +1072,16 @@ mod tests {
         let best = &r.ranking[0];
         let (d0, se) = (best.params["d0_mm"], best.standard_errors["d0_mm"].unwrap());
         assert!((d0 - 0.1).abs() < 3.0 * se, "d0 = {d0} +- {se}");
+        // the profile interval is bounded, contains the planted value and
+        // is about +-1.96 standard errors wide (the model is nearly linear)
+        let profile = &best.profile[0];
+        let (lo, hi) = (profile.lower.unwrap(), profile.upper.unwrap());
+        assert!(lo < 0.1 && 0.1 < hi, "{}", profile.describe());
+        assert!(
+            ((hi - lo) / (2.0 * 1.96 * se) - 1.0).abs() < 0.3,
+            "{} for se {se}",
+            profile.describe()
+        );
         assert!(best.heldout_after < 1.2 * 0.01 && best.misfit_before > 2.0 * best.misfit_after);
         assert!(!r.where_.is_empty() && r.where_[0].axis == "displacement_mm");
         assert!((r.noise_sd / 0.01 - 1.0).abs() < 0.2);

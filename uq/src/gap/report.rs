@@ -2,6 +2,7 @@
 //! the vectors a plot needs, and its markdown rendering.
 
 use super::noise::NoiseEstimate;
+use super::profile::ProfileInterval;
 use super::score::ScoreTest;
 use super::structure::{GapWindow, WhitenessTests};
 use serde::{Deserialize, Serialize};
@@ -65,6 +66,10 @@ pub struct RankedEffect {
     pub max_correlation: f64,
     /// Why the fit is or is not identifiable (from the calibration report).
     pub identifiability: String,
+    /// 95 % profile-likelihood intervals of the effect's own parameters
+    /// (computed for the verdict's effect only).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub profile: Vec<ProfileInterval>,
 }
 
 /// A candidate whose refit could not be made (reported, not hidden).
