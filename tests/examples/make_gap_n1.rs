@@ -87,11 +87,11 @@ fn main() {
         }
         std::fs::write(dir.join(format!("{}.csv", c.name)), csv).expect("write record");
         let effects: Vec<String> = c.effects.iter().map(|e| format!("\"{e}\"")).collect();
-        let _ = write!(
+        let _ = writeln!(
             truth,
             "  \"{}\": {{\"benchmark\": \"N1\", \"base_model\": \"neo-Hookean, frictionless needle, bonded base\", \
              \"effects\": [{}], \"params\": {{\"C10_MPa\": {}, \"friction\": {}, \"base\": \"{:?}\"}}, \
-             \"noise_sd_N\": {sd:.6e}, \"expected\": \"{}\"}}{}\n",
+             \"noise_sd_N\": {sd:.6e}, \"expected\": \"{}\"}}{}",
             c.name,
             effects.join(", "),
             c.c10,
