@@ -112,6 +112,10 @@ pub struct DiagnoseStep {
     pub data: Vec<String>,
     /// Base law, e.g. `neo-hookean`.
     pub base: String,
+    /// Candidate effects (GAP.md names); default: C1 every effect its model
+    /// offers, N1 `friction` and `boundary_condition`.
+    #[serde(default)]
+    pub effects: Option<Vec<String>>,
 }
 
 fn default_residuals() -> Vec<String> {

@@ -312,9 +312,18 @@ fn run_diagnose(
         let d = &data[name];
         let benchmark = if d.test == TestKind::N1 { "N1" } else { "C1" };
         let model = crate::cli::diagnose::base_model(benchmark, law)?;
-        let gap =
-            palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &Default::default())
-                .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
+        let options = palpate_uq::gap::GapOptions {
+            effects: match &step.effects {
+                Some(list) => Some(
+                    crate::cli::diagnose::parse_effects(list)
+                        .with_context(|| format!("step `{}`: effects", step.name))?,
+                ),
+                None => crate::cli::diagnose::default_effects(benchmark),
+            },
+            ..Default::default()
+        };
+        let gap = palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &options)
+            .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
         let best = gap.ranking.first();
         let _ = writeln!(
             report,

@@ -11,10 +11,16 @@
 //! * a sliding base (0.6-1.1 % less force, almost uniformly: absorbed by C10)
 //!   -> `none`, the effect too weak to see at 0.5 % noise.
 //!
-//! The diagnosis runs the FE model some 60 times per record (a minute of
-//! CPU in the dev profile): the three records run in parallel.
+//! * the friction record with `material_form` as the rival candidate: the
+//!   two are reported as confounded (a stiffening law bends one force-depth
+//!   curve as friction does), not one picked.
+//!
+//! The candidates are GAP.md's N1 effects (friction, boundary_condition),
+//! the CLI's default for N1. The diagnosis runs the FE model some 60 times
+//! per record (a minute of CPU in the dev profile): the four diagnoses run in
+//! parallel.
 
-use palpate_core::{Drive, Loading, Table};
+use palpate_core::{Drive, Effect, Loading, Table};
 use palpate_fe::{MeshDensity, N1Needle};
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
@@ -25,7 +31,7 @@ fn dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n1")
 }
 
-fn diagnose_case(name: &str) -> GapReport {
+fn diagnose_case(name: &str, effects: &[Effect]) -> GapReport {
     let table = Table::read(dir().join(format!("{name}.csv"))).unwrap();
     let d = table.column("displacement_mm").unwrap().to_vec();
     let f = table.column("force_N").unwrap().to_vec();
@@ -33,8 +39,15 @@ fn diagnose_case(name: &str) -> GapReport {
     let mut base = N1Needle::new(Law::NeoHookean);
     base.friction = 0.0;
     base.mesh = MeshDensity::COARSE;
-    diagnose(&base, &loading, &f, &GapOptions::default()).unwrap()
+    let options = GapOptions {
+        effects: Some(effects.to_vec()),
+        ..GapOptions::default()
+    };
+    diagnose(&base, &loading, &f, &options).unwrap()
 }
+
+/// GAP.md's N1 candidates (the CLI's default for N1).
+const N1_EFFECTS: [Effect; 2] = [Effect::Friction, Effect::BoundaryCondition];
 
 #[test]
 fn n1_records_get_the_expected_verdicts() {
@@ -42,10 +55,35 @@ fn n1_records_get_the_expected_verdicts() {
         serde_json::from_str(&std::fs::read_to_string(dir().join("truth.json")).unwrap()).unwrap();
     let names: Vec<String> = truth.as_object().unwrap().keys().cloned().collect();
     assert_eq!(names.len(), 3);
-    let reports: Vec<(String, GapReport)> = names
-        .par_iter()
-        .map(|n| (n.clone(), diagnose_case(n)))
+    // The three records with the N1 candidates, and the friction record
+    // once more with a stiffening law as a rival candidate.
+    let mut jobs: Vec<(String, Vec<Effect>)> = names
+        .iter()
+        .map(|n| (n.clone(), N1_EFFECTS.to_vec()))
         .collect();
+    jobs.push((
+        "n1-friction".into(),
+        vec![Effect::Friction, Effect::MaterialForm],
+    ));
+    let mut reports: Vec<(String, GapReport)> = jobs
+        .par_iter()
+        .map(|(n, e)| (n.clone(), diagnose_case(n, e)))
+        .collect();
+    let rival = reports.pop().unwrap().1;
+    // On one force-depth curve friction and a stiffening C20 bend the curve
+    // alike (both fit to the noise): reported as confounded, not picked.
+    assert!(
+        ["friction", "material_form"].contains(&rival.verdict.as_str()),
+        "{}",
+        rival.explanation
+    );
+    let other = if rival.verdict == "friction" {
+        "material_form"
+    } else {
+        "friction"
+    };
+    assert_eq!(rival.confounded, [other], "{}", rival.explanation);
+    assert!(!rival.ranking[0].identifiable);
     for (name, r) in &reports {
         let t = &truth[name.as_str()];
         let expected = t["expected"].as_str().unwrap();

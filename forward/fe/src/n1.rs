@@ -14,11 +14,17 @@
 //!   fits. (A continuous bonded-to-sliding blend would need a base spring
 //!   whose stiffness spans many decades, badly conditioned near "bonded";
 //!   the switch answers the same question.)
+//! * `material_form` — the next richer law (neo-Hookean -> reduced
+//!   polynomial N=2 with a stiffening C20 >= 0, ...; `palpate_analytic::richer_law`).
+//! * `zero_offset` — contact starts at a recorded displacement d0
+//!   (`palpate_analytic::ZeroOffset`, the same wrapper as for C1).
 
+use palpate_analytic::{richer_law, MaterialForm, ZeroOffset};
 use palpate_core::{
     Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
 use palpate_material::Law;
+use std::sync::Arc;
 
 use crate::contact::{ContactOptions, ContactPoints, ContactSet, RigidTool};
 use crate::kinematics::Kinematics;
@@ -285,6 +291,12 @@ impl ForwardModel for N1Needle {
         if self.base == Base::Bonded {
             v.push(Effect::BoundaryCondition);
         }
+        // (one enrichment at a time: the richer law of a model whose friction
+        // is already a parameter is not offered)
+        if !self.friction_is_parameter && richer_law(&self.law).is_some() {
+            v.push(Effect::MaterialForm);
+        }
+        v.push(Effect::ZeroOffset);
         v
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
@@ -306,6 +318,22 @@ impl ForwardModel for N1Needle {
                 m.base = Base::Sliding;
                 Ok(Box::new(m))
             }
+            Effect::MaterialForm
+                if !self.friction_is_parameter && richer_law(&self.law).is_some() =>
+            {
+                let richer = richer_law(&self.law).expect("checked above");
+                let mut inner = self.clone();
+                inner.law = richer.law;
+                let space = richer.space.clone();
+                inner.space = space.clone();
+                Ok(Box::new(MaterialForm::new(
+                    Box::new(inner),
+                    richer.embed_law_params.clone(),
+                    self.law.to_string(),
+                    space,
+                )))
+            }
+            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(self.clone())))),
             _ => Err(ForwardError::InvalidConfig {
                 field: "effect".into(),
                 reason: format!("`{effect}` does not apply to {}", self.name()),

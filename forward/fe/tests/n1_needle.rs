@@ -152,3 +152,46 @@ fn boundary_condition_effect_gives_a_sliding_base() {
     let both = sliding.enrich(Effect::Friction).unwrap();
     assert_eq!(both.space().len(), m.space().len() + 1);
 }
+
+/// GAP.md `material_form` and `zero_offset` on N1: "off" reproduces the base
+/// model (the richer law with C20 = 0 to rounding, the offset exactly); a
+/// stiffening C20 raises the force; an offset d0 delays contact, so the
+/// force at d equals the base force at d - d0 (and is zero before contact).
+#[test]
+fn material_form_and_zero_offset_effects_on_n1() {
+    let m = model("neo-hookean", 0.0);
+    let effects = m.effects();
+    assert!(effects.contains(&Effect::MaterialForm) && effects.contains(&Effect::ZeroOffset));
+    let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.0, 0.5, 1.0, 1.5, 2.0]);
+    let base = m.predict(&NH, &loading).unwrap();
+
+    let richer = m.enrich(Effect::MaterialForm).unwrap();
+    assert_eq!(richer.space().names(), ["C10", "C20"]);
+    let off = richer.embed(&NH);
+    assert_eq!(off, [NH[0], 0.0]);
+    let same = richer.predict(&off, &loading).unwrap();
+    for (a, b) in base.iter().zip(&same) {
+        assert!((a - b).abs() <= 1e-9 * a.abs().max(1e-6), "{a} vs {b}");
+    }
+    let stiff = richer.predict(&[NH[0], 2.0 * NH[0]], &loading).unwrap();
+    assert!(stiff[4] > base[4] * 1.001, "{} vs {}", stiff[4], base[4]);
+
+    let offset = m.enrich(Effect::ZeroOffset).unwrap();
+    assert_eq!(offset.embed(&NH), [NH[0], 0.0]);
+    assert_eq!(offset.predict(&[NH[0], 0.0], &loading).unwrap(), base);
+    let shifted = offset.predict(&[NH[0], 0.5], &loading).unwrap();
+    assert_eq!(shifted[1], 0.0);
+    for k in 2..5 {
+        let rel = (shifted[k] - base[k - 1]).abs() / base[k - 1];
+        assert!(
+            rel < 1e-6,
+            "d = {}: {} vs {}",
+            0.5 * k as f64,
+            shifted[k],
+            base[k - 1]
+        );
+    }
+    // the friction model does not offer the richer law (one effect at a time)
+    let with_friction = m.enrich(Effect::Friction).unwrap();
+    assert!(!with_friction.effects().contains(&Effect::MaterialForm));
+}
