@@ -24,7 +24,9 @@
 //! a / R), and an independent CalculiX model of the same problem
 //! (docs/validation/hertz/) is 4.0 % below Hertz: ours is 0.2-0.4 % above
 //! it, within its own uncertainty. The 3 % target of issue 3 holds against
-//! Sneddon to 0.1 R and against Hertz to 0.06 R only.
+//! Hertz to 0.1 R on a near-half-space (the N1 cylinder enlarged 10x, the
+//! body Hertz's formula assumes), against Sneddon to 0.1 R on the N1
+//! cylinder, and against Hertz to 0.06 R on the N1 cylinder.
 
 use std::path::Path;
 use std::sync::OnceLock;
@@ -185,8 +187,13 @@ fn sphere_force_matches_calculix() {
 /// 0.98 %, the 1/size behaviour of a far-field correction), and that
 /// near-half-space is 1-2.5 % below Sneddon, in proportion to a / R: the
 /// finite-deformation part of the deviation.
+///
+/// Hertz's formula is a half-space result: on this near-half-space the FE
+/// force is within 3 % of it at every depth up to 0.1 R (issue 3's
+/// criterion; -2.8 % at 0.1 R), while on the N1-sized cylinder the finite
+/// body takes another 0.8-1 % off.
 #[test]
-fn larger_cylinder_is_stiffer_and_closer_to_sneddon() {
+fn near_half_space_is_within_3_percent_of_hertz_up_to_0_1_r() {
     let big = forces(&sphere_model(0.04, 1.2, 10.0, DEPTHS[0]), &DEPTHS);
     let n1 = default_forces();
     let stiffening: Vec<f64> = big.iter().zip(n1).map(|(b, f)| b / f - 1.0).collect();
@@ -200,6 +207,11 @@ fn larger_cylinder_is_stiffer_and_closer_to_sneddon() {
     );
     assert!(stiffening.iter().all(|s| *s > 0.0), "{msg}");
     assert!(dev[last] > -0.025 && dev[last] < -0.01, "{msg}");
+    let vs_hertz = deviations(&big, &DEPTHS, hertz);
+    assert!(
+        vs_hertz.iter().all(|r| r.abs() < 0.03),
+        "{DEPTHS:?}: big / Hertz - 1 = {vs_hertz:?}"
+    );
     // in proportion to a / R = sqrt(d / R) within 25 %: the ratio of the
     // deviations at 0.1 R and 0.02 R against sqrt(5)
     let ratio = dev[last] / dev[0];
