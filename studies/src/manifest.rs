@@ -230,6 +230,11 @@ impl Manifest {
                     if let Err(e) = d.base.parse::<palpate_material::Law>() {
                         anyhow::bail!("{where_}: {at}.base = \"{}\": {e}", d.base);
                     }
+                    for e in d.effects.iter().flatten() {
+                        if let Err(m) = e.parse::<palpate_core::Effect>() {
+                            anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}");
+                        }
+                    }
                 }
             }
         }
@@ -305,5 +310,27 @@ fits = { u = ["uni"] }
         assert!(e.contains("models.nh.law"), "{e}");
         let m = Manifest::parse(&p, GOOD).unwrap();
         m.validate(&p).unwrap();
+    }
+
+    #[test]
+    fn diagnose_effects_are_checked_by_name() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "displacement_mm,force_N\n0,0\n").unwrap();
+        let p = dir.path().join("s.toml");
+        let text = |effects: &str| {
+            format!(
+                "[study]\nname = \"t\"\n\n[data.rec]\nfile = \"r.csv\"\ntest = \"N1\"\n\n\
+                 [[steps]]\n[steps.diagnose]\nname = \"gap\"\nbase = \"neo-hookean\"\n\
+                 data = [\"rec\"]\neffects = [{effects}]\n"
+            )
+        };
+        let m = Manifest::parse(&p, &text("\"friction\", \"zero_offset\"")).unwrap();
+        m.validate(&p).unwrap();
+        let m = Manifest::parse(&p, &text("\"frictoin\"")).unwrap();
+        let e = m.validate(&p).unwrap_err().to_string();
+        assert!(
+            e.contains("steps[0].diagnose") && e.contains("effects") && e.contains("frictoin"),
+            "{e}"
+        );
     }
 }
