@@ -14,11 +14,12 @@
 //! run is on one thread; the CPU column is the process user + system time
 //! of the run (`/proc/self/stat`).
 //!
-//! `--max-step=S` (mm, default 0.25) and `--penalty=P` (default 100) change
+//! `--max-step=S` (mm, default 0.25), `--penalty=P` (default 100) and
+//! `--augment=TOL` (inner augmentation loop to a penetration of TOL mm) change
 //! the increment size and the contact penalty factor, to separate their
 //! errors from the mesh's.
 //!
-//! `cargo run --release -p palpate-fe --example convergence_n1 -- [level | h/zone/growth ...] [--max-step=S] [--penalty=P]`
+//! `cargo run --release -p palpate-fe --example convergence_n1 -- [level | h/zone/growth ...] [--max-step=S] [--penalty=P] [--augment=TOL]`
 
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
@@ -92,6 +93,8 @@ struct Row {
 struct Knobs {
     max_step: Option<f64>,
     penalty: Option<f64>,
+    /// Inner augmentation loop: accepted penetration (mm), up to 20 updates.
+    augment: Option<f64>,
 }
 
 fn forces(case: Case, knobs: Knobs) -> Row {
@@ -101,6 +104,10 @@ fn forces(case: Case, knobs: Knobs) -> Row {
     }
     if let Some(p) = knobs.penalty {
         m.penalty = p;
+    }
+    if let Some(tol) = knobs.augment {
+        m.penetration_tol = tol;
+        m.options.max_augmentations = 20;
     }
     match case {
         Case::Level(level) => m.mesh = MeshDensity { level },
@@ -161,6 +168,7 @@ fn main() {
     let knobs = Knobs {
         max_step: flag("--max-step="),
         penalty: flag("--penalty="),
+        augment: flag("--augment="),
     };
     let mut cases: Vec<Case> = args.iter().filter_map(|a| Case::parse(a)).collect();
     if cases.is_empty() {
