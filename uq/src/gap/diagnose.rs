@@ -1,6 +1,6 @@
 //! The diagnosis itself: base fit, residual structure, candidates, verdict.
 
-use super::fit::{fit_from_starts, Fitted};
+use super::fit::{fit_from_starts, scale_moduli, Fitted};
 use super::noise::difference_noise_sd;
 use super::profile::profile_interval;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
@@ -113,17 +113,7 @@ fn base_starts(base: &dyn ForwardModel, loading: &Loading, observed: &[f64]) -> 
     let theta0 = base.space().initial();
     let mut starts = Vec::new();
     if let Ok(f0) = base.predict(&theta0, loading) {
-        let ff: f64 = f0.iter().map(|v| v * v).sum();
-        let fy: f64 = f0.iter().zip(observed).map(|(a, b)| a * b).sum();
-        let a = fy / ff;
-        if a.is_finite() && a > 0.0 {
-            let scaled = base
-                .space()
-                .params
-                .iter()
-                .zip(&theta0)
-                .map(|(s, v)| if s.unit == "MPa" { v * a } else { *v })
-                .collect();
+        if let Some((_, scaled)) = scale_moduli(&base.space().params, &theta0, &f0, observed) {
             starts.push(scaled);
         }
     }
@@ -210,22 +200,14 @@ fn screen_starts(
             let Ok(f) = model.predict(&s, loading) else {
                 return (f64::INFINITY, s);
             };
-            let ff: f64 = f.iter().map(|v| v * v).sum();
-            let fy: f64 = f.iter().zip(observed).map(|(a, b)| a * b).sum();
-            let a = fy / ff;
-            if !(a.is_finite() && a > 0.0) {
+            let Some((a, scaled)) = scale_moduli(specs, &s, &f, observed) else {
                 return (f64::INFINITY, s);
-            }
+            };
             let misfit: f64 = f
                 .iter()
                 .zip(observed)
                 .map(|(v, y)| (y - a * v).powi(2))
                 .sum();
-            let scaled = specs
-                .iter()
-                .zip(&s)
-                .map(|(spec, v)| if spec.unit == "MPa" { v * a } else { *v })
-                .collect();
             (misfit, scaled)
         })
         .collect();

@@ -107,6 +107,30 @@ fn gap_lm_options(expensive: bool) -> LmOptions {
     }
 }
 
+/// The least-squares factor a = <f, y> / <f, f> of predictions `f` against
+/// data `y`, and `theta` with every parameter in MPa multiplied by it: the
+/// best refit of the moduli alone (exact for a strain energy linear in its
+/// moduli under prescribed displacement, e.g. neo-Hookean, whose force is
+/// then linear in C10). `None` when a is not a positive finite number.
+pub(crate) fn scale_moduli(
+    specs: &[ParamSpec],
+    theta: &[f64],
+    f: &[f64],
+    y: &[f64],
+) -> Option<(f64, Vec<f64>)> {
+    let ff: f64 = f.iter().map(|v| v * v).sum();
+    let fy: f64 = f.iter().zip(y).map(|(a, b)| a * b).sum();
+    let a = fy / ff;
+    (a.is_finite() && a > 0.0).then(|| {
+        let scaled = specs
+            .iter()
+            .zip(theta)
+            .map(|(s, v)| if s.unit == "MPa" { v * a } else { *v })
+            .collect();
+        (a, scaled)
+    })
+}
+
 /// `x` moved strictly inside the bounds of `spec` (the unbounded transforms
 /// send a bound to infinity): a value on or beyond a bound moves a tenth of
 /// the way towards the starting value, or by a small relative step.

@@ -3,9 +3,9 @@
 //! says nothing when the response saturates, as friction does once the
 //! contact sticks).
 
-use super::fit::{fit_from_starts, interior};
+use super::fit::{fit_from_starts, interior, scale_moduli};
 use super::structure::chi2_isf;
-use palpate_core::{ForwardModel, Loading};
+use palpate_core::{ForwardModel, Loading, ParamSpec};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -68,14 +68,21 @@ fn profile_sse(
     start[j] = x;
     if expensive {
         let f = model.predict(&start, loading).ok()?;
-        let scaled = specs
+        // the moduli other than theta_j rescaled (theta_j itself is held)
+        let others: Vec<ParamSpec> = specs
             .iter()
             .enumerate()
-            .any(|(k, s)| k != j && s.unit == "MPa");
-        let ff: f64 = f.iter().map(|v| v * v).sum();
-        let fy: f64 = f.iter().zip(observed).map(|(a, b)| a * b).sum();
-        let a = if scaled && ff > 0.0 && fy > 0.0 {
-            fy / ff
+            .map(|(k, s)| {
+                let mut s = s.clone();
+                if k == j {
+                    s.unit = String::new();
+                }
+                s
+            })
+            .collect();
+        let a = scale_moduli(&others, &start, &f, observed).map_or(1.0, |(a, _)| a);
+        let a = if others.iter().any(|s| s.unit == "MPa") {
+            a
         } else {
             1.0
         };
