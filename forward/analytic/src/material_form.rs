@@ -124,6 +124,9 @@ impl ForwardModel for MaterialForm {
     fn observable(&self) -> Observable {
         self.inner.observable()
     }
+    fn expensive(&self) -> bool {
+        self.inner.expensive()
+    }
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(MaterialFormEvaluator {
             space: &self.space,

@@ -135,6 +135,9 @@ impl ForwardModel for ToolCompliance {
     fn observable(&self) -> Observable {
         self.base.observable()
     }
+    fn expensive(&self) -> bool {
+        self.base.expensive()
+    }
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(ToolComplianceEvaluator {
             model: self,

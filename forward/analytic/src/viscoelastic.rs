@@ -194,6 +194,9 @@ impl ForwardModel for Viscoelastic {
     fn observable(&self) -> Observable {
         self.base.observable()
     }
+    fn expensive(&self) -> bool {
+        self.base.expensive()
+    }
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(ViscoelasticEvaluator {
             model: self,

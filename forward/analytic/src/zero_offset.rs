@@ -65,6 +65,9 @@ impl ForwardModel for ZeroOffset {
     fn observable(&self) -> Observable {
         self.base.observable()
     }
+    fn expensive(&self) -> bool {
+        self.base.expensive()
+    }
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(ZeroOffsetEvaluator {
             model: self,

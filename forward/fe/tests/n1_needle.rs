@@ -177,6 +177,8 @@ fn material_form_and_zero_offset_effects_on_n1() {
     assert!(stiff[4] > base[4] * 1.001, "{} vs {}", stiff[4], base[4]);
 
     let offset = m.enrich(Effect::ZeroOffset).unwrap();
+    // the wrappers pass on that a prediction is an FE solve
+    assert!(m.expensive() && richer.expensive() && offset.expensive());
     assert_eq!(offset.embed(&NH), [NH[0], 0.0]);
     assert_eq!(offset.predict(&[NH[0], 0.0], &loading).unwrap(), base);
     let shifted = offset.predict(&[NH[0], 0.5], &loading).unwrap();

@@ -69,6 +69,9 @@ impl ForwardModel for Masked {
     fn observable(&self) -> Observable {
         self.inner.observable()
     }
+    fn expensive(&self) -> bool {
+        self.inner.expensive()
+    }
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(MaskedEvaluator {
             model: self,
