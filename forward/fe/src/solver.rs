@@ -506,6 +506,9 @@ impl Solver {
             let mut alpha = 1.0;
             let mut last_err = None;
             let mut accepted = None;
+            // Armijo backtracking by halves: alpha = 1, 1/2, ..., 1/16, where
+            // the step is taken whatever the residual; 1/32 is tried only
+            // when the assembly at 1/16 fails (an inverted element).
             for _ in 0..6 {
                 self.apply(&du, alpha, &u0, &q0);
                 match self.assemble(mat, vol, drive, true) {

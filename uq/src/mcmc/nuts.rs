@@ -155,8 +155,9 @@ fn vadd(a: &[f64], b: &[f64]) -> Vec<f64> {
     a.iter().zip(b).map(|(x, y)| x + y).collect()
 }
 
-/// Merges two adjacent trees given in spatial order (`l` backward of `r`);
-/// `None` when the merged tree (or one of the cross checks) turns.
+/// Whether the merge of two adjacent trees given in spatial order (`l`
+/// backward of `r`) makes a U-turn: `true` when the merged tree (or one of
+/// the cross checks) turns.
 fn merged_turns(ctx: &Ctx, l: &Tree, r: &Tree, rho: &[f64]) -> bool {
     ctx.turning(rho, &l.left.p, &r.right.p)
         || ctx.turning(&vadd(&l.rho, &r.left.p), &l.left.p, &r.left.p)
