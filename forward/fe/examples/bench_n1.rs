@@ -48,26 +48,13 @@ const MARGIN_GRADING: Grading = Grading {
     fine_length: 3.0,
     growth: 1.08,
 };
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
+
 const CCX_WALL: f64 = 627.7;
 const CCX_CPU: f64 = 287.8;
 const CCX_README_WALL: f64 = 586.0;
-
-/// User + system CPU seconds of this process (`self`: fields 14, 15 of
-/// `/proc/self/stat`) or of its waited-for children (fields 16, 17), in
-/// clock ticks of 1/100 s (Linux USER_HZ). NaN off Linux.
-fn cpu_seconds(children: bool) -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit(')').next().unwrap_or("");
-    // after ")" only field 3 (state) is not numeric: field k is index k - 4
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|s| s.parse().ok())
-        .collect();
-    let k = if children { 12 } else { 10 };
-    f.get(k)
-        .zip(f.get(k + 1))
-        .map_or(f64::NAN, |(u, s)| (u + s) / 100.0)
-}
 
 /// One mesh of the table.
 #[derive(Clone, Copy)]

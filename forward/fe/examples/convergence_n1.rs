@@ -65,19 +65,11 @@ impl Case {
     }
 }
 
-/// User + system CPU seconds of this process so far (Linux `/proc/self/stat`,
-/// fields 14 and 15 in clock ticks of 1/100 s).
+#[path = "common/cpu.rs"]
+mod cpu;
+
 fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
-    let after = stat.rsplit(')').next().unwrap_or("");
-    let f: Vec<f64> = after
-        .split_whitespace()
-        .filter_map(|s| s.parse().ok())
-        .collect();
-    // after the ")" field 3 (state) is not numeric, so utime/stime are 11, 12
-    f.get(10)
-        .zip(f.get(11))
-        .map_or(f64::NAN, |(u, s)| (u + s) / 100.0)
+    cpu::cpu_seconds(false)
 }
 
 struct Row {
