@@ -3,6 +3,7 @@
 //! (mean dilatation penalty or an exact constraint, see [`crate::element`]).
 
 use nalgebra::{Matrix3, SMatrix};
+use palpate_material::invariant_kinematics::InvariantKinematics;
 use palpate_material::{Law, Volumetric};
 
 use crate::kinematics::F_COMPONENTS;
@@ -66,29 +67,17 @@ impl PointMaterial for LawMaterial {
     fn shear_modulus(&self) -> f64 {
         self.law.shear_modulus(&self.params)
     }
-    /// For the laws written in invariants, the formulas of
-    /// `palpate_material::invariant_kinematics::stress_tangent` (isochoric
-    /// part, `U = 0`) evaluated for the five 2D components only (15 tangent
+    /// For the laws written in invariants, the isochoric stress and tangent
+    /// entries of `palpate_material::invariant_kinematics::InvariantKinematics`
+    /// (the same formulas as the material's 9 x 9 path) for the five 2D components only (15 tangent
     /// entries instead of 45; none when `tangent` is false): the material
     /// evaluation was 30 % of an N1 run. Ogden goes through the 9 x 9 path.
     fn iso_stress_tangent_2d(&self, f: &Matrix3<f64>, tangent: bool) -> StressTangent5 {
-        let nan = ([f64::NAN; 5], [[f64::NAN; 5]; 5]);
-        let j = f.determinant();
-        if !(j > 0.0 && j.is_finite()) {
-            return nan;
-        }
-        let Some(finv) = f.try_inverse() else {
-            return nan;
+        let Some(kin) = InvariantKinematics::new(f) else {
+            return ([f64::NAN; 5], [[f64::NAN; 5]; 5]);
         };
-        let fit = finv.transpose();
-        let c = f.transpose() * f;
-        let b = f * f.transpose();
-        let i1 = c.trace();
-        let i2 = 0.5 * (i1 * i1 - c.norm_squared());
-        let (k1, k2) = (2.0 / 3.0, 4.0 / 3.0);
-        let a1 = j.powf(-k1);
-        let a2 = a1 * a1;
-        let Some(d) = self.law.invariant_derivs(&self.params, a1 * i1, a2 * i2) else {
+        let (i1b, i2b) = kin.modified();
+        let Some(d) = self.law.invariant_derivs(&self.params, i1b, i2b) else {
             let (p, a) = self.iso_stress_tangent(f);
             let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
             let a5 = if tangent {
@@ -100,41 +89,18 @@ impl PointMaterial for LawMaterial {
             };
             return (p5, a5);
         };
-        let di1 = f * 2.0;
-        let di2 = (f * i1 - f * c) * 2.0;
-        let g1 = (di1 - fit * (k1 * i1)) * a1;
-        let g2 = (di2 - fit * (k2 * i2)) * a2;
         let idx = F_COMPONENTS.map(|r| (r / 3, r % 3));
-        let p5 = idx.map(|(i, jj)| g1[(i, jj)] * d.w1 + g2[(i, jj)] * d.w2);
+        let p = kin.iso_stress(&d);
+        let p5 = idx.map(|(i, jj)| p[(i, jj)]);
         let mut a5 = [[0.0; 5]; 5];
         if !tangent {
             return (p5, a5);
         }
-        let delta = |x: usize, y: usize| if x == y { 1.0 } else { 0.0 };
         for r in 0..5 {
             let (i, jj) = idx[r];
             for s in r..5 {
                 let (k, l) = idx[s];
-                let cross = finv[(jj, k)] * finv[(l, i)];
-                let ff = fit[(i, jj)] * fit[(k, l)];
-                let d2i1 = 2.0 * delta(i, k) * delta(jj, l);
-                let d2i2 = 4.0 * f[(i, jj)] * f[(k, l)] + 2.0 * i1 * delta(i, k) * delta(jj, l)
-                    - 2.0 * delta(i, k) * c[(l, jj)]
-                    - 2.0 * f[(i, l)] * f[(k, jj)]
-                    - 2.0 * b[(i, k)] * delta(jj, l);
-                let h1 = a1
-                    * (d2i1 - k1 * (di1[(i, jj)] * fit[(k, l)] + fit[(i, jj)] * di1[(k, l)])
-                        + k1 * k1 * i1 * ff
-                        + k1 * i1 * cross);
-                let h2 = a2
-                    * (d2i2 - k2 * (di2[(i, jj)] * fit[(k, l)] + fit[(i, jj)] * di2[(k, l)])
-                        + k2 * k2 * i2 * ff
-                        + k2 * i2 * cross);
-                a5[r][s] = d.w11 * g1[(i, jj)] * g1[(k, l)]
-                    + d.w12 * (g1[(i, jj)] * g2[(k, l)] + g2[(i, jj)] * g1[(k, l)])
-                    + d.w22 * g2[(i, jj)] * g2[(k, l)]
-                    + d.w1 * h1
-                    + d.w2 * h2;
+                a5[r][s] = kin.iso_tangent(&d, i, jj, k, l);
                 a5[s][r] = a5[r][s];
             }
         }
