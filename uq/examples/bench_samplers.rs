@@ -12,27 +12,18 @@
 //! printed once).
 
 use palpate_analytic::C1Compression;
-use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_core::ForwardModel;
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, Posterior, Prior};
 use palpate_uq::mcmc::{summarize, DemcSettings, EnsembleSettings, NutsSettings, Sampler};
 use std::path::Path;
 use std::sync::Arc;
 
+#[path = "../tests/common/mod.rs"]
+mod common;
+
 fn main() {
+    let (loading, observed, sigma) = common::c1_rp2_record();
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation");
-    let t = Table::read(dir.join("mcmc_c1_rp2_data.csv")).expect("data file");
-    let sigma: f64 = t
-        .comments
-        .iter()
-        .find_map(|c| {
-            c.split_once("sigma_N = ")
-                .and_then(|(_, v)| v.trim().parse().ok())
-        })
-        .expect("sigma comment");
-    let loading = Loading::quasi_static(
-        Drive::DisplacementMm,
-        t.column("displacement_mm").unwrap().to_vec(),
-    );
     let model: Arc<dyn ForwardModel> =
         Arc::new(C1Compression::new("reduced-polynomial:2".parse().unwrap()));
     let post = Posterior::new(
@@ -40,7 +31,7 @@ fn main() {
             name: "c1".into(),
             model,
             loading,
-            observed: t.column("force_N").unwrap().to_vec(),
+            observed,
             noise: NoiseModel::known(sigma),
         }],
         vec![Prior::Flat; 2],

@@ -6,21 +6,20 @@
 //! Mooney-Rivlin on the same data shows a strongly correlated posterior.
 
 use palpate_analytic::C1Compression;
-use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, Posterior, Prior};
 use palpate_uq::mcmc::{
     correlation, summarize, DemcSettings, EnsembleSettings, NutsSettings, ParamSummary, SampleRun,
     Sampler,
 };
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 const TRUE_THETA: [f64; 2] = [6.86428e-4, 1.929606e-3];
 const SEED: u64 = 20240611;
 
-fn data_path() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv")
-}
+mod common;
+use common::{c1_rp2_path as data_path, c1_rp2_record as read_data};
 
 /// The synthetic data set as CSV text (deterministic for the seed).
 fn synthetic_csv() -> String {
@@ -48,21 +47,6 @@ fn synthetic_csv() -> String {
         s.push_str(&format!("{di:.17e},{:.17e}\n", fi + sigma * e));
     }
     s
-}
-
-fn read_data() -> (Loading, Vec<f64>, f64) {
-    let t = Table::read(data_path()).unwrap();
-    let sigma: f64 = t
-        .comments
-        .iter()
-        .find_map(|c| {
-            c.split_once("sigma_N = ")
-                .map(|(_, v)| v.trim().parse().unwrap())
-        })
-        .unwrap();
-    let d = t.column("displacement_mm").unwrap().to_vec();
-    let f = t.column("force_N").unwrap().to_vec();
-    (Loading::quasi_static(Drive::DisplacementMm, d), f, sigma)
 }
 
 fn posterior(law: &str) -> Posterior {

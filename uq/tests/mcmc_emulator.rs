@@ -3,32 +3,14 @@
 //! an FE model, whose direct sampling would be too slow).
 
 use palpate_analytic::C1Compression;
-use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_core::ForwardModel;
 use palpate_uq::emulator::CurveEmulator;
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, Posterior, Prior};
 use palpate_uq::mcmc::{summarize, DemcSettings, Sampler};
-use std::path::Path;
 use std::sync::Arc;
 
-fn data() -> (Loading, Vec<f64>, f64) {
-    let t = Table::read(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv"),
-    )
-    .unwrap();
-    let sigma = t
-        .comments
-        .iter()
-        .find_map(|c| {
-            c.split_once("sigma_N = ")
-                .map(|(_, v)| v.trim().parse().unwrap())
-        })
-        .unwrap();
-    let l = Loading::quasi_static(
-        Drive::DisplacementMm,
-        t.column("displacement_mm").unwrap().to_vec(),
-    );
-    (l, t.column("force_N").unwrap().to_vec(), sigma)
-}
+mod common;
+use common::c1_rp2_record as data;
 
 fn posterior(model: Arc<dyn ForwardModel>) -> Posterior {
     let (loading, observed, sigma) = data();

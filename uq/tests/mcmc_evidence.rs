@@ -8,33 +8,18 @@
 
 use nalgebra::{DMatrix, DVector};
 use palpate_analytic::C1Compression;
-use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_core::ForwardModel;
 use palpate_uq::likelihood::{
     fit_and_laplace, thermodynamic_integration, DataSet, NoiseModel, Posterior, Prior,
 };
 use palpate_uq::mcmc::{DemcSettings, Sampler};
-use std::path::Path;
 use std::sync::Arc;
+
+mod common;
 
 #[test]
 fn laplace_and_thermodynamic_integration_match_the_exact_evidence() {
-    let t = Table::read(
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/mcmc_c1_rp2_data.csv"),
-    )
-    .unwrap();
-    let sigma: f64 = t
-        .comments
-        .iter()
-        .find_map(|c| {
-            c.split_once("sigma_N = ")
-                .map(|(_, v)| v.trim().parse().unwrap())
-        })
-        .unwrap();
-    let loading = Loading::quasi_static(
-        Drive::DisplacementMm,
-        t.column("displacement_mm").unwrap().to_vec(),
-    );
-    let y = t.column("force_N").unwrap().to_vec();
+    let (loading, y, sigma) = common::c1_rp2_record();
     let model = Arc::new(C1Compression::new("reduced-polynomial:2".parse().unwrap()));
     let (mu0, sd0) = ([7e-4, 2e-3], [2e-4, 1e-3]);
 
