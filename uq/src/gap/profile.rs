@@ -5,7 +5,7 @@
 
 use super::fit::{fit_from_starts, interior, scale_moduli};
 use super::structure::chi2_isf;
-use palpate_core::{ForwardModel, Loading, ParamSpec};
+use palpate_core::{ForwardModel, Loading};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -69,20 +69,12 @@ fn profile_sse(
     if expensive {
         let f = model.predict(&start, loading).ok()?;
         // the moduli other than theta_j rescaled (theta_j itself is held)
-        let others: Vec<ParamSpec> = specs
+        let others_scaled = specs
             .iter()
             .enumerate()
-            .map(|(k, s)| {
-                let mut s = s.clone();
-                if k == j {
-                    s.unit = String::new();
-                }
-                s
-            })
-            .collect();
-        let a = scale_moduli(&others, &start, &f, observed).map_or(1.0, |(a, _)| a);
-        let a = if others.iter().any(|s| s.unit == "MPa") {
-            a
+            .any(|(k, s)| k != j && s.unit == "MPa");
+        let a = if others_scaled {
+            scale_moduli(specs, &start, &f, observed).map_or(1.0, |(a, _)| a)
         } else {
             1.0
         };
