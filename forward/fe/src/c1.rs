@@ -11,7 +11,8 @@ use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, Observable, P
 use palpate_material::Law;
 
 use crate::kinematics::Kinematics;
-use crate::mesh::{Grading, Mesh};
+use crate::mesh::Grading;
+use crate::mesh2d::Mesh;
 use crate::model::{law_space, simulate, Bulk, FeEvaluator, Setup, Simulation};
 use crate::solver::{Constraints, Progress, Solver, SolverOptions};
 use crate::FeError;

@@ -22,7 +22,7 @@
 //! writes the trial state; [`ContactSet::commit`] accepts it.
 
 use crate::kinematics::Kinematics;
-use crate::mesh::Mesh;
+use crate::mesh2d::Mesh;
 use crate::tool::ToolShape;
 use crate::FeError;
 
@@ -341,6 +341,7 @@ impl ContactSet {
 mod tests {
     use super::*;
     use crate::mesh::Grading;
+    use crate::mesh2d::Mesh;
 
     fn set_with(friction: f64, points: ContactPoints) -> (Mesh, ContactSet) {
         let m =

@@ -33,6 +33,7 @@ pub mod error;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;
+pub mod mesh2d;
 pub mod model;
 pub mod n1;
 pub mod quadrature;

@@ -28,7 +28,8 @@ use std::sync::Arc;
 
 use crate::contact::{ContactOptions, ContactPoints, ContactSet, RigidTool};
 use crate::kinematics::Kinematics;
-use crate::mesh::{Grading, Mesh};
+use crate::mesh::Grading;
+use crate::mesh2d::Mesh;
 use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
 use crate::solver::{Constraints, Progress, Solver, SolverOptions};
 use crate::tool::ToolShape;

@@ -11,7 +11,7 @@ use crate::contact::{ContactSet, NodeContact};
 use crate::element::{quad4, reference_volume, ElementOutput, VolumeConstraint};
 use crate::kinematics::Kinematics;
 use crate::material::PointMaterial;
-use crate::mesh::Mesh;
+use crate::mesh2d::Mesh;
 use crate::sparse::{Pattern, SparseLu, NONE};
 use crate::FeError;
 
