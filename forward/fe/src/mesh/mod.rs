@@ -239,7 +239,7 @@ impl Mesh {
                 format!("{:?} cells in a {}D mesh", self.cell_type, self.dim),
             ));
         }
-        if self.cells.len() % self.cell_type.nodes() != 0 {
+        if !self.cells.len().is_multiple_of(self.cell_type.nodes()) {
             return Err(bad(
                 "cells".into(),
                 "connectivity length is not a multiple of the cell's node count".into(),
@@ -269,7 +269,7 @@ impl Mesh {
             }
         }
         for (name, set) in &self.facet_sets {
-            if set.nodes.len() % set.cell_type.nodes() != 0 {
+            if !set.nodes.len().is_multiple_of(set.cell_type.nodes()) {
                 return Err(bad(
                     format!("facet set `{name}`"),
                     "ragged facet list".into(),
