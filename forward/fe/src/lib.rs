@@ -37,6 +37,7 @@ pub mod mesh2d;
 pub mod model;
 pub mod n1;
 pub mod quadrature;
+pub mod shape;
 pub mod solver;
 pub mod sparse;
 pub mod tool;
