@@ -30,6 +30,7 @@ pub mod c1;
 pub mod contact;
 pub mod element;
 pub mod error;
+pub mod kernel;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;

@@ -1,0 +1,754 @@
+//! The solid kernel: one implementation, over the node count `N` and the
+//! reference dimension `D` (fixed-size local algebra), for every continuum
+//! cell in every kinematics, with the pressure field of [`PressureSpace`].
+//!
+//! Residual and tangent are the exact first and second derivatives of the
+//! condensed element functional (see [`super::pressure`]):
+//!
+//! ```text
+//! r_u = int B^T P_iso dV + G^T p                 G_m = dv_m/du = int psi_m (dJ/dF : B) dV
+//! K_uu = int B^T A_iso B dV + sum_m p_m int psi_m B^T (d2J/dF2) B dV  [+ G^T M^-1 Q M^-1 G]
+//! ```
+//!
+//! with `p = s q` for the exact constraint (plus the rows `s (v - V)` and
+//! the coupling `s G`), and `p = M^-1 int U'(theta) psi dV`,
+//! `Q = int U''(theta) psi psi^T dV` for the penalty. The operator B holds
+//! `dF_k / du_(a,c)`: `dN_a/dX_j` at `k = 3 c + j`, and in axisymmetry also
+//! `N_a / R` at `k = 8` (hoop) for `c = 0`. In plane stress the material
+//! point returns the condensed in-plane stress and tangent and there is no
+//! pressure field.
+
+use nalgebra::{Matrix3, SMatrix, SVector};
+use palpate_material::Volumetric;
+
+use super::{ElementInput, ElementKernel, ElementOutput, PressureSpace};
+use crate::kinematics::{jacobian_derivs_3d, Kinematics};
+use crate::mesh::CellType;
+use crate::quadrature::QuadratureRule;
+use crate::shape::ShapeEval;
+use crate::FeError;
+
+/// One column of B: the (at most four) components of `F` that the
+/// displacement dof moves, and by how much.
+#[derive(Debug, Clone, Copy, Default)]
+struct BColumn {
+    k: [usize; 4],
+    v: [f64; 4],
+    len: usize,
+}
+
+/// Reference geometry of one quadrature point.
+struct PointGeometry<const N: usize> {
+    n: [f64; N],
+    /// `dN_a / dX_j` (components beyond `D` zero).
+    g: [[f64; 3]; N],
+    /// Interpolated reference position.
+    x: [f64; 3],
+    /// Reference volume weight (quadrature weight x det J x volume factor).
+    dv: f64,
+}
+
+/// The solid kernel for `N`-node cells of reference dimension `D`.
+pub struct SolidKernel<const N: usize, const D: usize> {
+    cell: CellType,
+    kin: Kinematics,
+    pressure: PressureSpace,
+    /// Shape functions and reference gradients at the quadrature points.
+    shape: Vec<ShapeEval<N, D>>,
+    weights: Vec<f64>,
+}
+
+impl<const N: usize, const D: usize> SolidKernel<N, D> {
+    /// A kernel for `cell` with shape functions `shape` (full integration).
+    pub fn new(
+        cell: CellType,
+        shape: fn(&[f64; 3]) -> ShapeEval<N, D>,
+        kin: Kinematics,
+        pressure: PressureSpace,
+    ) -> Result<Self, FeError> {
+        if cell.nodes() != N || cell.dim() != D || kin.dim() != D {
+            return Err(FeError::InvalidConfig {
+                field: "element".into(),
+                reason: format!("{cell:?} does not fit a {N}-node, {D}D kernel in {kin:?}"),
+            });
+        }
+        let rule = QuadratureRule::for_cell(cell);
+        Ok(SolidKernel {
+            cell,
+            kin,
+            pressure,
+            shape: rule.points.iter().map(shape).collect(),
+            weights: rule.weights,
+        })
+    }
+
+    fn geometry(
+        &self,
+        x: &[[f64; 3]],
+        (n, dns): &ShapeEval<N, D>,
+        w: f64,
+    ) -> Result<PointGeometry<N>, f64> {
+        let mut jac = [[0.0; D]; D]; // jac[i][k] = dX_i / dxi_k
+        let mut xp = [0.0; 3];
+        for a in 0..N {
+            for i in 0..D {
+                xp[i] += n[a] * x[a][i];
+                for k in 0..D {
+                    jac[i][k] += x[a][i] * dns[a][k];
+                }
+            }
+        }
+        let mut g = [[0.0; 3]; N];
+        let det;
+        if D == 2 {
+            det = jac[0][0] * jac[1][1] - jac[0][1] * jac[1][0];
+            if !(det > 0.0) {
+                return Err(det);
+            }
+            // dN/dX = dN/dxi * (dxi/dX); closed-form 2x2 inverse of the Jacobian.
+            let inv = [
+                [jac[1][1] / det, -jac[0][1] / det],
+                [-jac[1][0] / det, jac[0][0] / det],
+            ];
+            for a in 0..N {
+                for j in 0..2 {
+                    g[a][j] = dns[a][0] * inv[0][j] + dns[a][1] * inv[1][j];
+                }
+            }
+        } else {
+            let m = Matrix3::from_fn(|i, k| jac[i][k]);
+            det = m.determinant();
+            if !(det > 0.0) {
+                return Err(det);
+            }
+            let Some(inv) = m.try_inverse() else {
+                return Err(det);
+            };
+            for a in 0..N {
+                for j in 0..3 {
+                    g[a][j] = (0..3).map(|k| dns[a][k] * inv[(k, j)]).sum();
+                }
+            }
+        }
+        Ok(PointGeometry {
+            n: *n,
+            g,
+            x: xp,
+            dv: self.kin.volume_factor(xp[0]) * det * w,
+        })
+    }
+
+    /// Centroid of the corner nodes and the cell size `h` (square root of
+    /// the corner polygon's area in 2D, cube root of the volume in 3D).
+    fn centre_and_size(&self, x: &[[f64; 3]]) -> ([f64; 3], f64) {
+        let corners = match self.cell {
+            CellType::Hex8 => 8,
+            _ => 4,
+        };
+        let mut c = [0.0; 3];
+        for p in &x[..corners] {
+            for i in 0..3 {
+                c[i] += p[i] / corners as f64;
+            }
+        }
+        (c, cell_size(self.cell, x))
+    }
+
+    /// Deformation gradient and the B columns at a point.
+    fn gradient(&self, p: &PointGeometry<N>, u: &[[f64; 3]]) -> (Matrix3<f64>, [[BColumn; 3]; N]) {
+        let mut f = Matrix3::identity();
+        let mut ur = 0.0;
+        for a in 0..N {
+            ur += p.n[a] * u[a][0];
+            for i in 0..D {
+                for j in 0..D {
+                    f[(i, j)] += u[a][i] * p.g[a][j];
+                }
+            }
+        }
+        let hoop = self.kin == Kinematics::Axisymmetric;
+        let mut df22 = 0.0;
+        if D == 2 {
+            let (f22, d) = self.kin.out_of_plane(p.x[0], ur);
+            f[(2, 2)] = f22;
+            df22 = d;
+        }
+        let mut cols = [[BColumn::default(); 3]; N];
+        for a in 0..N {
+            for c in 0..D {
+                let col = &mut cols[a][c];
+                for j in 0..D {
+                    col.k[j] = 3 * c + j;
+                    col.v[j] = p.g[a][j];
+                }
+                col.len = D;
+                if hoop && c == 0 {
+                    col.k[D] = 8;
+                    col.v[D] = p.n[a] * df22;
+                    col.len = D + 1;
+                }
+            }
+        }
+        (f, cols)
+    }
+}
+
+/// Cell size used to scale multipliers and P1 functions: the square root
+/// of the area of the corner polygon (2D) or the cube root of the volume of
+/// the corner hexahedron, by the divergence theorem on its faces (3D).
+pub fn cell_size(cell: CellType, x: &[[f64; 3]]) -> f64 {
+    match cell {
+        CellType::Hex8 => {
+            // volume of the trilinear hexahedron = sum of 6 tetrahedra on the diagonal 0-6
+            let tet = |a: usize, b: usize| {
+                let d = |p: usize| [x[p][0] - x[0][0], x[p][1] - x[0][1], x[p][2] - x[0][2]];
+                let (u, v, w) = (d(a), d(b), d(6));
+                (u[0] * (v[1] * w[2] - v[2] * w[1]) - u[1] * (v[0] * w[2] - v[2] * w[0])
+                    + u[2] * (v[0] * w[1] - v[1] * w[0]))
+                    / 6.0
+            };
+            let v = tet(1, 2) + tet(2, 3) + tet(3, 7) + tet(7, 4) + tet(4, 5) + tet(5, 1);
+            v.abs().cbrt()
+        }
+        _ => {
+            let area2: f64 = (0..4)
+                .map(|k| x[k][0] * x[(k + 1) % 4][1] - x[(k + 1) % 4][0] * x[k][1])
+                .sum();
+            (0.5 * area2).abs().sqrt()
+        }
+    }
+}
+
+/// `t = sum_e v_e X[k_e][.]` over the active components.
+#[inline]
+fn row(col: &BColumn, x: &[[f64; 9]; 9], comps: &[usize]) -> [f64; 9] {
+    let mut t = [0.0; 9];
+    for e in 0..col.len {
+        let (k, v) = (col.k[e], col.v[e]);
+        for &l in comps {
+            t[l] += v * x[k][l];
+        }
+    }
+    t
+}
+
+#[inline]
+fn dot(col: &BColumn, t: &[f64; 9]) -> f64 {
+    let mut s = 0.0;
+    for e in 0..col.len {
+        s += t[col.k[e]] * col.v[e];
+    }
+    s
+}
+
+impl<const N: usize, const D: usize> ElementKernel for SolidKernel<N, D> {
+    fn cell_type(&self) -> CellType {
+        self.cell
+    }
+
+    fn kinematics(&self) -> Kinematics {
+        self.kin
+    }
+
+    fn element_unknowns(&self, volumetric: Volumetric) -> usize {
+        match volumetric {
+            Volumetric::Incompressible => self.pressure.len(D),
+            Volumetric::D1(_) => 0,
+        }
+    }
+
+    fn reference_volume(&self, x: &[[f64; 3]]) -> Result<f64, FeError> {
+        let mut v = 0.0;
+        for (s, &w) in self.shape.iter().zip(&self.weights) {
+            v += self
+                .geometry(x, s, w)
+                .map_err(|det| FeError::InvalidMesh {
+                    field: "element".into(),
+                    reason: format!("reference Jacobian {det:.3e} <= 0"),
+                })?
+                .dv;
+        }
+        Ok(v)
+    }
+
+    fn evaluate(
+        &self,
+        input: &ElementInput,
+        tangent: bool,
+        out: &mut ElementOutput,
+    ) -> Result<(), FeError> {
+        let e = input.element;
+        let nu = N * D;
+        let np = self.pressure.len(D);
+        let exact = matches!(input.volumetric, Volumetric::Incompressible) && np > 0;
+        let nloc = nu + if exact { np } else { 0 };
+        out.reset(nloc, tangent);
+        let comps = self.kin.components();
+        let (centre, h) = self.centre_and_size(input.x);
+        // volume gradients G_m (per local dof) and the psi-weighted
+        // B^T (d2J/dF2) B of each pressure mode
+        let mut gv = vec![[0.0; 4]; nu];
+        let mut d2v = if tangent && np > 0 {
+            vec![0.0; np * nu * nu]
+        } else {
+            Vec::new()
+        };
+        let (mut v, mut vref) = ([0.0; 4], [0.0; 4]);
+        let mut mass = SMatrix::<f64, 4, 4>::identity();
+        for m in 0..np {
+            mass[(m, m)] = 0.0;
+        }
+        let mut points: Vec<([f64; 4], f64)> = Vec::with_capacity(self.weights.len());
+        let (mut vol, mut vol_ref) = (0.0, 0.0);
+        for (s, &w) in self.shape.iter().zip(&self.weights) {
+            let p = self
+                .geometry(input.x, s, w)
+                .map_err(|det| FeError::InvalidMesh {
+                    field: format!("element {e}"),
+                    reason: format!(
+                        "reference Jacobian {det:.3e} <= 0 (corners must be counter-clockwise)"
+                    ),
+                })?;
+            let (mut f, cols) = self.gradient(&p, input.u);
+            let det2 = f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)];
+            if D == 2 && !(det2 > 0.0) {
+                return Err(FeError::InvertedElement {
+                    element: e,
+                    det_f: det2,
+                });
+            }
+            let Some((ps, amat)) =
+                self.kin
+                    .stress_tangent(input.material, input.volumetric, &mut f, tangent)
+            else {
+                return Err(FeError::NonFiniteStress { element: e });
+            };
+            let (j, cof, hj) = jacobian_derivs_3d(&f);
+            if !(j > 0.0) {
+                return Err(FeError::InvertedElement {
+                    element: e,
+                    det_f: j,
+                });
+            }
+            vol += j * p.dv;
+            vol_ref += p.dv;
+            let psi = self.pressure.eval(D, &p.x, &centre, h);
+            points.push((psi, p.dv));
+            for m in 0..np {
+                v[m] += psi[m] * j * p.dv;
+                vref[m] += psi[m] * p.dv;
+                for n in 0..np {
+                    mass[(m, n)] += psi[m] * psi[n] * p.dv;
+                }
+            }
+            for a in 0..N {
+                for c in 0..D {
+                    let col = &cols[a][c];
+                    let i = a * D + c;
+                    out.residual[i] += dot(col, &ps) * p.dv;
+                    if np > 0 {
+                        let dj = dot(col, &cof) * p.dv;
+                        for m in 0..np {
+                            gv[i][m] += psi[m] * dj;
+                        }
+                    }
+                }
+            }
+            if !tangent {
+                continue;
+            }
+            for a in 0..N {
+                for c in 0..D {
+                    let col = &cols[a][c];
+                    let i = a * D + c;
+                    let ta = row(col, &amat, comps);
+                    let th = if np > 0 {
+                        row(col, &hj, comps)
+                    } else {
+                        [0.0; 9]
+                    };
+                    for b in 0..N {
+                        for d in 0..D {
+                            let col2 = &cols[b][d];
+                            let jx = b * D + d;
+                            out.tangent[i * nloc + jx] += dot(col2, &ta) * p.dv;
+                            if np > 0 {
+                                let hv = dot(col2, &th) * p.dv;
+                                for m in 0..np {
+                                    d2v[(m * nu + i) * nu + jx] += psi[m] * hv;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out.volume = vol;
+        out.ref_volume = vol_ref;
+        if np == 0 {
+            return Ok(());
+        }
+        // pressure coefficients p_m (and the penalty's Q)
+        let mut pc = [0.0; 4];
+        let mut penalty_q = None;
+        match input.volumetric {
+            Volumetric::Incompressible => {
+                for m in 0..np {
+                    pc[m] = input.scale * input.q[m];
+                    out.residual[nu + m] = input.scale * (v[m] - vref[m]);
+                }
+            }
+            Volumetric::D1(_) => {
+                let chol = mass.cholesky().ok_or(FeError::InvertedElement {
+                    element: e,
+                    det_f: 0.0,
+                })?;
+                let theta = chol.solve(&SVector::<f64, 4>::from_fn(|m, _| v[m]));
+                let mut rhs = SVector::<f64, 4>::zeros();
+                let mut q = SMatrix::<f64, 4, 4>::zeros();
+                for (psi, dv) in &points {
+                    let th: f64 = (0..np).map(|m| psi[m] * theta[m]).sum();
+                    let (du, d2u) = (input.volumetric.du(th), input.volumetric.d2u(th));
+                    for m in 0..np {
+                        rhs[m] += du * psi[m] * dv;
+                        for n in 0..np {
+                            q[(m, n)] += d2u * psi[m] * psi[n] * dv;
+                        }
+                    }
+                }
+                let p = chol.solve(&rhs);
+                for m in 0..np {
+                    pc[m] = p[m];
+                }
+                if tangent {
+                    // M^-1 Q M^-1
+                    let mq = chol.solve(&q);
+                    penalty_q = Some(chol.solve(&mq.transpose()));
+                }
+            }
+        }
+        out.pressure = pc[0];
+        for i in 0..nu {
+            for m in 0..np {
+                out.residual[i] += pc[m] * gv[i][m];
+            }
+        }
+        if !tangent {
+            return Ok(());
+        }
+        for i in 0..nu {
+            for jx in 0..nu {
+                let mut s = 0.0;
+                for m in 0..np {
+                    s += pc[m] * d2v[(m * nu + i) * nu + jx];
+                }
+                out.tangent[i * nloc + jx] += s;
+            }
+        }
+        if exact {
+            for i in 0..nu {
+                for m in 0..np {
+                    let k = input.scale * gv[i][m];
+                    out.tangent[i * nloc + nu + m] = k;
+                    out.tangent[(nu + m) * nloc + i] = k;
+                }
+            }
+        } else if let Some(q) = penalty_q {
+            for i in 0..nu {
+                for jx in 0..nu {
+                    let mut s = 0.0;
+                    for m in 0..np {
+                        for n in 0..np {
+                            s += gv[i][m] * q[(m, n)] * gv[jx][n];
+                        }
+                    }
+                    out.tangent[i * nloc + jx] += s;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn mean_cauchy_stress(&self, input: &ElementInput, pressure: f64) -> [f64; 6] {
+        let mut s = [0.0; 6];
+        let mut vsum = 0.0;
+        for (sh, &w) in self.shape.iter().zip(&self.weights) {
+            let Ok(p) = self.geometry(input.x, sh, w) else {
+                continue;
+            };
+            let (mut f, _) = self.gradient(&p, input.u);
+            let Some((_, _)) =
+                self.kin
+                    .stress_tangent(input.material, input.volumetric, &mut f, false)
+            else {
+                continue;
+            };
+            let j = f.determinant();
+            let sig = match self.kin {
+                Kinematics::PlaneStress { .. } => {
+                    let (pt, _) = crate::kinematics::total_stress_tangent(
+                        input.material,
+                        input.volumetric,
+                        &f,
+                    );
+                    let pm = Matrix3::from_fn(|i, k| pt[3 * i + k]);
+                    let sig = pm * f.transpose() / j;
+                    // incompressible: the pressure that makes sigma_33 = 0
+                    if matches!(input.volumetric, Volumetric::Incompressible) {
+                        sig - Matrix3::identity() * sig[(2, 2)]
+                    } else {
+                        sig
+                    }
+                }
+                _ => {
+                    let (p_iso, _) = input.material.iso_stress_tangent(&f);
+                    p_iso * f.transpose() / j + Matrix3::identity() * pressure
+                }
+            };
+            for (k, (i, jj)) in [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0)]
+                .into_iter()
+                .enumerate()
+            {
+                s[k] += sig[(i, jj)] * p.dv;
+            }
+            vsum += p.dv;
+        }
+        s.map(|v| v / vsum)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::kernel::kernel_for;
+    use crate::material::{LawMaterial, NeoHookeanIso, PointMaterial};
+
+    fn quad4_x() -> Vec<[f64; 3]> {
+        vec![
+            [0.5, 0.0, 0.0],
+            [1.6, 0.1, 0.0],
+            [1.5, 1.2, 0.0],
+            [0.4, 0.9, 0.0],
+        ]
+    }
+
+    /// A distorted 9-node quadrilateral: the corners of `quad4_x`, edge
+    /// nodes moved off the midpoints, centre off the centroid.
+    fn quad9_x() -> Vec<[f64; 3]> {
+        let c = quad4_x();
+        let mid = |a: usize, b: usize, o: [f64; 2]| {
+            [
+                0.5 * (c[a][0] + c[b][0]) + o[0],
+                0.5 * (c[a][1] + c[b][1]) + o[1],
+                0.0,
+            ]
+        };
+        let mut x = c.clone();
+        x.push(mid(0, 1, [0.02, -0.03]));
+        x.push(mid(1, 2, [0.04, 0.01]));
+        x.push(mid(2, 3, [-0.01, 0.03]));
+        x.push(mid(3, 0, [-0.02, 0.0]));
+        x.push([1.02, 0.57, 0.0]);
+        x
+    }
+
+    fn hex8_x() -> Vec<[f64; 3]> {
+        let mut x: Vec<[f64; 3]> = crate::shape::HEX8_NODES
+            .iter()
+            .map(|p| [0.5 * (p[0] + 1.0), 0.6 * (p[1] + 1.0), 0.55 * (p[2] + 1.0)])
+            .collect();
+        x[6][0] += 0.1;
+        x[1][1] -= 0.05;
+        x[4][2] += 0.07;
+        x
+    }
+
+    fn displacements(x: &[[f64; 3]], dim: usize) -> Vec<[f64; 3]> {
+        x.iter()
+            .enumerate()
+            .map(|(a, p)| {
+                let s = a as f64;
+                let mut u = [
+                    0.05 * (s * 1.3).sin() + 0.02 * p[1],
+                    -0.04 * (s * 0.7).cos() - 0.01 * p[0],
+                    0.03 * (s * 0.9).sin(),
+                ];
+                if dim == 2 {
+                    u[2] = 0.0;
+                }
+                u
+            })
+            .collect()
+    }
+
+    fn check_fd(
+        cell: CellType,
+        kin: Kinematics,
+        pressure: PressureSpace,
+        vol: Volumetric,
+        mat: &dyn PointMaterial,
+    ) {
+        let k = kernel_for(cell, kin, pressure).unwrap();
+        let x = match cell {
+            CellType::Quad4 => quad4_x(),
+            CellType::Quad9 => quad9_x(),
+            _ => hex8_x(),
+        };
+        let dim = kin.dim();
+        let u = displacements(&x, dim);
+        let np = k.element_unknowns(vol);
+        let q: Vec<f64> = (0..np).map(|m| 0.3 - 0.2 * m as f64).collect();
+        let input = |u: &[[f64; 3]], q: &[f64], out: &mut ElementOutput, t: bool| {
+            let inp = ElementInput {
+                element: 0,
+                x: &x,
+                u,
+                q,
+                material: mat,
+                volumetric: vol,
+                scale: 0.7,
+            };
+            k.evaluate(&inp, t, out).unwrap();
+        };
+        let mut out = ElementOutput::default();
+        input(&u, &q, &mut out, true);
+        let n = out.residual.len();
+        assert_eq!(n, x.len() * dim + np);
+        let h = 1e-6;
+        let (mut plus, mut minus) = (ElementOutput::default(), ElementOutput::default());
+        let scale = out.tangent.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        for c in 0..n {
+            let (mut up, mut um, mut qp, mut qm) = (u.clone(), u.clone(), q.clone(), q.clone());
+            if c < x.len() * dim {
+                up[c / dim][c % dim] += h;
+                um[c / dim][c % dim] -= h;
+            } else {
+                qp[c - x.len() * dim] += h;
+                qm[c - x.len() * dim] -= h;
+            }
+            input(&up, &qp, &mut plus, false);
+            input(&um, &qm, &mut minus, false);
+            for r in 0..n {
+                let fd = (plus.residual[r] - minus.residual[r]) / (2.0 * h);
+                let kk = out.tangent[r * n + c];
+                assert!(
+                    (fd - kk).abs() < 1e-6 * scale,
+                    "{cell:?} {kin:?} {pressure:?} {vol:?} K[{r}][{c}] = {kk}, fd {fd}"
+                );
+            }
+        }
+        for r in 0..n {
+            for c in 0..n {
+                let (a, b) = (out.tangent[r * n + c], out.tangent[c * n + r]);
+                assert!(
+                    (a - b).abs() < 1e-10 * scale,
+                    "{cell:?} {kin:?} unsymmetric {r} {c}"
+                );
+            }
+        }
+    }
+
+    /// Every kernel in every kinematics, exact and penalty: the tangent is
+    /// the derivative of the residual, and symmetric (energy-derived).
+    #[test]
+    fn tangents_match_finite_differences_in_every_kinematics() {
+        let nh = NeoHookeanIso { c10: 0.5 };
+        let yeoh =
+            LawMaterial::new("reduced-polynomial:2".parse().unwrap(), vec![0.4, 0.2]).unwrap();
+        let mats: [&dyn PointMaterial; 2] = [&nh, &yeoh];
+        let two_d = [
+            Kinematics::Axisymmetric,
+            Kinematics::PlaneStrain { thickness: 2.0 },
+        ];
+        for mat in mats {
+            for vol in [Volumetric::Incompressible, Volumetric::D1(0.05)] {
+                for kin in two_d {
+                    check_fd(CellType::Quad4, kin, PressureSpace::P0, vol, mat);
+                    check_fd(CellType::Quad9, kin, PressureSpace::P1, vol, mat);
+                    check_fd(CellType::Quad9, kin, PressureSpace::P0, vol, mat);
+                }
+                check_fd(
+                    CellType::Hex8,
+                    Kinematics::ThreeD,
+                    PressureSpace::P0,
+                    vol,
+                    mat,
+                );
+                let ps = Kinematics::PlaneStress { thickness: 0.5 };
+                check_fd(CellType::Quad4, ps, PressureSpace::None, vol, mat);
+                check_fd(CellType::Quad9, ps, PressureSpace::None, vol, mat);
+            }
+        }
+    }
+
+    /// The 4-node mixed quadrilateral equals the original Q1/P0 element
+    /// (the one N1 and C1 were validated with) to round-off.
+    #[test]
+    fn quad4_p0_equals_the_original_element() {
+        use crate::element::{quad4, ElementOutput as Old, VolumeConstraint};
+        let m = NeoHookeanIso { c10: 0.5 };
+        let x = quad4_x();
+        let u = displacements(&x, 2);
+        let x2: [[f64; 2]; 4] = std::array::from_fn(|a| [x[a][0], x[a][1]]);
+        let u2: [[f64; 2]; 4] = std::array::from_fn(|a| [u[a][0], u[a][1]]);
+        for kin in [
+            Kinematics::Axisymmetric,
+            Kinematics::PlaneStrain { thickness: 2.0 },
+        ] {
+            for (vol, cons) in [
+                (
+                    Volumetric::Incompressible,
+                    VolumeConstraint::Exact { scale: 0.7 },
+                ),
+                (Volumetric::D1(0.05), VolumeConstraint::Penalty { d1: 0.05 }),
+            ] {
+                let mut old = Old::default();
+                quad4(kin, &x2, &u2, 0.3, &m, cons, true, 0, &mut old).unwrap();
+                let k = kernel_for(CellType::Quad4, kin, PressureSpace::P0).unwrap();
+                let mut out = ElementOutput::default();
+                let q = [0.3];
+                let inp = ElementInput {
+                    element: 0,
+                    x: &x,
+                    u: &u,
+                    q: &q[..k.element_unknowns(vol)],
+                    material: &m,
+                    volumetric: vol,
+                    scale: 0.7,
+                };
+                k.evaluate(&inp, true, &mut out).unwrap();
+                let n = out.residual.len();
+                for r in 0..n {
+                    assert!(
+                        (out.residual[r] - old.residual[r]).abs() < 1e-13,
+                        "{kin:?} r{r}"
+                    );
+                    for c in 0..n {
+                        let d = out.tangent[r * n + c] - old.tangent[r][c];
+                        assert!(d.abs() < 1e-12, "{kin:?} {vol:?} K{r}{c} {d}");
+                    }
+                }
+                assert!((out.pressure - old.pressure).abs() < 1e-13);
+            }
+        }
+    }
+
+    #[test]
+    fn plane_stress_with_a_pressure_field_is_refused() {
+        let ps = Kinematics::PlaneStress { thickness: 1.0 };
+        assert!(kernel_for(CellType::Quad4, ps, PressureSpace::P0).is_err());
+        assert!(kernel_for(
+            CellType::Quad4,
+            Kinematics::Axisymmetric,
+            PressureSpace::None
+        )
+        .is_err());
+        assert!(kernel_for(CellType::Hex8, Kinematics::Axisymmetric, PressureSpace::P0).is_err());
+        assert!(kernel_for(
+            CellType::Quad4,
+            Kinematics::PlaneStrain { thickness: -1.0 },
+            PressureSpace::P0
+        )
+        .is_err());
+    }
+}
