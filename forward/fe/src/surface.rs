@@ -16,8 +16,8 @@
 //! ```
 //!
 //! where `x_c` is the closest point of the surface (the normal-gap
-//! definition of Wriggers, *Computational Contact Mechanics*, 2nd ed.,
-//! Springer 2006, ch. 4.1, eqs. 4.4-4.6). For each smooth piece of surface
+//! definition and closest-point projection of Wriggers, *Computational
+//! Contact Mechanics*, 2nd ed., Springer 2006, ch. 4). For each smooth piece of surface
 //! the gap is a distance function, so `dg/dp = n` and `dn/dp` is its
 //! (symmetric) Hessian: in the principal directions of the surface at `x_c`
 //! with curvatures `k_a` (positive for a convex tool) its eigenvalues are
@@ -40,9 +40,10 @@
 //!
 //!   the second term being the hoop (parallel-circle) curvature of the
 //!   distance function at the query point's own radius (the principal
-//!   curvature `sin(angle)/r` of a surface of revolution, e.g. do Carmo,
-//!   *Differential Geometry of Curves and Surfaces*, 1976, sec. 3-3,
-//!   example 4, evaluated on the offset surface through `p`).
+//!   curvature of a surface of revolution along its parallels, normal
+//!   component `n_r` over radius; e.g. do Carmo, *Differential Geometry of
+//!   Curves and Surfaces*, 1976, ch. 3; here on the offset surface through
+//!   `p`).
 //!
 //! In 2D [`SurfacePoint`] also carries the tangent `t = (-n_y, n_x)` and the
 //! arc length `xi` of the closest point along the profile, exactly as
@@ -814,6 +815,23 @@ mod tests {
         // The sphere's hoop curvature on the axis is its meridional one.
         let sp = Revolution3d(sphere_shape()).project([0.0, 0.0, -1.5]);
         assert!((sp.dnormal[0][0] - 0.25).abs() < 1e-15 && (sp.dnormal[1][1] - 0.25).abs() < 1e-15);
+    }
+
+    #[test]
+    fn platen_3d_is_the_plane_z_0() {
+        let s = Revolution3d(ToolShape::Platen);
+        for p in [
+            [0.0, 0.0, -1.0],
+            [3.0, -4.0, 0.5],
+            [-1e-9, 2.0, -7.0],
+            [1e6, 1e6, 0.0],
+        ] {
+            let sp = s.project(p);
+            assert_eq!(sp.gap, -p[2]);
+            assert_eq!(sp.normal, [0.0, 0.0, -1.0]);
+            assert_eq!(sp.dnormal, [[0.0; 3]; 3]);
+            assert_eq!(sp.closest(p), [p[0], p[1], 0.0]);
+        }
     }
 
     #[test]
