@@ -7,6 +7,8 @@
 //! * [`mesh`] — structured graded quadrilateral meshes with named sets.
 //! * [`kinematics`] — the kinematic idealisation (an enum owned by the element).
 //! * [`element`] — the Q1/P0 (Simo-Taylor-Pister) mixed element.
+//! * [`surface`] — rigid tool surfaces for 2D and 3D models behind one
+//!   trait (revolved profiles, wheels, platens).
 //! * [`tool`] / [`contact`] — analytic rigid tools and augmented-Lagrangian
 //!   Coulomb contact at surface nodes or edge Gauss points, with
 //!   trial/commit history.
@@ -41,6 +43,7 @@ pub mod quadrature;
 pub mod shape;
 pub mod solver;
 pub mod sparse;
+pub mod surface;
 pub mod tool;
 pub mod vtu;
 
@@ -51,4 +54,5 @@ pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Needle};
 pub use solver::{Progress, RunStats, SolverOptions};
+pub use surface::{Cylinder3d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};
 pub use tool::ToolShape;

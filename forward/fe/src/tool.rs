@@ -46,6 +46,40 @@ pub struct Projection {
     pub dxi: [f64; 2],
 }
 
+/// One smooth piece of a tool's profile, in tool-local `(r, z)`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Segment {
+    /// A circular arc of `radius` centred at `centre`, with arc length
+    /// `xi = xi0 + radius * phi`, `phi` measured from straight down
+    /// (counter-clockwise in the `(r, z)` plane).
+    Arc {
+        centre: [f64; 2],
+        radius: f64,
+        xi0: f64,
+    },
+    /// A straight line through `point` with outward unit `normal`; `xi` is
+    /// `xi0` at `point` and increases along the tangent `(-n_z, n_r)`.
+    Line {
+        point: [f64; 2],
+        normal: [f64; 2],
+        xi0: f64,
+    },
+}
+
+impl Segment {
+    /// Projection of `p` onto this segment (extended beyond its ends).
+    pub fn project(&self, p: [f64; 2]) -> Projection {
+        match *self {
+            Segment::Arc {
+                centre,
+                radius,
+                xi0,
+            } => arc(p, centre, radius, xi0),
+            Segment::Line { point, normal, xi0 } => line(p, point, normal, xi0),
+        }
+    }
+}
+
 /// Projection onto a circular arc of radius `radius` centred at `c`, with
 /// `xi = xi0 + radius * phi`, `phi` measured from straight down.
 fn arc(p: [f64; 2], c: [f64; 2], radius: f64, xi0: f64) -> Projection {
@@ -125,8 +159,21 @@ impl ToolShape {
 
     /// Closest-point projection of the tool-local point `p = (r, z)`.
     pub fn project(&self, p: [f64; 2]) -> Projection {
+        self.segment(p).project(p)
+    }
+
+    /// The profile segment (arc or straight line) that [`ToolShape::project`]
+    /// projects `p = (r, z)` onto. The choice is made by region (the angle
+    /// about an arc's centre, or the punch's corner coordinates), so a point
+    /// deep inside the tool may be assigned a segment that is not the
+    /// globally closest one.
+    pub fn segment(&self, p: [f64; 2]) -> Segment {
         match *self {
-            ToolShape::Sphere { radius } => arc(p, [0.0, radius], radius, 0.0),
+            ToolShape::Sphere { radius } => Segment::Arc {
+                centre: [0.0, radius],
+                radius,
+                xi0: 0.0,
+            },
             ToolShape::Needle {
                 tip_radius: rt,
                 half_angle_deg,
@@ -135,29 +182,48 @@ impl ToolShape {
                 let phi_t = std::f64::consts::FRAC_PI_2 - alpha;
                 let phi = p[0].atan2(-(p[1] - rt));
                 if phi <= phi_t {
-                    arc(p, [0.0, rt], rt, 0.0)
+                    Segment::Arc {
+                        centre: [0.0, rt],
+                        radius: rt,
+                        xi0: 0.0,
+                    }
                 } else {
                     let tp = [rt * phi_t.sin(), rt - rt * phi_t.cos()];
-                    line(p, tp, [alpha.cos(), -alpha.sin()], rt * phi_t)
+                    Segment::Line {
+                        point: tp,
+                        normal: [alpha.cos(), -alpha.sin()],
+                        xi0: rt * phi_t,
+                    }
                 }
             }
-            ToolShape::Platen => line(p, [0.0, 0.0], [0.0, -1.0], 0.0),
+            ToolShape::Platen => Segment::Line {
+                point: [0.0, 0.0],
+                normal: [0.0, -1.0],
+                xi0: 0.0,
+            },
             ToolShape::FlatPunch {
                 radius,
                 edge_radius,
             } => {
                 let c = [radius - edge_radius, edge_radius];
                 if p[0] <= c[0] {
-                    line(p, [0.0, 0.0], [0.0, -1.0], 0.0)
+                    Segment::Line {
+                        point: [0.0, 0.0],
+                        normal: [0.0, -1.0],
+                        xi0: 0.0,
+                    }
                 } else if p[1] <= c[1] {
-                    arc(p, c, edge_radius, c[0])
+                    Segment::Arc {
+                        centre: c,
+                        radius: edge_radius,
+                        xi0: c[0],
+                    }
                 } else {
-                    line(
-                        p,
-                        [radius, edge_radius],
-                        [1.0, 0.0],
-                        c[0] + edge_radius * std::f64::consts::FRAC_PI_2 - edge_radius,
-                    )
+                    Segment::Line {
+                        point: [radius, edge_radius],
+                        normal: [1.0, 0.0],
+                        xi0: c[0] + edge_radius * std::f64::consts::FRAC_PI_2 - edge_radius,
+                    }
                 }
             }
         }
