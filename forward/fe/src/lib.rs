@@ -9,6 +9,8 @@
 //! * [`element`] — the Q1/P0 (Simo-Taylor-Pister) mixed element.
 //! * [`surface`] — rigid tool surfaces for 2D and 3D models behind one
 //!   trait (revolved profiles, wheels, platens).
+//! * [`motion`] — rigid tool motion (translation, rotation, rolling
+//!   without slip) driven by loading channels, and the global projection.
 //! * [`tool`] / [`contact`] — analytic rigid tools and augmented-Lagrangian
 //!   Coulomb contact at surface nodes or edge Gauss points, with
 //!   trial/commit history.
@@ -38,6 +40,7 @@ pub mod material;
 pub mod mesh;
 pub mod mesh2d;
 pub mod model;
+pub mod motion;
 pub mod n1;
 pub mod quadrature;
 pub mod shape;

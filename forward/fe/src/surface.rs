@@ -107,7 +107,7 @@ impl SurfacePoint {
     }
 
     /// A 2D profile projection embedded with zero z components.
-    fn from_2d(pr: &Projection) -> Self {
+    pub(crate) fn from_2d(pr: &Projection) -> Self {
         let v = |a: [f64; 2]| [a[0], a[1], 0.0];
         let m = |a: [[f64; 2]; 2]| [v(a[0]), v(a[1]), [0.0; 3]];
         SurfacePoint {
