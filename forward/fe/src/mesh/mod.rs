@@ -9,8 +9,13 @@
 //!
 //! * [`grading`] — graded spacings along one coordinate.
 //! * [`structured`] — tensor-product generators for the reference problems.
+//! * [`gmsh`] — reader for Gmsh MSH 4.1 ASCII files (physical groups become
+//!   regions, facet sets and node sets).
+//! * [`jacobian`] — corner Jacobian determinants (the inversion test).
 
+pub mod gmsh;
 pub mod grading;
+pub mod jacobian;
 pub mod structured;
 
 use std::collections::BTreeMap;
