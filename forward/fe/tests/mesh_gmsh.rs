@@ -141,3 +141,23 @@ fn hex_box() {
         }
     }
 }
+
+/// Elevating Gmsh's first-order mesh gives the node and set counts of the
+/// second-order mesh Gmsh made from the same geometry (one node per edge and
+/// per cell), though its curved interface stays polygonal.
+#[test]
+fn quad4_fixture_elevated_matches_gmsh_second_order_counts() {
+    let q4 = fixture("inclusion_quad4.msh").to_quadratic().unwrap();
+    let q9 = fixture("inclusion_quad9.msh");
+    q4.validate().unwrap();
+    assert_eq!(q4.nodes.len(), q9.nodes.len());
+    assert_eq!(q4.cell_count(), q9.cell_count());
+    assert_eq!(q4.regions, q9.regions);
+    for name in q9.facet_sets.keys() {
+        let (a, b) = (q4.facet_set(name).unwrap(), q9.facet_set(name).unwrap());
+        assert_eq!((a.cell_type, a.len()), (b.cell_type, b.len()), "{name}");
+    }
+    for (name, set) in &q9.node_sets {
+        assert_eq!(q4.node_set(name).unwrap().len(), set.len(), "{name}");
+    }
+}

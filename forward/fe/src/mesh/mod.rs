@@ -12,10 +12,12 @@
 //! * [`gmsh`] — reader for Gmsh MSH 4.1 ASCII files (physical groups become
 //!   regions, facet sets and node sets).
 //! * [`jacobian`] — corner Jacobian determinants (the inversion test).
+//! * [`quadratic`] — order elevation, 4-node to 9-node quadrilaterals.
 
 pub mod gmsh;
 pub mod grading;
 pub mod jacobian;
+pub mod quadratic;
 pub mod structured;
 
 use std::collections::BTreeMap;
