@@ -9,6 +9,14 @@ pub enum FeError {
     /// A mesh description is unusable.
     #[error("mesh `{field}`: {reason}")]
     InvalidMesh { field: String, reason: String },
+    /// A mesh file is unreadable or describes an unusable mesh; `line` is
+    /// 1-based (0 when the fault is not tied to a line, e.g. an I/O error).
+    #[error("{file}:{line}: {reason}")]
+    MeshFile {
+        file: String,
+        line: usize,
+        reason: String,
+    },
     /// A rigid tool starts inside the body.
     #[error("tool `{tool}` starts inside the body at node {node} (r = {r} mm, z = {z} mm, gap {gap:.3e} mm)")]
     ToolStartsInside {

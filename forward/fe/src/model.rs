@@ -71,6 +71,10 @@ pub(crate) fn to_forward(e: FeError) -> ForwardError {
         FeError::InvalidConfig { field, reason } | FeError::InvalidMesh { field, reason } => {
             ForwardError::InvalidConfig { field, reason }
         }
+        FeError::MeshFile { file, line, reason } => ForwardError::InvalidConfig {
+            field: file,
+            reason: format!("line {line}: {reason}"),
+        },
         other => ForwardError::InvalidConfig {
             field: "fe".into(),
             reason: other.to_string(),
@@ -82,6 +86,7 @@ fn failure(f: RunFailure) -> ForwardError {
     match f.error {
         FeError::InvalidConfig { .. }
         | FeError::InvalidMesh { .. }
+        | FeError::MeshFile { .. }
         | FeError::ToolStartsInside { .. } => to_forward(f.error),
         e => ForwardError::NotConverged {
             sample: f.sample,

@@ -9,9 +9,22 @@
 //!
 //! * [`grading`] — graded spacings along one coordinate.
 //! * [`structured`] — tensor-product generators for the reference problems.
+//! * [`gmsh`] — reader for Gmsh MSH 4.1 ASCII files (physical groups become
+//!   regions, facet sets and node sets).
+//! * [`jacobian`] — corner Jacobian determinants (the inversion test).
+//! * [`quadratic`] — order elevation, 4-node to 9-node quadrilaterals.
+//! * [`vtu`] — VTK XML UnstructuredGrid output of a mesh or a facet set,
+//!   any cell type, with point and cell data.
+//!
+//! The old solver still runs on [`crate::mesh2d`] and writes with
+//! [`crate::vtu`]; those stay until it moves onto this mesh.
 
+pub mod gmsh;
 pub mod grading;
+pub mod jacobian;
+pub mod quadratic;
 pub mod structured;
+pub mod vtu;
 
 use std::collections::BTreeMap;
 

@@ -1,7 +1,12 @@
 //! Structured (tensor-product) meshes for the reference problems: graded
-//! rectangles of 4-node quadrilaterals in 2D. Sets are named after the
-//! sides: node and facet sets `axis` (x = 0), `side` (x = width), `bottom`
-//! (y = 0) and `top` (y = height); every cell is in region `body`.
+//! rectangles of 4-node quadrilaterals in 2D and graded boxes of 8-node
+//! hexahedra in 3D; every cell is in region `body`.
+//!
+//! Rectangle sets are named after the sides: node and facet sets `axis`
+//! (x = 0), `side` (x = width), `bottom` (y = 0) and `top` (y = height).
+//! Box sets: node and Quad4 facet sets `x0`, `x1`, `y0`, `y1`, `bottom`
+//! (z = 0) and `top` (z = lz), facets ordered so that their normals (right
+//! hand rule) point out of the box.
 
 use super::{CellType, FacetSet, Grading, Mesh};
 use crate::FeError;
@@ -63,8 +68,110 @@ impl Mesh {
     }
 }
 
+impl Mesh {
+    /// The box `[0, lx] x [0, ly] x [0, lz]` of 8-node hexahedra with the
+    /// fine end of `gx` at x = 0, of `gy` at y = 0 and of `gz` at the top
+    /// z = lz (where tools press). Node `(i, j, k)` is
+    /// `(k * ny + j) * nx + i`; cells are in Gmsh order (positive volume).
+    pub fn graded_box(
+        lx: f64,
+        ly: f64,
+        lz: f64,
+        gx: Grading,
+        gy: Grading,
+        gz: Grading,
+    ) -> Result<Mesh, FeError> {
+        let xs = gx.positions(lx)?;
+        let ys = gy.positions(ly)?;
+        let zs: Vec<f64> = gz.positions(lz)?.iter().rev().map(|t| lz - t).collect();
+        Ok(Self::tensor3(&xs, &ys, &zs))
+    }
+
+    /// Tensor-product mesh of 8-node hexahedra on the increasing coordinate
+    /// lines `xs` x `ys` x `zs`, with the sets of [`Mesh::graded_box`].
+    pub fn tensor3(xs: &[f64], ys: &[f64], zs: &[f64]) -> Mesh {
+        let (nx, ny, nz) = (xs.len(), ys.len(), zs.len());
+        let id = |i: usize, j: usize, k: usize| (k * ny + j) * nx + i;
+        let mut m = Mesh::empty(3, CellType::Hex8);
+        for &z in zs {
+            for &y in ys {
+                for &x in xs {
+                    m.nodes.push([x, y, z]);
+                }
+            }
+        }
+        let (ex, ey, ez) = (
+            nx.saturating_sub(1),
+            ny.saturating_sub(1),
+            nz.saturating_sub(1),
+        );
+        for k in 0..ez {
+            for j in 0..ey {
+                for i in 0..ex {
+                    m.cells.extend([
+                        id(i, j, k),
+                        id(i + 1, j, k),
+                        id(i + 1, j + 1, k),
+                        id(i, j + 1, k),
+                        id(i, j, k + 1),
+                        id(i + 1, j, k + 1),
+                        id(i + 1, j + 1, k + 1),
+                        id(i, j + 1, k + 1),
+                    ]);
+                }
+            }
+        }
+        // A face of the box: the grid of the two free indices `(a, b)`, and
+        // whether the quad `(a, b) (a+1, b) (a+1, b+1) (a, b+1)` faces out
+        // (otherwise it is reversed).
+        let mut face =
+            |name: &str, na: usize, nb: usize, node: &dyn Fn(usize, usize) -> usize, out: bool| {
+                let mut facets = Vec::new();
+                for b in 0..nb.saturating_sub(1) {
+                    for a in 0..na.saturating_sub(1) {
+                        let q = [
+                            node(a, b),
+                            node(a + 1, b),
+                            node(a + 1, b + 1),
+                            node(a, b + 1),
+                        ];
+                        if out {
+                            facets.extend(q);
+                        } else {
+                            facets.extend([q[0], q[3], q[2], q[1]]);
+                        }
+                    }
+                }
+                let mut set: Vec<usize> = (0..nb)
+                    .flat_map(|b| (0..na).map(move |a| (a, b)))
+                    .map(|(a, b)| node(a, b))
+                    .collect();
+                set.sort_unstable();
+                m.facet_sets.insert(
+                    name.into(),
+                    FacetSet {
+                        cell_type: CellType::Quad4,
+                        nodes: facets,
+                    },
+                );
+                m.node_sets.insert(name.into(), set);
+            };
+        // (a, b) = (y, z) turns about +x, (x, z) about -y, (x, y) about +z.
+        face("x0", ny, nz, &|a, b| id(0, a, b), false);
+        face("x1", ny, nz, &|a, b| id(nx.saturating_sub(1), a, b), true);
+        face("y0", nx, nz, &|a, b| id(a, 0, b), true);
+        face("y1", nx, nz, &|a, b| id(a, ny.saturating_sub(1), b), false);
+        face("bottom", nx, ny, &|a, b| id(a, b, 0), false);
+        face("top", nx, ny, &|a, b| id(a, b, nz.saturating_sub(1)), true);
+        m.regions
+            .insert("body".into(), (0..m.cell_count()).collect());
+        m
+    }
+}
+
 #[cfg(test)]
 mod tests {
+    use super::super::jacobian::corner_jacobians;
     use super::*;
 
     #[test]
@@ -95,5 +202,70 @@ mod tests {
         }
         assert!(m.node_set("nope").is_err());
         assert_eq!(m.region("body").unwrap().len(), 6);
+    }
+
+    #[test]
+    fn box_sets_orientation_and_grading() {
+        let g = Grading {
+            h_fine: 0.5,
+            fine_length: 1.0,
+            growth: 1.5,
+        };
+        let m = Mesh::graded_box(3.0, 2.0, 4.0, g, Grading::uniform(2.0, 2), g).unwrap();
+        m.validate().unwrap();
+        let xs = g.positions(3.0).unwrap();
+        let nz = g.positions(4.0).unwrap().len();
+        let (nx, ny) = (xs.len(), 3);
+        assert_eq!(m.nodes.len(), nx * ny * nz);
+        assert_eq!(m.cell_count(), (nx - 1) * (ny - 1) * (nz - 1));
+        assert_eq!(m.region("body").unwrap().len(), m.cell_count());
+        // Fine end of x at x = 0, of z at the top.
+        assert!((m.nodes[1][0] - 0.5).abs() < 1e-12);
+        let top = m.nodes[(nz - 1) * nx * ny][2];
+        let below = m.nodes[(nz - 2) * nx * ny][2];
+        assert_eq!(top, 4.0);
+        assert!((top - below - 0.5).abs() < 1e-12);
+        for c in m.cells() {
+            let x: Vec<[f64; 3]> = c.iter().map(|&n| m.nodes[n]).collect();
+            assert!(corner_jacobians(CellType::Hex8, &x)
+                .iter()
+                .all(|&j| j > 0.0));
+        }
+        let centre = [1.5, 1.0, 2.0];
+        let planes = [
+            ("x0", 0, 0.0),
+            ("x1", 0, 3.0),
+            ("y0", 1, 0.0),
+            ("y1", 1, 2.0),
+            ("bottom", 2, 0.0),
+            ("top", 2, 4.0),
+        ];
+        let mut facets = 0;
+        for (name, axis, at) in planes {
+            let set = m.node_set(name).unwrap();
+            assert!(set.iter().all(|&n| m.nodes[n][axis] == at), "{name}");
+            let count = m.nodes.iter().filter(|p| p[axis] == at).count();
+            assert_eq!(set.len(), count, "{name}");
+            let fs = m.facet_set(name).unwrap();
+            assert_eq!(fs.cell_type, CellType::Quad4);
+            for f in fs.iter() {
+                let p: Vec<[f64; 3]> = f.iter().map(|&n| m.nodes[n]).collect();
+                assert!(p.iter().all(|q| q[axis] == at), "{name}");
+                // Normal from the diagonals' cross product, against the
+                // direction from the box centre.
+                let d1: Vec<f64> = (0..3).map(|i| p[2][i] - p[0][i]).collect();
+                let d2: Vec<f64> = (0..3).map(|i| p[3][i] - p[1][i]).collect();
+                let n = [
+                    d1[1] * d2[2] - d1[2] * d2[1],
+                    d1[2] * d2[0] - d1[0] * d2[2],
+                    d1[0] * d2[1] - d1[1] * d2[0],
+                ];
+                let out: f64 = (0..3).map(|i| n[i] * (p[0][i] - centre[i])).sum();
+                assert!(n[axis].abs() > 0.0 && out > 0.0, "{name}");
+            }
+            facets += fs.len();
+        }
+        let (ex, ey, ez) = (nx - 1, ny - 1, nz - 1);
+        assert_eq!(facets, 2 * (ex * ey + ey * ez + ex * ez));
     }
 }
