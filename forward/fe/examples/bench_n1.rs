@@ -121,7 +121,7 @@ fn run(case: Case, threads: usize) -> Run {
     Run {
         forces: [at(AT[0]), at(AT[1]), at(AT[2])],
         stats: sim.stats,
-        elements: solver.mesh.elements.len(),
+        elements: solver.mesh.cell_count(),
         unknowns: solver.equations(),
         wall,
         cpu,

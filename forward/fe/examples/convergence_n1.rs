@@ -120,7 +120,7 @@ fn forces(case: Case, knobs: Knobs) -> Row {
     let at = |d: f64| f[(d / 0.25).round() as usize - 1];
     Row {
         forces: [at(AT[0]), at(AT[1]), at(AT[2])],
-        elements: solver.mesh.elements.len(),
+        elements: solver.mesh.cell_count(),
         unknowns: solver.equations(),
         wall,
         cpu,

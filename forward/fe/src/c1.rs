@@ -10,11 +10,14 @@
 use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace};
 use palpate_material::Law;
 
+use crate::body::{RegionMaterial, SolidBody};
+use crate::dofs::Dirichlet;
+use crate::kernel::{kernel_for, PressureSpace};
 use crate::kinematics::Kinematics;
-use crate::mesh::Grading;
-use crate::mesh2d::Mesh;
+use crate::mesh::{CellType, Grading, Mesh};
 use crate::model::{law_space, simulate, Bulk, FeEvaluator, Setup, Simulation};
-use crate::solver::{Constraints, Progress, Solver, SolverOptions};
+use crate::stepper::Progress;
+use crate::system::{SolverOptions, System};
 use crate::FeError;
 
 /// Platen contact condition.
@@ -59,16 +62,16 @@ impl C1Fe {
         }
     }
 
-    /// Runs one history with a progress observer; keeps the solver for the caller.
+    /// Runs one history with a progress observer; keeps the system for the caller.
     pub fn simulate(
         &self,
         theta: &[f64],
         loading: &Loading,
-        progress: Option<&dyn Fn(&Progress)>,
-    ) -> Result<(Simulation, Solver), ForwardError> {
-        let mut solver = self.build().map_err(crate::model::to_forward)?;
-        let sim = simulate(self, &self.space, &mut solver, theta, loading, progress)?;
-        Ok((sim, solver))
+        progress: Option<&mut dyn FnMut(&Progress)>,
+    ) -> Result<(Simulation, System), ForwardError> {
+        let mut sys = self.build().map_err(crate::model::to_forward)?;
+        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
+        Ok((sim, sys))
     }
 }
 
@@ -82,7 +85,7 @@ impl Setup for C1Fe {
     fn options(&self) -> SolverOptions {
         self.options
     }
-    fn build(&self) -> Result<Solver, FeError> {
+    fn build(&self) -> Result<System, FeError> {
         let r = 0.5 * self.diameter;
         let (nr, nz) = self.elements;
         if nr == 0 || nz == 0 {
@@ -97,29 +100,35 @@ impl Setup for C1Fe {
             Grading::uniform(r, nr),
             Grading::uniform(self.height, nz),
         )?;
-        let mut c = Constraints::default();
-        for &n in mesh.node_set("axis")? {
-            c.fixed.push((n, 0));
+        let body = SolidBody::new(
+            "body",
+            &mesh,
+            &["body"],
+            kernel_for(CellType::Quad4, Kinematics::Axisymmetric, PressureSpace::P0)?,
+            self.bulk.exact(),
+        )?;
+        let mut bcs = vec![Dirichlet::fixed("axis", 0), Dirichlet::fixed("bottom", 1)];
+        if self.platens == Platens::Bonded {
+            bcs.push(Dirichlet::fixed("bottom", 0));
         }
-        for &n in mesh.node_set("bottom")? {
-            c.fixed.push((n, 1));
-            if self.platens == Platens::Bonded && mesh.nodes[n][0] > 0.0 {
-                c.fixed.push((n, 0));
-            }
+        bcs.push(Dirichlet::driven("top", 1, 0, -1.0));
+        if self.platens == Platens::Bonded {
+            bcs.push(Dirichlet::fixed("top", 0));
         }
-        for &n in mesh.node_set("top")? {
-            c.driven.push((n, 1, -1.0));
-            if self.platens == Platens::Bonded && mesh.nodes[n][0] > 0.0 {
-                c.fixed.push((n, 0));
-            }
-        }
-        Solver::new(
-            mesh,
-            Kinematics::Axisymmetric,
-            c,
-            None,
-            self.bulk.incompressibility(),
-        )
+        System::new(mesh, 2, vec![Box::new(body)], &bcs, 1)
+    }
+    fn prepare(
+        &self,
+        sys: &mut System,
+        material: RegionMaterial,
+        _extra: &[f64],
+    ) -> Result<(), FeError> {
+        let mu = material.material.shear_modulus();
+        sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
+        sys.part_mut::<SolidBody>(0)?.set_material("body", material)
+    }
+    fn observe(&self, sys: &System) -> Vec<f64> {
+        vec![sys.channel_reaction(0)]
     }
 }
 
@@ -141,7 +150,7 @@ impl ForwardModel for C1Fe {
         Box::new(FeEvaluator {
             setup: self,
             space: &self.space,
-            solver: None,
+            system: None,
         })
     }
     /// A nonlinear FE solve per prediction.

@@ -18,12 +18,11 @@ pub enum FeError {
         reason: String,
     },
     /// A rigid tool starts inside the body.
-    #[error("tool `{tool}` starts inside the body at node {node} (r = {r} mm, z = {z} mm, gap {gap:.3e} mm)")]
+    #[error("tool `{tool}` starts inside the body at node {node} ({:.4}, {:.4}, {:.4}) mm, gap {gap:.3e} mm", at[0], at[1], at[2])]
     ToolStartsInside {
         tool: String,
         node: usize,
-        r: f64,
-        z: f64,
+        at: [f64; 3],
         gap: f64,
     },
     /// An element turned inside out (det F <= 0 at a quadrature point).

@@ -30,23 +30,25 @@
     clippy::collapsible_match
 )]
 
+pub mod body;
 pub mod c1;
 pub mod contact;
-pub mod element;
+pub mod contribution;
+pub mod dofs;
 pub mod error;
 pub mod kernel;
 pub mod kinematics;
 pub mod material;
 pub mod mesh;
-pub mod mesh2d;
 pub mod model;
 pub mod motion;
 pub mod n1;
 pub mod quadrature;
 pub mod shape;
-pub mod solver;
 pub mod sparse;
+pub mod stepper;
 pub mod surface;
+pub mod system;
 pub mod tool;
 pub mod vtu;
 
@@ -56,6 +58,7 @@ pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Needle};
-pub use solver::{Progress, RunStats, SolverOptions};
+pub use stepper::{LoadPath, Progress};
 pub use surface::{Cylinder3d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};
+pub use system::{RunStats, SolverOptions, System};
 pub use tool::ToolShape;

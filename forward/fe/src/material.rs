@@ -18,7 +18,7 @@ pub type StressTangent9 = (Matrix3<f64>, SMatrix<f64, 9, 9>);
 
 /// A hyperelastic material at a quadrature point: the isochoric part
 /// `W(J^{-1/3} F)` only.
-pub trait PointMaterial: Sync {
+pub trait PointMaterial: Send + Sync {
     /// `P_iso = dW/dF` and `A_iso = dP_iso/dF` at `f`.
     fn iso_stress_tangent(&self, f: &Matrix3<f64>) -> StressTangent9;
     /// Initial shear modulus (MPa), used to scale penalties and tolerances.

@@ -6,8 +6,12 @@
 use palpate_core::{Drive, Evaluator, ForwardError, Loading, ParamSpace, ParamSpec};
 use palpate_material::{Law, Volumetric};
 
+use std::sync::Arc;
+
+use crate::body::RegionMaterial;
 use crate::material::LawMaterial;
-use crate::solver::{Incompressibility, Progress, RunFailure, RunStats, Solver, SolverOptions};
+use crate::stepper::{self, LoadPath, Progress, RunFailure};
+use crate::system::{RunStats, SolverOptions, System};
 use crate::FeError;
 
 /// How an "incompressible" law is treated in the FE model.
@@ -22,11 +26,9 @@ pub enum Bulk {
 }
 
 impl Bulk {
-    pub(crate) fn incompressibility(self) -> Incompressibility {
-        match self {
-            Bulk::Exact => Incompressibility::Exact,
-            Bulk::Ratio(_) => Incompressibility::Penalty,
-        }
+    /// Whether the body carries pressure multipliers (exact constraint).
+    pub(crate) fn exact(self) -> bool {
+        self == Bulk::Exact
     }
     pub(crate) fn volumetric(self, mu: f64) -> Volumetric {
         match self {
@@ -49,21 +51,32 @@ pub fn law_space(law: &Law) -> ParamSpace {
 /// The result of one simulation with its counters.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Simulation {
+    /// The first output at each sample (the force).
     pub forces: Vec<f64>,
+    /// Every output at each sample.
+    pub outputs: Vec<Vec<f64>>,
     pub stats: RunStats,
 }
 
-/// Something that builds a solver for given extra (non-material) parameters
-/// and applies those parameters before a run.
+/// Something that builds a system for given extra (non-material)
+/// parameters and applies those parameters before a run.
 pub(crate) trait Setup: Send + Sync {
     fn law(&self) -> &Law;
     fn bulk(&self) -> Bulk;
     fn options(&self) -> SolverOptions;
-    fn build(&self) -> Result<Solver, FeError>;
-    /// Sets what depends on the parameters before a run: contact penalties
-    /// (scaled by the shear modulus `mu`) and the parameters that follow the
-    /// law's (e.g. friction).
-    fn prepare(&self, _solver: &mut Solver, _mu: f64, _extra: &[f64]) {}
+    fn build(&self) -> Result<System, FeError>;
+    /// Sets what depends on the parameters before a run: the materials,
+    /// contact penalties (scaled by the shear modulus `mu`) and the
+    /// parameters that follow the law's (e.g. friction).
+    fn prepare(
+        &self,
+        sys: &mut System,
+        material: RegionMaterial,
+        extra: &[f64],
+    ) -> Result<(), FeError>;
+    /// The outputs of a converged state; the first is the force a
+    /// single-output model predicts.
+    fn observe(&self, sys: &System) -> Vec<f64>;
 }
 
 pub(crate) fn to_forward(e: FeError) -> ForwardError {
@@ -93,19 +106,19 @@ fn failure(f: RunFailure) -> ForwardError {
             drive: f.drive,
             cuts: f.cuts,
             reason: e.to_string(),
-            completed: f.completed,
+            completed: f.completed.iter().map(|o| o[0]).collect(),
         },
     }
 }
 
-/// Runs one loading history on `solver` (built by `setup`).
+/// Runs one loading history on `sys` (built by `setup`).
 pub(crate) fn simulate(
     setup: &dyn Setup,
     space: &ParamSpace,
-    solver: &mut Solver,
+    sys: &mut System,
     theta: &[f64],
     loading: &Loading,
-    progress: Option<&dyn Fn(&Progress)>,
+    progress: Option<&mut dyn FnMut(&Progress)>,
 ) -> Result<Simulation, ForwardError> {
     space.check(theta)?;
     if loading.drive_kind != Drive::DisplacementMm {
@@ -120,23 +133,30 @@ pub(crate) fn simulate(
     let n_law = law.params().len();
     let mat = LawMaterial::new(*law, theta[..n_law].to_vec()).map_err(to_forward)?;
     let mu = law.shear_modulus(&theta[..n_law]);
-    setup.prepare(solver, mu, &theta[n_law..]);
-    let vol = setup.bulk().volumetric(mu);
-    let forces = solver
-        .run(&mat, vol, &loading.drive, &setup.options(), progress)
-        .map_err(failure)?;
+    let material = RegionMaterial {
+        material: Arc::new(mat),
+        volumetric: setup.bulk().volumetric(mu),
+    };
+    setup
+        .prepare(sys, material, &theta[n_law..])
+        .map_err(to_forward)?;
+    let path = LoadPath::from_drive(&loading.drive);
+    let mut observe = |s: &System| setup.observe(s);
+    let outputs =
+        stepper::run(sys, &path, &setup.options(), &mut observe, progress).map_err(failure)?;
     Ok(Simulation {
-        forces,
-        stats: solver.stats,
+        forces: outputs.iter().map(|o| o[0]).collect(),
+        outputs,
+        stats: sys.stats,
     })
 }
 
-/// The per-thread evaluator of an FE model: the solver is built on first use
+/// The per-thread evaluator of an FE model: the system is built on first use
 /// and kept (pattern, symbolic LU, scratch) for every later call.
 pub(crate) struct FeEvaluator<'a> {
     pub setup: &'a dyn Setup,
     pub space: &'a ParamSpace,
-    pub solver: Option<Solver>,
+    pub system: Option<System>,
 }
 
 impl Evaluator for FeEvaluator<'_> {
@@ -153,17 +173,17 @@ impl Evaluator for FeEvaluator<'_> {
                 loading.len()
             )));
         }
-        if self.solver.is_none() {
-            self.solver = Some(self.setup.build().map_err(to_forward)?);
+        if self.system.is_none() {
+            self.system = Some(self.setup.build().map_err(to_forward)?);
         }
-        let solver = self
-            .solver
+        let sys = self
+            .system
             .as_mut()
             .ok_or_else(|| ForwardError::InvalidConfig {
                 field: "fe".into(),
-                reason: "solver unavailable".into(),
+                reason: "system unavailable".into(),
             })?;
-        let sim = simulate(self.setup, self.space, solver, theta, loading, None)?;
+        let sim = simulate(self.setup, self.space, sys, theta, loading, None)?;
         out.copy_from_slice(&sim.forces);
         Ok(())
     }

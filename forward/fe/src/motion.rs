@@ -445,12 +445,27 @@ impl Pose {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::contact::RigidTool;
     use crate::surface::{Cylinder3d, Profile2d, Revolution3d, Wheel2d};
     use crate::tool::ToolShape;
     use std::f64::consts::PI;
 
     const H: f64 = 1e-7;
+
+    /// The tool-local point of the original axisymmetric contact code
+    /// (`x - origin - travel * direction`, in that order).
+    struct RigidTool {
+        origin: [f64; 2],
+        direction: [f64; 2],
+    }
+
+    impl RigidTool {
+        fn local(&self, x: [f64; 2], travel: f64) -> [f64; 2] {
+            [
+                x[0] - self.origin[0] - travel * self.direction[0],
+                x[1] - self.origin[1] - travel * self.direction[1],
+            ]
+        }
+    }
 
     fn bits(sp: &SurfacePoint) -> Vec<u64> {
         let mut v = vec![sp.gap.to_bits(), sp.xi.to_bits()];
@@ -469,7 +484,6 @@ mod tests {
         let surface = Profile2d(shape);
         for height in [0.0, 1.0, 0.1, 20.0 / 3.0] {
             let legacy = RigidTool {
-                shape,
                 origin: [0.0, height],
                 direction: [0.0, -1.0],
             };
@@ -491,7 +505,6 @@ mod tests {
         }
         // Forming p = origin + u first and then x - p rounds differently.
         let legacy = RigidTool {
-            shape,
             origin: [0.0, 20.0 / 3.0],
             direction: [0.0, -1.0],
         };

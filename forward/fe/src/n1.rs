@@ -26,12 +26,17 @@ use palpate_core::{
 use palpate_material::Law;
 use std::sync::Arc;
 
-use crate::contact::{ContactOptions, ContactPoints, ContactSet, RigidTool};
+use crate::body::{RegionMaterial, SolidBody};
+use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::dofs::Dirichlet;
+use crate::kernel::{kernel_for, PressureSpace};
 use crate::kinematics::Kinematics;
-use crate::mesh::Grading;
-use crate::mesh2d::Mesh;
+use crate::mesh::{CellType, Grading, Mesh};
 use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
-use crate::solver::{Constraints, Progress, Solver, SolverOptions};
+use crate::motion::ToolMotion;
+use crate::stepper::Progress;
+use crate::surface::Profile2d;
+use crate::system::{SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::FeError;
 
@@ -171,17 +176,17 @@ impl N1Needle {
             .unwrap_or_else(|| self.mesh.grading(self.fine_zone))
     }
 
-    /// Runs one history with a progress observer; returns the solver too
+    /// Runs one history with a progress observer; returns the system too
     /// (fields for VTK output).
     pub fn simulate(
         &self,
         theta: &[f64],
         loading: &Loading,
-        progress: Option<&dyn Fn(&Progress)>,
-    ) -> Result<(Simulation, Solver), ForwardError> {
-        let mut solver = self.build().map_err(to_forward)?;
-        let sim = simulate(self, &self.space, &mut solver, theta, loading, progress)?;
-        Ok((sim, solver))
+        progress: Option<&mut dyn FnMut(&Progress)>,
+    ) -> Result<(Simulation, System), ForwardError> {
+        let mut sys = self.build().map_err(to_forward)?;
+        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
+        Ok((sim, sys))
     }
 }
 
@@ -195,7 +200,7 @@ impl Setup for N1Needle {
     fn options(&self) -> SolverOptions {
         self.options
     }
-    fn build(&self) -> Result<Solver, FeError> {
+    fn build(&self) -> Result<System, FeError> {
         if !(self.friction >= 0.0 && self.friction.is_finite()) {
             return Err(FeError::InvalidConfig {
                 field: "friction".into(),
@@ -203,21 +208,18 @@ impl Setup for N1Needle {
             });
         }
         let mesh = self.build_mesh()?;
-        let mut c = Constraints::default();
-        for &n in mesh.node_set("axis")? {
-            c.fixed.push((n, 0));
+        let kin = Kinematics::Axisymmetric;
+        let body = SolidBody::new(
+            "body",
+            &mesh,
+            &["body"],
+            kernel_for(CellType::Quad4, kin, PressureSpace::P0)?,
+            self.bulk.exact(),
+        )?;
+        let mut bcs = vec![Dirichlet::fixed("axis", 0), Dirichlet::fixed("bottom", 1)];
+        if self.base == Base::Bonded {
+            bcs.push(Dirichlet::fixed("bottom", 0));
         }
-        for &n in mesh.node_set("bottom")? {
-            c.fixed.push((n, 1));
-            if self.base == Base::Bonded && mesh.nodes[n][0] > 0.0 {
-                c.fixed.push((n, 0));
-            }
-        }
-        let tool = RigidTool {
-            shape: self.tool,
-            origin: [0.0, self.height],
-            direction: [0.0, -1.0],
-        };
         // Penalties scale with the initial shear modulus, set per run.
         let options = ContactOptions {
             friction: self.friction,
@@ -226,33 +228,44 @@ impl Setup for N1Needle {
             penetration_tol: self.penetration_tol,
             points: self.contact_points,
         };
-        let contact = ContactSet::new(
+        let motion = ToolMotion::translating([0.0, self.height, 0.0], vec![(0, [0.0, -1.0, 0.0])]);
+        let contact = RigidContact::new(
             &self.tool.name(),
-            tool,
+            Box::new(Profile2d(self.tool)),
+            motion,
             &mesh,
             "top",
-            Kinematics::Axisymmetric,
+            kin,
             options,
+            1,
         )?;
-        Solver::new(
-            mesh,
-            Kinematics::Axisymmetric,
-            c,
-            Some(contact),
-            self.bulk.incompressibility(),
-        )
+        System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 1)
     }
-    fn prepare(&self, solver: &mut Solver, mu: f64, extra: &[f64]) {
+    fn prepare(
+        &self,
+        sys: &mut System,
+        material: RegionMaterial,
+        extra: &[f64],
+    ) -> Result<(), FeError> {
+        let mu = material.material.shear_modulus();
         let h = self.effective_grading().h_fine;
-        if let Some(cs) = solver.contact.as_mut() {
-            cs.options.penalty_normal = self.penalty * mu / h;
-            cs.options.penalty_tangent = self.penalty * mu / h;
-            cs.options.friction = if self.friction_is_parameter {
-                extra.first().copied().unwrap_or(self.friction)
-            } else {
-                self.friction
-            };
-        }
+        sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
+        sys.part_mut::<SolidBody>(0)?
+            .set_material("body", material)?;
+        let cs = sys.part_mut::<RigidContact>(1)?;
+        cs.options.penalty_normal = self.penalty * mu / h;
+        cs.options.penalty_tangent = self.penalty * mu / h;
+        cs.options.friction = if self.friction_is_parameter {
+            extra.first().copied().unwrap_or(self.friction)
+        } else {
+            self.friction
+        };
+        Ok(())
+    }
+    fn observe(&self, sys: &System) -> Vec<f64> {
+        vec![sys.contributions[1]
+            .tool_force([0.0, -1.0, 0.0])
+            .unwrap_or(0.0)]
     }
 }
 
@@ -277,7 +290,7 @@ impl ForwardModel for N1Needle {
         Box::new(FeEvaluator {
             setup: self,
             space: &self.space,
-            solver: None,
+            system: None,
         })
     }
     /// A nonlinear FE solve per prediction (seconds).

@@ -1,102 +1,64 @@
-//! VTK XML UnstructuredGrid (.vtu, ASCII) output of the deformed state for
-//! ParaView: reference mesh (r, z, 0) with point data `displacement` and cell
-//! data `pressure` (hydrostatic, compression positive, MPa) and the mean
-//! Cauchy stress components `stress_rr`, `stress_zz`, `stress_tt`, `stress_rz`.
-//! Use ParaView's "Warp By Vector" on `displacement` for the deformed shape.
+//! VTK XML UnstructuredGrid (.vtu) output of a solved system for ParaView:
+//! the reference mesh (any cell type, [`crate::mesh::vtu`]) with point data
+//! `displacement` and, for every cell of the first solid body, `pressure`
+//! (hydrostatic, compression positive, MPa) and the volume-average Cauchy
+//! stress `stress_xx, stress_yy, stress_zz, stress_xy, stress_yz, stress_zx`
+//! (in axisymmetry x, y, z are r, z, theta). Use ParaView's "Warp By
+//! Vector" on `displacement` for the deformed shape.
 
-use std::fmt::Write;
+use crate::body::SolidBody;
+use crate::mesh::vtu::{mesh_vtu, Field};
+use crate::system::System;
+use crate::FeError;
 
-use crate::element::mean_cauchy_stress;
-use crate::material::PointMaterial;
-use crate::solver::Solver;
-
-/// The current state of `solver` as a .vtu document.
-pub fn to_vtu(solver: &Solver, mat: &dyn PointMaterial) -> String {
-    let mesh = &solver.mesh;
-    let pressures = solver.pressures();
-    let mut s = String::new();
-    let (np, nc) = (mesh.nodes.len(), mesh.elements.len());
-    let _ = writeln!(s, "<?xml version=\"1.0\"?>");
-    let _ = writeln!(
-        s,
-        "<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">"
-    );
-    let _ = writeln!(
-        s,
-        "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{np}\" NumberOfCells=\"{nc}\">"
-    );
-    let _ = writeln!(
-        s,
-        "<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">"
-    );
-    for p in &mesh.nodes {
-        let _ = writeln!(s, "{} {} 0", p[0], p[1]);
-    }
-    let _ = writeln!(s, "</DataArray>\n</Points>\n<Cells>");
-    let _ = writeln!(
-        s,
-        "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">"
-    );
-    for e in &mesh.elements {
-        let _ = writeln!(s, "{} {} {} {}", e[0], e[1], e[2], e[3]);
-    }
-    let _ = writeln!(
-        s,
-        "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">"
-    );
-    for k in 0..nc {
-        let _ = writeln!(s, "{}", 4 * (k + 1));
-    }
-    let _ = writeln!(
-        s,
-        "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">"
-    );
-    for _ in 0..nc {
-        let _ = writeln!(s, "9");
-    }
-    let _ = writeln!(
-        s,
-        "</DataArray>\n</Cells>\n<PointData Vectors=\"displacement\">"
-    );
-    let _ = writeln!(s, "<DataArray type=\"Float64\" Name=\"displacement\" NumberOfComponents=\"3\" format=\"ascii\">");
-    for u in &solver.u {
-        let _ = writeln!(s, "{} {} 0", u[0], u[1]);
-    }
-    let _ = writeln!(
-        s,
-        "</DataArray>\n</PointData>\n<CellData Scalars=\"pressure\">"
-    );
-    let _ = writeln!(
-        s,
-        "<DataArray type=\"Float64\" Name=\"pressure\" format=\"ascii\">"
-    );
-    for p in &pressures {
-        let _ = writeln!(s, "{}", -p);
-    }
-    let _ = writeln!(s, "</DataArray>");
-    let stresses: Vec<[f64; 4]> = mesh
-        .elements
+/// The current state of `sys` as a .vtu document.
+pub fn to_vtu(sys: &System) -> Result<String, FeError> {
+    let mesh = &sys.mesh;
+    let u: Vec<f64> = sys.displacements().into_iter().flatten().collect();
+    let nc = mesh.cell_count();
+    let mut pressure = vec![0.0; nc];
+    let mut stress = vec![vec![0.0; nc]; 6];
+    if let Some(body) = sys
+        .contributions
         .iter()
-        .enumerate()
-        .map(|(e, el)| {
-            let x = el.map(|n| mesh.nodes[n]);
-            let u = el.map(|n| solver.u[n]);
-            mean_cauchy_stress(solver.kinematics, &x, &u, pressures[e], mat)
-        })
-        .collect();
-    for (k, name) in ["stress_rr", "stress_zz", "stress_tt", "stress_rz"]
-        .iter()
-        .enumerate()
+        .find_map(|c| c.as_any().downcast_ref::<SolidBody>())
     {
-        let _ = writeln!(
-            s,
-            "<DataArray type=\"Float64\" Name=\"{name}\" format=\"ascii\">"
-        );
-        for st in &stresses {
-            let _ = writeln!(s, "{}", st[k]);
+        let p = body.pressures();
+        let s = body.mean_cauchy_stresses(&sys.u, sys.dofs.dim);
+        for (k, &cell) in body.cells().iter().enumerate() {
+            pressure[cell] = -p[k];
+            for (i, st) in stress.iter_mut().enumerate() {
+                st[cell] = if s[k][i].is_finite() { s[k][i] } else { 0.0 };
+            }
         }
-        let _ = writeln!(s, "</DataArray>");
     }
-    let _ = writeln!(s, "</CellData>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>");
-    s
+    let names = [
+        "stress_xx",
+        "stress_yy",
+        "stress_zz",
+        "stress_xy",
+        "stress_yz",
+        "stress_zx",
+    ];
+    let mut cell_data = vec![Field {
+        name: "pressure",
+        components: 1,
+        values: &pressure,
+    }];
+    for (name, values) in names.iter().zip(&stress) {
+        cell_data.push(Field {
+            name,
+            components: 1,
+            values,
+        });
+    }
+    mesh_vtu(
+        mesh,
+        &[Field {
+            name: "displacement",
+            components: 3,
+            values: &u,
+        }],
+        &cell_data,
+    )
 }

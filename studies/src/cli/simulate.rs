@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, Context};
 use indicatif::{ProgressBar, ProgressStyle};
 use palpate_core::{Drive, Loading};
 use palpate_fe::{
-    Base, Bulk, C1Fe, LawMaterial, MeshDensity, N1Needle, Platens, Progress, Simulation, ToolShape,
+    Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens, Progress, Simulation, ToolShape,
 };
 use palpate_material::Law;
 
@@ -170,11 +170,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         ProgressStyle::with_template("{bar:40} {pos}/{len} samples  {msg}  [{elapsed_precise}]")
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
-    let cb = |p: &Progress| {
+    let mut cb = |p: &Progress| {
         bar.set_position(p.sample as u64 + 1);
         bar.set_message(format!(
             "d = {:.3} mm  F = {:.5} N  ({} increments, {} iterations)",
-            p.drive, p.force, p.increments, p.iterations
+            p.drive,
+            p.outputs.first().copied().unwrap_or(0.0),
+            p.increments,
+            p.iterations
         ));
     };
     let (title, result) = if n1 {
@@ -188,7 +191,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         (
             palpate_core::ForwardModel::name(&m),
-            m.simulate(&theta, &loading, Some(&cb)),
+            m.simulate(&theta, &loading, Some(&mut cb)),
         )
     } else {
         let mut m = C1Fe::new(
@@ -203,7 +206,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         m.elements = (19 * level, 9 * level);
         (
             palpate_core::ForwardModel::name(&m),
-            m.simulate(&theta, &loading, Some(&cb)),
+            m.simulate(&theta, &loading, Some(&mut cb)),
         )
     };
     bar.finish_and_clear();
@@ -230,7 +233,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     eprintln!(
         "{title}: {} elements, {} unknowns, {} increments, {} Newton iterations ({} factorisations), F({depth} mm) = {:.6} N",
-        solver.mesh.elements.len(),
+        solver.mesh.cell_count(),
         solver.equations(),
         sim.stats.increments,
         sim.stats.iterations,
@@ -247,8 +250,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         write_curve(path, &drive, &sim.forces)?;
     }
     if let Some(path) = &args.vtu {
-        let mat = LawMaterial::new(law, theta.clone()).map_err(|e| anyhow!("{e}"))?;
-        write_atomic(path, palpate_fe::vtu::to_vtu(&solver, &mat).as_bytes())?;
+        let vtu = palpate_fe::vtu::to_vtu(&solver).map_err(|e| anyhow!("{e}"))?;
+        write_atomic(path, vtu.as_bytes())?;
     }
     if let Some(path) = &args.plot {
         let plot = Plot::new(&title, "displacement (mm)", "force (N)").with(Series::line(

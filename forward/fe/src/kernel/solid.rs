@@ -681,58 +681,6 @@ mod tests {
         }
     }
 
-    /// The 4-node mixed quadrilateral equals the original Q1/P0 element
-    /// (the one N1 and C1 were validated with) to round-off.
-    #[test]
-    fn quad4_p0_equals_the_original_element() {
-        use crate::element::{quad4, ElementOutput as Old, VolumeConstraint};
-        let m = NeoHookeanIso { c10: 0.5 };
-        let x = quad4_x();
-        let u = displacements(&x, 2);
-        let x2: [[f64; 2]; 4] = std::array::from_fn(|a| [x[a][0], x[a][1]]);
-        let u2: [[f64; 2]; 4] = std::array::from_fn(|a| [u[a][0], u[a][1]]);
-        for kin in [
-            Kinematics::Axisymmetric,
-            Kinematics::PlaneStrain { thickness: 2.0 },
-        ] {
-            for (vol, cons) in [
-                (
-                    Volumetric::Incompressible,
-                    VolumeConstraint::Exact { scale: 0.7 },
-                ),
-                (Volumetric::D1(0.05), VolumeConstraint::Penalty { d1: 0.05 }),
-            ] {
-                let mut old = Old::default();
-                quad4(kin, &x2, &u2, 0.3, &m, cons, true, 0, &mut old).unwrap();
-                let k = kernel_for(CellType::Quad4, kin, PressureSpace::P0).unwrap();
-                let mut out = ElementOutput::default();
-                let q = [0.3];
-                let inp = ElementInput {
-                    element: 0,
-                    x: &x,
-                    u: &u,
-                    q: &q[..k.element_unknowns(vol)],
-                    material: &m,
-                    volumetric: vol,
-                    scale: 0.7,
-                };
-                k.evaluate(&inp, true, &mut out).unwrap();
-                let n = out.residual.len();
-                for r in 0..n {
-                    assert!(
-                        (out.residual[r] - old.residual[r]).abs() < 1e-13,
-                        "{kin:?} r{r}"
-                    );
-                    for c in 0..n {
-                        let d = out.tangent[r * n + c] - old.tangent[r][c];
-                        assert!(d.abs() < 1e-12, "{kin:?} {vol:?} K{r}{c} {d}");
-                    }
-                }
-                assert!((out.pressure - old.pressure).abs() < 1e-13);
-            }
-        }
-    }
-
     #[test]
     fn plane_stress_with_a_pressure_field_is_refused() {
         let ps = Kinematics::PlaneStress { thickness: 1.0 };

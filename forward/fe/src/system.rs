@@ -1,0 +1,481 @@
+//! The global system of one step: the state, the numbering, the
+//! contributions it sums, the sparse tangent with its symbolic
+//! factorisation, and Newton-Raphson at fixed loading-channel values.
+//! The increments (time stepping, cut-back) are [`crate::stepper`]'s.
+
+use crate::contribution::{Assembly, AssemblyContext, Contribution};
+use crate::dofs::{DofMap, DofValue};
+use crate::mesh::Mesh;
+use crate::sparse::{Pattern, SparseLu, NONE};
+use crate::FeError;
+
+/// Newton and stepping controls.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SolverOptions {
+    /// Largest increment of the path coordinate (mm of drive for
+    /// displacement-driven histories).
+    pub max_step: f64,
+    /// First increment.
+    pub first_step: f64,
+    /// Halvings of the increment allowed at one sample before giving up.
+    pub max_cuts: usize,
+    /// Newton iterations per attempt.
+    pub max_iterations: usize,
+    /// Relative residual tolerance.
+    pub tolerance: f64,
+    /// Augmentations of the contact multipliers per increment.
+    pub max_augmentations: usize,
+    /// Relative residual accepted when Newton stagnates at the iteration
+    /// limit (contact kinks can stall quadratic convergence); such
+    /// increments are counted in [`RunStats::loose`].
+    pub stagnation_tolerance: f64,
+    /// Modified Newton: after an iteration that cut the residual tenfold,
+    /// try the next step with the same factorisation and keep it when it
+    /// cuts the residual fourfold (otherwise refactorise).
+    pub reuse_factorisation: bool,
+}
+
+impl Default for SolverOptions {
+    fn default() -> Self {
+        SolverOptions {
+            max_step: 0.25,
+            first_step: 0.05,
+            max_cuts: 12,
+            max_iterations: 25,
+            tolerance: 1e-9,
+            max_augmentations: 20,
+            stagnation_tolerance: 1e-4,
+            reuse_factorisation: true,
+        }
+    }
+}
+
+/// Counters of one run.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RunStats {
+    pub increments: usize,
+    pub iterations: usize,
+    pub cuts: usize,
+    pub augmentations: usize,
+    pub factorisations: usize,
+    /// Newton iterations that reused an earlier factorisation (chord steps).
+    pub chord_steps: usize,
+    /// Increments accepted at the stagnation tolerance.
+    pub loose: usize,
+    /// Wall time in assembly and in factorise-and-solve (s).
+    pub assembly_seconds: f64,
+    pub solve_seconds: f64,
+}
+
+/// What one assembly measured.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Assembled {
+    pub norm: f64,
+    pub scale: f64,
+}
+
+/// The loading state an increment is solved at.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct Target {
+    pub channels: Vec<f64>,
+    pub time: f64,
+    pub dt: f64,
+}
+
+/// The global system.
+pub struct System {
+    pub mesh: Mesh,
+    pub dofs: DofMap,
+    pub contributions: Vec<Box<dyn Contribution>>,
+    first_group: Vec<usize>,
+    pattern: Pattern,
+    lu: SparseLu,
+    /// The state: node displacements (mm), then owned unknowns.
+    pub u: Vec<f64>,
+    fint: Vec<f64>,
+    residual: Vec<f64>,
+    values: Vec<f64>,
+    /// Channel values and time at the last commit.
+    pub(crate) committed: Target,
+    length_scale: f64,
+    /// Smallest force scale of the residual test (N), e.g. `1e-6 mu h^2`.
+    pub force_floor: f64,
+    pub stats: RunStats,
+    /// A test hook: the assembly fails once this many assemblies from now.
+    #[doc(hidden)]
+    pub fail_after: Option<usize>,
+}
+
+impl System {
+    /// Binds the owned unknowns of `contributions` after the node
+    /// displacements, numbers the equations from `bcs` (in `dofs`'s
+    /// arguments), and builds the pattern and the symbolic LU.
+    pub fn new(
+        mesh: Mesh,
+        dim: usize,
+        mut contributions: Vec<Box<dyn Contribution>>,
+        bcs: &[crate::dofs::Dirichlet],
+        channels: usize,
+    ) -> Result<System, FeError> {
+        mesh.validate()?;
+        let mut first = mesh.nodes.len() * dim;
+        for c in contributions.iter_mut() {
+            c.bind(first);
+            first += c.unknowns();
+        }
+        let extra = first - mesh.nodes.len() * dim;
+        let dofs = DofMap::new(&mesh, dim, extra, bcs, channels)?;
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut first_group = Vec::with_capacity(contributions.len());
+        for c in &contributions {
+            first_group.push(groups.len());
+            groups.extend(
+                c.couplings(dim)
+                    .into_iter()
+                    .map(|g| g.into_iter().map(|k| dofs.equation(k)).collect()),
+            );
+        }
+        let pattern = Pattern::new(dofs.equations, &groups);
+        let lu = SparseLu::new(&pattern)?;
+        let n = dofs.len();
+        let length_scale = mesh.extent();
+        let nnz = pattern.nnz();
+        Ok(System {
+            committed: Target {
+                channels: vec![0.0; channels],
+                time: 0.0,
+                dt: 0.0,
+            },
+            u: vec![0.0; n],
+            fint: vec![0.0; n],
+            residual: vec![0.0; dofs.equations],
+            values: vec![0.0; nnz],
+            mesh,
+            dofs,
+            contributions,
+            first_group,
+            pattern,
+            lu,
+            length_scale,
+            force_floor: 0.0,
+            stats: RunStats::default(),
+            fail_after: None,
+        })
+    }
+
+    /// Contribution `index` as its concrete type, or an error naming it.
+    pub fn part_mut<T: Contribution + 'static>(&mut self, index: usize) -> Result<&mut T, FeError> {
+        let name = self
+            .contributions
+            .get(index)
+            .map(|c| c.name())
+            .unwrap_or_else(|| "nothing".into());
+        self.contributions
+            .get_mut(index)
+            .and_then(|c| c.as_any_mut().downcast_mut::<T>())
+            .ok_or_else(|| FeError::InvalidConfig {
+                field: format!("contribution {index}"),
+                reason: format!("is {name}, not a {}", std::any::type_name::<T>()),
+            })
+    }
+
+    /// Contribution `index` as its concrete type.
+    pub fn part<T: Contribution + 'static>(&self, index: usize) -> Option<&T> {
+        self.contributions
+            .get(index)
+            .and_then(|c| c.as_any().downcast_ref::<T>())
+    }
+
+    /// Number of equations.
+    pub fn equations(&self) -> usize {
+        self.dofs.equations
+    }
+
+    /// Node displacements as `[f64; 3]` (unused components zero).
+    pub fn displacements(&self) -> Vec<[f64; 3]> {
+        let d = self.dofs.dim;
+        (0..self.dofs.nodes)
+            .map(|n| std::array::from_fn(|c| if c < d { self.u[n * d + c] } else { 0.0 }))
+            .collect()
+    }
+
+    /// Internal forces of the last assembly (per state entry).
+    pub fn internal_forces(&self) -> &[f64] {
+        &self.fint
+    }
+
+    /// Reaction of the prescribed entries driven by `channel`:
+    /// `sum scale * f_int` (N), from the last assembly.
+    pub fn channel_reaction(&self, channel: usize) -> f64 {
+        self.dofs
+            .prescribed
+            .iter()
+            .filter_map(|&(k, v)| match v {
+                DofValue::Channel { channel: c, scale } if c == channel => {
+                    Some(self.fint[k] * scale)
+                }
+                _ => None,
+            })
+            .sum()
+    }
+
+    /// Starts a loading history afresh: zero state, fresh history.
+    pub fn reset(&mut self) {
+        self.u.iter_mut().for_each(|v| *v = 0.0);
+        self.committed = Target {
+            channels: vec![0.0; self.committed.channels.len()],
+            time: 0.0,
+            dt: 0.0,
+        };
+        for c in self.contributions.iter_mut() {
+            c.reset(&self.mesh.nodes);
+        }
+        self.stats = RunStats::default();
+    }
+
+    /// Prescribed entries take their values for `target`.
+    pub(crate) fn prescribe(&mut self, target: &Target) {
+        for &(k, v) in &self.dofs.prescribed {
+            self.u[k] = match v {
+                DofValue::Fixed => 0.0,
+                DofValue::Channel { channel, scale } => scale * target.channels[channel],
+            };
+        }
+    }
+
+    fn context<'a>(&'a self, target: &'a Target) -> AssemblyContext<'a> {
+        AssemblyContext {
+            u: &self.u,
+            x0: &self.mesh.nodes,
+            channels: &target.channels,
+            channels_committed: &self.committed.channels,
+            time: target.time,
+            dt: target.dt,
+            dofs: &self.dofs,
+        }
+    }
+
+    /// Residual and (when `tangent`) tangent of every contribution at `target`.
+    pub(crate) fn assemble(
+        &mut self,
+        target: &Target,
+        tangent: bool,
+    ) -> Result<Assembled, FeError> {
+        let t0 = std::time::Instant::now();
+        let r = self.assemble_inner(target, tangent);
+        self.stats.assembly_seconds += t0.elapsed().as_secs_f64();
+        r
+    }
+
+    fn assemble_inner(&mut self, target: &Target, tangent: bool) -> Result<Assembled, FeError> {
+        if let Some(n) = self.fail_after.as_mut() {
+            if *n == 0 {
+                self.fail_after = None;
+                return Err(FeError::NonFiniteStress {
+                    element: usize::MAX,
+                });
+            }
+            *n -= 1;
+        }
+        self.fint.iter_mut().for_each(|v| *v = 0.0);
+        if tangent {
+            self.values.iter_mut().for_each(|v| *v = 0.0);
+        }
+        let mut force2 = 0.0;
+        let mut contributions = std::mem::take(&mut self.contributions);
+        let mut result = Ok(());
+        let mut fint = std::mem::take(&mut self.fint);
+        let mut values = std::mem::take(&mut self.values);
+        {
+            let ctx = self.context(target);
+            for (c, first) in contributions.iter_mut().zip(&self.first_group) {
+                let mut out = Assembly {
+                    fint: &mut fint,
+                    values: if tangent { Some(&mut values) } else { None },
+                    pattern: &self.pattern,
+                    first_group: *first,
+                    dofs: &self.dofs,
+                    force_scale2: 0.0,
+                };
+                if let Err(e) = c.assemble(&ctx, &mut out) {
+                    result = Err(e);
+                    break;
+                }
+                force2 += out.force_scale2;
+            }
+        }
+        self.fint = fint;
+        self.values = values;
+        self.contributions = contributions;
+        result?;
+        let mut scale2 = force2;
+        for &(k, _) in &self.dofs.prescribed {
+            scale2 += self.fint[k].powi(2);
+        }
+        for (k, f) in self.fint.iter().enumerate() {
+            let e = self.dofs.equation(k);
+            if e != NONE {
+                self.residual[e] = *f;
+            }
+        }
+        let norm = self.residual.iter().map(|v| v * v).sum::<f64>().sqrt();
+        if !norm.is_finite() {
+            return Err(FeError::NonFiniteStress {
+                element: usize::MAX,
+            });
+        }
+        Ok(Assembled {
+            norm,
+            scale: scale2.sqrt().max(self.force_floor),
+        })
+    }
+
+    fn apply(&mut self, du: &[f64], alpha: f64, u0: &[f64]) {
+        for (k, u) in self.u.iter_mut().enumerate() {
+            let e = self.dofs.equation(k);
+            if e != NONE {
+                *u = u0[k] + alpha * du[e];
+            }
+        }
+    }
+
+    /// Newton iterations at `target` (modified Newton with the factors
+    /// reused while they contract the residual fast, and an Armijo
+    /// backtracking line search).
+    pub(crate) fn newton(&mut self, target: &Target, opts: &SolverOptions) -> Result<(), FeError> {
+        self.prescribe(target);
+        let mut a = self.assemble(target, true)?;
+        let mut du = vec![0.0; self.dofs.equations];
+        let mut chord = false;
+        for it in 0..=opts.max_iterations {
+            let small_step = it > 0
+                && du.iter().fold(0.0f64, |m: f64, v: &f64| m.max(v.abs()))
+                    < 1e-12 * self.length_scale;
+            if a.norm <= opts.tolerance * a.scale || (small_step && a.norm <= 1e-6 * a.scale) {
+                return Ok(());
+            }
+            if it == opts.max_iterations {
+                break;
+            }
+            self.stats.iterations += 1;
+            let norm0 = a.norm;
+            if chord {
+                // Modified Newton: reuse the factors of an earlier tangent of
+                // this increment while they still contract the residual fast.
+                du.iter_mut().zip(&self.residual).for_each(|(d, r)| *d = -r);
+                let t0 = std::time::Instant::now();
+                let solved = self.lu.solve_factored(&mut du);
+                self.stats.solve_seconds += t0.elapsed().as_secs_f64();
+                solved?;
+                let u0 = self.u.clone();
+                self.apply(&du, 1.0, &u0);
+                // residual only: the tangent is needed only if the chord is rejected
+                match self.assemble(target, false) {
+                    Ok(t) if t.norm <= 0.25 * norm0 => {
+                        a = t;
+                        self.stats.chord_steps += 1;
+                        continue;
+                    }
+                    _ => {
+                        self.u.clone_from(&u0);
+                        a = self.assemble(target, true)?;
+                    }
+                }
+            }
+            du.iter_mut().zip(&self.residual).for_each(|(d, r)| *d = -r);
+            let values = std::mem::take(&mut self.values);
+            let t0 = std::time::Instant::now();
+            let solved = self.lu.solve(&values, &mut du);
+            self.stats.solve_seconds += t0.elapsed().as_secs_f64();
+            self.values = values;
+            solved?;
+            self.stats.factorisations += 1;
+            let u0 = self.u.clone();
+            let mut alpha = 1.0;
+            let mut last_err = None;
+            let mut accepted = None;
+            // Armijo backtracking by halves: alpha = 1, 1/2, ..., 1/16, where
+            // the step is taken whatever the residual; 1/32 is tried only
+            // when the assembly at 1/16 fails (an inverted element).
+            for _ in 0..6 {
+                self.apply(&du, alpha, &u0);
+                match self.assemble(target, true) {
+                    Ok(t) if t.norm <= (1.0 - 1e-4 * alpha) * a.norm || alpha <= 1.0 / 16.0 => {
+                        accepted = Some(t);
+                        break;
+                    }
+                    Ok(t) => accepted = Some(t),
+                    Err(e) => {
+                        accepted = None;
+                        last_err = Some(e);
+                    }
+                }
+                alpha *= 0.5;
+            }
+            match accepted {
+                Some(t) => {
+                    chord = opts.reuse_factorisation && t.norm <= 0.1 * norm0;
+                    a = t;
+                }
+                None => {
+                    return Err(last_err.unwrap_or(FeError::NewtonFailed {
+                        iterations: it,
+                        residual: a.norm,
+                        tolerance: opts.tolerance * a.scale,
+                    }))
+                }
+            }
+        }
+        if a.norm <= opts.stagnation_tolerance * a.scale {
+            self.stats.loose += 1;
+            return Ok(());
+        }
+        Err(FeError::NewtonFailed {
+            iterations: opts.max_iterations,
+            residual: a.norm,
+            tolerance: opts.tolerance * a.scale,
+        })
+    }
+
+    /// Newton plus augmentations of the contributions' multipliers at `target`.
+    pub(crate) fn solve_increment(
+        &mut self,
+        target: &Target,
+        opts: &SolverOptions,
+    ) -> Result<(), FeError> {
+        self.newton(target, opts)?;
+        for _ in 0..opts.max_augmentations {
+            let mut changed = false;
+            for c in self.contributions.iter_mut() {
+                changed |= c.augment();
+            }
+            if !changed {
+                break;
+            }
+            self.stats.augmentations += 1;
+            self.newton(target, opts)?;
+        }
+        Ok(())
+    }
+
+    /// Accepts the state at `target` as converged.
+    pub(crate) fn commit(&mut self, target: &Target) {
+        let mut contributions = std::mem::take(&mut self.contributions);
+        {
+            let ctx = self.context(target);
+            for c in contributions.iter_mut() {
+                c.commit(&ctx);
+            }
+        }
+        self.contributions = contributions;
+        self.committed = target.clone();
+    }
+
+    /// Restores the contributions' history of the last commit (the state
+    /// vector is the stepper's to restore).
+    pub(crate) fn rollback(&mut self) {
+        for c in self.contributions.iter_mut() {
+            c.rollback();
+        }
+    }
+}
