@@ -5,6 +5,9 @@
 //! reduced polynomial) at 0.5..6 mm, C1 frictionless and bonded, exact and
 //! K = 1000 mu, on a ramp-and-unload.
 
+// recorded digits, as printed
+#![allow(clippy::excessive_precision)]
+
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens};
 
