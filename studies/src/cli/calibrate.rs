@@ -3,7 +3,7 @@
 
 use crate::calibration::{calibrate, parse_method, Calibration, Request, TestData, TestKind};
 use crate::output::{write_atomic, write_json};
-use crate::plot::{Plot, Series};
+use crate::report::fit_plot;
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
@@ -117,6 +117,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let data = read_data(&args.data, args.benchmark.as_deref())?;
     let result = calibrate(Request {
         law,
+        model: None,
         fitted: &data,
         predict: &[],
         residual,
@@ -195,57 +196,4 @@ pub fn table(c: &Calibration) -> String {
         );
     }
     s
-}
-
-/// Data (markers) against the fitted law (lines), one colour per data set.
-pub fn fit_plot(c: &Calibration) -> Plot {
-    let homogeneous = c
-        .predictions
-        .iter()
-        .all(|p| p.data != "C1" && p.data != "N1");
-    let (xl, yl) = if homogeneous {
-        ("stretch", "nominal stress (MPa)")
-    } else {
-        ("displacement (mm)", "force (N)")
-    };
-    let mut plot = Plot::new(
-        format!(
-            "{} fitted to {} ({} residuals)",
-            c.law,
-            c.data.join(" + "),
-            c.residual
-        ),
-        xl,
-        yl,
-    );
-    const COLOURS: [&str; 6] = [
-        "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
-    ];
-    for (k, p) in c.predictions.iter().enumerate() {
-        let col = COLOURS[k % COLOURS.len()];
-        plot.push(
-            Series::markers(
-                format!("{} data", p.data),
-                &p.stretch_or_displacement,
-                &p.observed,
-            )
-            .color(col),
-        );
-        let (x, y) = (&p.stretch_or_displacement, &p.predicted);
-        let label = format!(
-            "{} {} (R^2 {:.4})",
-            p.data,
-            if p.fitted { "fit" } else { "prediction" },
-            p.r2
-        );
-        plot.push(
-            if p.fitted {
-                Series::line(label, x, y)
-            } else {
-                Series::dashed(label, x, y)
-            }
-            .color(col),
-        );
-    }
-    plot
 }
