@@ -72,7 +72,7 @@ struct Manifest {
     analysis: AnalysisSpec,
 }
 
-#[derive(Debug, Default, Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct DesignSpec {
     seed: Option<u64>,
@@ -84,6 +84,18 @@ struct DesignSpec {
 
 fn one() -> usize {
     1
+}
+
+/// A manifest without `[design]`: one replicate in standard order (a derived
+/// Default would give 0 replicates, rejected by the design).
+impl Default for DesignSpec {
+    fn default() -> Self {
+        DesignSpec {
+            seed: None,
+            replicates: one(),
+            generators: Vec::new(),
+        }
+    }
 }
 
 #[derive(Debug, Default, Deserialize)]
