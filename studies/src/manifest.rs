@@ -471,6 +471,38 @@ fits = { u = ["uni"] }
     }
 
     #[test]
+    fn a_diagnose_step_takes_a_base_law_or_a_named_model() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "displacement_mm,force_N\n0,0\n").unwrap();
+        let p = dir.path().join("s.toml");
+        let text = |base: &str| {
+            format!(
+                "[study]\nname = \"t\"\n\n[data.rec]\nfile = \"r.csv\"\ntest = \"N1\"\n\n\
+                 [models.needle.n1_needle]\nlaw = \"neo-hookean\"\n\n\
+                 [models.press.c1]\nlaw = \"neo-hookean\"\n\n\
+                 [[steps]]\n[steps.diagnose]\nname = \"gap\"\ndata = [\"rec\"]\n{base}\n"
+            )
+        };
+        for ok in ["base = \"neo-hookean\"", "model = \"needle\""] {
+            let m = Manifest::parse(&p, &text(ok)).unwrap();
+            m.validate(&p).unwrap();
+        }
+        for (bad, needle) in [
+            ("", "exactly one of `base`"),
+            (
+                "base = \"yeoh\"\nmodel = \"needle\"",
+                "exactly one of `base`",
+            ),
+            ("model = \"nedle\"", "unknown model \"nedle\""),
+            ("model = \"press\"", "does not predict data set \"rec\""),
+        ] {
+            let m = Manifest::parse(&p, &text(bad)).unwrap();
+            let e = m.validate(&p).unwrap_err().to_string();
+            assert!(e.contains("steps[0].diagnose") && e.contains(needle), "{e}");
+        }
+    }
+
+    #[test]
     fn diagnose_effects_are_checked_by_name() {
         let dir = tempfile::tempdir().unwrap();
         std::fs::write(dir.path().join("r.csv"), "displacement_mm,force_N\n0,0\n").unwrap();

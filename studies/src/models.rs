@@ -55,7 +55,7 @@ pub const MAX_MESH_LEVEL: usize = 12;
 
 /// A forward model, by kind.
 #[derive(Debug, Clone, PartialEq, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum ModelSpec {
     /// A homogeneous test of a law (analytic).
     Homogeneous(HomogeneousSpec),
@@ -441,4 +441,56 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
         .iter()
         .map(|e| e.parse::<Effect>().map_err(|m| anyhow::anyhow!("{m}")))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spec_reads_from_its_own_toml_table() {
+        let s: ModelSpec = toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nmesh = 4\n").unwrap();
+        assert_eq!(
+            s,
+            ModelSpec::C1Fe(C1FeSpec {
+                law: "yeoh".into(),
+                mesh: Some("4".into()),
+                ..Default::default()
+            })
+        );
+        assert!(matches!(s.validate(), Ok(Model::C1Fe(m)) if m.elements == (76, 36)));
+        let e = toml::from_str::<ModelSpec>("[c1]\nlaw = \"yeoh\"\nmesh = 4\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("mesh"), "{e}");
+    }
+
+    #[test]
+    fn the_one_mesh_parser() {
+        for (s, level) in [("coarse", 1), ("medium", 2), ("fine", 3), ("12", 12)] {
+            assert_eq!(parse_mesh("n1_needle", Some(s)), Ok(level));
+        }
+        assert_eq!(parse_mesh("n1_needle", None), Ok(2));
+        for bad in ["0", "13", "-1", "1.5", "Coarse"] {
+            let e = parse_mesh("n1_needle", Some(bad)).unwrap_err();
+            assert_eq!((e.field, e.value.as_str()), ("mesh", bad));
+        }
+    }
+
+    #[test]
+    fn bad_values_name_their_field() {
+        let n1 = |f: fn(&mut N1NeedleSpec)| {
+            let mut s = N1NeedleSpec {
+                law: "neo-hookean".into(),
+                ..Default::default()
+            };
+            f(&mut s);
+            ModelSpec::N1Needle(s).validate().unwrap_err().to_string()
+        };
+        assert!(n1(|s| s.law = "neo".into()).starts_with("n1_needle.law = \"neo\""));
+        assert!(n1(|s| s.friction = Some(-0.1)).starts_with("n1_needle.friction"));
+        assert!(n1(|s| s.bulk = Some("0".into())).starts_with("n1_needle.bulk"));
+        assert!(n1(|s| s.base = Some("glued".into())).starts_with("n1_needle.base"));
+        assert!(n1(|s| s.tool = Some("sphere:-1".into())).starts_with("n1_needle.tool"));
+    }
 }
