@@ -1,5 +1,6 @@
-//! Plots shared by the commands and the study runner: a calibration's data
-//! against its fit, and the gap diagnosis's two panels.
+//! Text and plots shared by the commands and the study runner: a
+//! calibration's table and its data against the fit; the gap diagnosis's
+//! terminal summary and two panels.
 
 use crate::calibration::Calibration;
 use crate::plot::{grid_svg, Band, Plot, Series};
@@ -95,4 +96,106 @@ pub fn gap_svg(r: &GapReport, title: &str) -> String {
         1,
         &format!("gap diagnosis of {title}: verdict {}", r.verdict),
     )
+}
+
+/// A readable table of a calibration.
+pub fn calibration_table(c: &Calibration) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "law {} fitted to {} ({} residuals, {})",
+        c.law,
+        c.data.join(" + "),
+        c.residual,
+        c.estimator
+    );
+    let _ = writeln!(
+        s,
+        "{:<10} {:>14} {:>14} {:>8}",
+        "parameter", "value", "std. error", "unit"
+    );
+    for (name, p) in c.params.iter() {
+        let se = match (p.fixed, p.standard_error) {
+            (true, _) => "fixed".to_string(),
+            (false, Some(e)) => format!("{e:.6e}"),
+            (false, None) => "n/a".to_string(),
+        };
+        let _ = writeln!(
+            s,
+            "{:<10} {:>14.6e} {:>14} {:>8}",
+            name, p.value, se, p.unit
+        );
+    }
+    let _ = writeln!(
+        s,
+        "R^2 {:.6}  RMS {:.4e}  SSE {:.6e}  iterations {}  evaluations {}  converged {}",
+        c.r2, c.rms, c.sse, c.iterations, c.evaluations, c.converged
+    );
+    if !c.identifiable {
+        let _ = writeln!(
+            s,
+            "NOT IDENTIFIABLE from these data: {} (condition number {:.2e}); values above are one of many equally good fits",
+            c.fit.identifiability.involved.join(", "),
+            c.fit.identifiability.condition_number
+        );
+    }
+    let d = &c.drucker;
+    let _ = writeln!(
+        s,
+        "Drucker stable stretch ranges: uniaxial [{:.3}, {:.3}]  biaxial [{:.3}, {:.3}]  planar [{:.3}, {:.3}]",
+        d.uniaxial.lower, d.uniaxial.upper, d.biaxial.lower, d.biaxial.upper, d.planar.lower, d.planar.upper
+    );
+    for p in &c.predictions {
+        let _ = writeln!(
+            s,
+            "  {:<12} {:<10} R^2 {:.5}  RMS {:.4e}",
+            p.data,
+            if p.fitted { "fitted" } else { "predicted" },
+            p.r2,
+            p.rms
+        );
+    }
+    s
+}
+
+/// A few lines of a gap diagnosis for the terminal.
+pub fn gap_summary(r: &GapReport) -> String {
+    use std::fmt::Write;
+    let mut s = String::new();
+    let _ = writeln!(s, "verdict: {}", r.verdict);
+    if !r.confounded.is_empty() {
+        let _ = writeln!(s, "cannot be told apart from: {}", r.confounded.join(", "));
+    }
+    let _ = writeln!(
+        s,
+        "noise SD {:.4} (estimated from the data); base misfit RMS {:.4}, held-out {:.4}",
+        r.noise_sd, r.base.misfit, r.base.heldout
+    );
+    for w in &r.where_ {
+        let _ = writeln!(
+            s,
+            "  misfit window {} {:.3} .. {:.3}: RMS {:.4}",
+            w.axis, w.from, w.to, w.misfit_rms
+        );
+    }
+    let _ = writeln!(
+        s,
+        "{:<18} {:>10} {:>10} {:>10} {:>10}  identifiable",
+        "effect", "fit before", "after", "held-out", "after"
+    );
+    for e in &r.ranking {
+        let _ = writeln!(
+            s,
+            "{:<18} {:>10.4} {:>10.4} {:>10.4} {:>10.4}  {}",
+            e.effect,
+            e.misfit_before,
+            e.misfit_after,
+            e.heldout_before,
+            e.heldout_after,
+            e.identifiable
+        );
+    }
+    let _ = write!(s, "{}", r.explanation);
+    s
 }

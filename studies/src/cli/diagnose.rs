@@ -5,7 +5,7 @@
 use crate::calibration::{TestData, TestKind};
 use crate::models::{build, default_effects, gap_base, parse_effects};
 use crate::output::{write_atomic, write_json};
-use crate::report::gap_svg;
+use crate::report::{gap_summary, gap_svg};
 use anyhow::Context;
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
@@ -97,7 +97,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         options.effects = Some(parse_effects(&args.effects).context("--effects")?);
     }
     let report = diagnose_file(&args.benchmark, &args.base, &args.data, &options)?;
-    println!("{}", summary(&report));
+    println!("{}", gap_summary(&report));
     if let Some(p) = &args.json {
         write_json(p, &report)?;
         eprintln!("wrote {}", p.display());
@@ -114,45 +114,4 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
-}
-
-/// A few lines for the terminal.
-pub fn summary(r: &GapReport) -> String {
-    use std::fmt::Write;
-    let mut s = String::new();
-    let _ = writeln!(s, "verdict: {}", r.verdict);
-    if !r.confounded.is_empty() {
-        let _ = writeln!(s, "cannot be told apart from: {}", r.confounded.join(", "));
-    }
-    let _ = writeln!(
-        s,
-        "noise SD {:.4} (estimated from the data); base misfit RMS {:.4}, held-out {:.4}",
-        r.noise_sd, r.base.misfit, r.base.heldout
-    );
-    for w in &r.where_ {
-        let _ = writeln!(
-            s,
-            "  misfit window {} {:.3} .. {:.3}: RMS {:.4}",
-            w.axis, w.from, w.to, w.misfit_rms
-        );
-    }
-    let _ = writeln!(
-        s,
-        "{:<18} {:>10} {:>10} {:>10} {:>10}  identifiable",
-        "effect", "fit before", "after", "held-out", "after"
-    );
-    for e in &r.ranking {
-        let _ = writeln!(
-            s,
-            "{:<18} {:>10.4} {:>10.4} {:>10.4} {:>10.4}  {}",
-            e.effect,
-            e.misfit_before,
-            e.misfit_after,
-            e.heldout_before,
-            e.heldout_after,
-            e.identifiable
-        );
-    }
-    let _ = write!(s, "{}", r.explanation);
-    s
 }
