@@ -31,7 +31,7 @@ pub enum TestKind {
 }
 
 impl TestKind {
-    /// Parses `uniaxial`, `biaxial`, `planar` (and their aliases) or `C1`.
+    /// Parses `uniaxial`, `biaxial`, `planar` (and their aliases), `C1` or `N1`.
     pub fn parse(s: &str) -> anyhow::Result<TestKind> {
         if s.eq_ignore_ascii_case("c1") {
             return Ok(TestKind::C1);
@@ -40,7 +40,7 @@ impl TestKind {
             return Ok(TestKind::N1);
         }
         s.parse::<Mode>().map(TestKind::Homogeneous).map_err(|_| {
-            anyhow::anyhow!("unknown test `{s}`; expected uniaxial, biaxial, planar or C1")
+            anyhow::anyhow!("unknown test `{s}`; expected uniaxial, biaxial, planar, C1 or N1")
         })
     }
 

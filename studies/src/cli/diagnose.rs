@@ -73,8 +73,9 @@ pub fn diagnose_file(
     let law: Law = base
         .parse()
         .map_err(|e| anyhow::anyhow!("base law `{base}`: {e}"))?;
-    let test = TestKind::parse(benchmark).context("--benchmark")?;
-    let spec = gap_base(test, law).with_context(|| format!("--benchmark {benchmark}"))?;
+    let spec = TestKind::parse(benchmark)
+        .and_then(|test| gap_base(test, law))
+        .with_context(|| format!("--benchmark {benchmark}"))?;
     let model = build(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
     // C1 and N1 records share the columns displacement_mm, force_N[, time_s].
     let record = TestData::read("record", TestKind::C1, data)?;
