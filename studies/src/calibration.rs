@@ -3,8 +3,9 @@
 //! model each test needs, fits, and adds what a material-model user expects
 //! beside the fit (Drucker stability range, predictions of other tests).
 
+use crate::models::ModelSpec;
 use anyhow::Context;
-use palpate_analytic::{C1Compression, Homogeneous, Mode};
+use palpate_analytic::Mode;
 use palpate_core::data::{Column, Table};
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_inverse::{
@@ -25,12 +26,12 @@ pub enum TestKind {
     Homogeneous(Mode),
     /// Benchmark C1: columns `displacement_mm`, `force_N` (and `time_s` when timed).
     C1,
-    /// Benchmark N1 (FE needle indentation, friction 0.8, coarse mesh): same columns as C1.
+    /// Benchmark N1 (FE needle indentation; by default friction 0.8, coarse mesh): same columns as C1.
     N1,
 }
 
 impl TestKind {
-    /// Parses `uniaxial`, `biaxial`, `planar` (and their aliases) or `C1`.
+    /// Parses `uniaxial`, `biaxial`, `planar` (and their aliases), `C1` or `N1`.
     pub fn parse(s: &str) -> anyhow::Result<TestKind> {
         if s.eq_ignore_ascii_case("c1") {
             return Ok(TestKind::C1);
@@ -39,21 +40,15 @@ impl TestKind {
             return Ok(TestKind::N1);
         }
         s.parse::<Mode>().map(TestKind::Homogeneous).map_err(|_| {
-            anyhow::anyhow!("unknown test `{s}`; expected uniaxial, biaxial, planar or C1")
+            anyhow::anyhow!("unknown test `{s}`; expected uniaxial, biaxial, planar, C1 or N1")
         })
     }
 
-    /// The forward model of this test for a law.
-    pub fn model(self, law: Law) -> Arc<dyn ForwardModel> {
-        match self {
-            TestKind::Homogeneous(mode) => Arc::new(Homogeneous::new(law, mode)),
-            TestKind::C1 => Arc::new(C1Compression::new(law)),
-            TestKind::N1 => {
-                let mut m = palpate_fe::N1Needle::new(law);
-                m.mesh = palpate_fe::MeshDensity::COARSE;
-                Arc::new(m)
-            }
-        }
+    /// The forward model of this test for a law ([`crate::models::for_test`]).
+    pub fn model(self, law: Law) -> anyhow::Result<Arc<dyn ForwardModel>> {
+        let m = crate::models::build(&crate::models::for_test(self, law))
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(Arc::from(m))
     }
 }
 
@@ -113,11 +108,11 @@ impl TestData {
         })
     }
 
-    /// The data set of this test for a law.
-    pub fn dataset(&self, law: Law) -> DataSet {
+    /// The data set of this record predicted by `model`.
+    pub fn dataset(&self, model: Arc<dyn ForwardModel>) -> DataSet {
         DataSet::new(
             self.name.clone(),
-            self.test.model(law),
+            model,
             self.loading.clone(),
             self.observed.clone(),
         )
@@ -198,6 +193,9 @@ pub struct Calibration {
 /// What to fit.
 pub struct Request<'a> {
     pub law: Law,
+    /// The model of every data set; `None`: the model of each data set's
+    /// test for `law` ([`crate::models::for_test`]).
+    pub model: Option<&'a ModelSpec>,
     pub fitted: &'a [TestData],
     /// Further data sets on which the fit is evaluated.
     pub predict: &'a [TestData],
@@ -220,9 +218,33 @@ pub fn parse_method(s: &str) -> anyhow::Result<Method> {
     }
 }
 
+impl Request<'_> {
+    /// The forward model of a data set.
+    fn model_of(&self, d: &TestData) -> anyhow::Result<Arc<dyn ForwardModel>> {
+        match self.model {
+            None => d.test.model(self.law),
+            Some(spec) => {
+                anyhow::ensure!(
+                    spec.test().ok() == Some(d.test),
+                    "data set `{}` is a {:?} record; a {} model does not predict it",
+                    d.name,
+                    d.test,
+                    spec.kind()
+                );
+                let m = crate::models::build(spec).map_err(|e| anyhow::anyhow!("{e}"))?;
+                Ok(Arc::from(m))
+            }
+        }
+    }
+}
+
 /// Fits a law and evaluates it on the fitted and the extra data sets.
 pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
-    let sets: Vec<DataSet> = req.fitted.iter().map(|d| d.dataset(req.law)).collect();
+    let sets: Vec<DataSet> = req
+        .fitted
+        .iter()
+        .map(|d| Ok(d.dataset(req.model_of(d)?)))
+        .collect::<anyhow::Result<_>>()?;
     let objective = Objective::new(sets, req.residual, &req.fixed).context("setting up the fit")?;
     // Laws with exponents (Ogden, Arruda-Boyce) have several local minima: start from several points.
     let starts = match req.law {
@@ -251,9 +273,8 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
         if fitted && req.predict.iter().any(|p| p.name == d.name) {
             continue;
         }
-        let predicted = d
-            .test
-            .model(req.law)
+        let predicted = req
+            .model_of(d)?
             .predict(&theta, &d.loading)
             .with_context(|| format!("predicting {}", d.name))?;
         let (r2, rms) = r2_rms(&d.observed, &predicted);

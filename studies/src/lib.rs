@@ -7,7 +7,9 @@
 pub mod calibration;
 pub mod cli;
 pub mod manifest;
+pub mod models;
 pub mod output;
 pub mod plot;
 pub mod provenance;
+pub mod report;
 pub mod runner;

@@ -26,6 +26,7 @@
 //! residuals = ["absolute", "relative"]
 //! ```
 
+use crate::models::ModelSpec;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
@@ -38,7 +39,7 @@ pub struct Manifest {
     #[serde(default)]
     pub data: BTreeMap<String, DataSpec>,
     #[serde(default)]
-    pub models: BTreeMap<String, ModelSpec>,
+    pub models: BTreeMap<String, ModelEntry>,
     pub steps: Vec<Step>,
 }
 
@@ -64,15 +65,104 @@ pub struct DataSpec {
     pub test: String,
 }
 
-/// A material law, with parameters optionally held fixed.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct ModelSpec {
-    /// `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N`, `yeoh`, `arruda-boyce`, `ogden:N`.
-    pub law: String,
+/// A named model: a law applied to each data set's own test (`law = "..."`,
+/// the original form) or one model of [`ModelSpec`] (`[models.NAME.n1_needle]`,
+/// `[models.NAME.c1_fe]`, ...), with parameters optionally held fixed in fits.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ModelEntry {
+    pub model: ModelForm,
     /// Parameters held at a value during fits, by name (MPa or dimensionless).
-    #[serde(default)]
     pub fixed: BTreeMap<String, f64>,
+}
+
+/// The two forms of a named model.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ModelForm {
+    /// `law = "..."`: `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N`,
+    /// `yeoh`, `arruda-boyce`, `ogden:N`, in the model of each data set's test
+    /// ([`crate::models::for_test`]).
+    Law(String),
+    /// One model kind with its settings.
+    Spec(ModelSpec),
+}
+
+impl<'de> Deserialize<'de> for ModelEntry {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use crate::models::{C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec};
+        use serde::de::{Error, MapAccess, Visitor};
+        const FIELDS: &[&str] = &["law", "fixed", "homogeneous", "c1", "c1_fe", "n1_needle"];
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = ModelEntry;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str(
+                    "a model: `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle",
+                )
+            }
+            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<ModelEntry, A::Error> {
+                let mut law: Option<String> = None;
+                let mut spec: Option<ModelSpec> = None;
+                let mut fixed = BTreeMap::new();
+                while let Some(key) = map.next_key::<String>()? {
+                    let next = match key.as_str() {
+                        "law" => {
+                            law = Some(map.next_value()?);
+                            None
+                        }
+                        "fixed" => {
+                            fixed = map.next_value()?;
+                            None
+                        }
+                        "homogeneous" => {
+                            Some(ModelSpec::Homogeneous(map.next_value::<HomogeneousSpec>()?))
+                        }
+                        "c1" => Some(ModelSpec::C1(map.next_value::<C1Spec>()?)),
+                        "c1_fe" => Some(ModelSpec::C1Fe(map.next_value::<C1FeSpec>()?)),
+                        "n1_needle" => Some(ModelSpec::N1Needle(map.next_value::<N1NeedleSpec>()?)),
+                        other => return Err(A::Error::unknown_field(other, FIELDS)),
+                    };
+                    if let Some(n) = next {
+                        if let Some(old) = &spec {
+                            return Err(A::Error::custom(format!(
+                                "two model kinds, `{}` and `{}`: a model has one",
+                                old.kind(),
+                                n.kind()
+                            )));
+                        }
+                        spec = Some(n);
+                    }
+                }
+                let model = match (law, spec) {
+                    (Some(l), None) => ModelForm::Law(l),
+                    (None, Some(s)) => ModelForm::Spec(s),
+                    (Some(_), Some(s)) => {
+                        return Err(A::Error::custom(format!(
+                            "both `law` and a `{}` table: give the law inside the `{}` table",
+                            s.kind(),
+                            s.kind()
+                        )))
+                    }
+                    (None, None) => {
+                        return Err(A::Error::custom(
+                            "no model: expected `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle",
+                        ))
+                    }
+                };
+                Ok(ModelEntry { model, fixed })
+            }
+        }
+        d.deserialize_map(V)
+    }
+}
+
+impl ModelEntry {
+    /// The law as written.
+    pub fn law_text(&self) -> &str {
+        match &self.model {
+            ModelForm::Law(l) => l,
+            ModelForm::Spec(s) => s.law_text(),
+        }
+    }
 }
 
 /// One step of a study.
@@ -103,15 +193,20 @@ pub struct CalibrateStep {
     pub predict: Vec<String>,
 }
 
-/// Diagnose the sim-to-real gap of a base model on one C1 data set.
+/// Diagnose the sim-to-real gap of a base model on C1 or N1 records.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DiagnoseStep {
     pub name: String,
     /// Data set names (each diagnosed separately).
     pub data: Vec<String>,
-    /// Base law, e.g. `neo-hookean`.
-    pub base: String,
+    /// Base law, e.g. `neo-hookean`, in the base model of each record's test
+    /// ([`crate::models::gap_base`]: C1 analytic; N1 frictionless, coarse mesh).
+    #[serde(default)]
+    pub base: Option<String>,
+    /// Or the base model by name (a `[models.NAME.<kind>]` entry).
+    #[serde(default)]
+    pub model: Option<String>,
     /// Candidate effects (GAP.md names); default: C1 every effect its model
     /// offers, N1 `friction` and `boundary_condition`.
     #[serde(default)]
@@ -162,8 +257,17 @@ impl Manifest {
             }
         }
         for (name, m) in &self.models {
-            if let Err(e) = m.law.parse::<palpate_material::Law>() {
-                anyhow::bail!("{where_}: models.{name}.law = \"{}\": {e}", m.law);
+            match &m.model {
+                ModelForm::Law(law) => {
+                    if let Err(e) = law.parse::<palpate_material::Law>() {
+                        anyhow::bail!("{where_}: models.{name}.law = \"{law}\": {e}");
+                    }
+                }
+                ModelForm::Spec(spec) => {
+                    if let Err(e) = spec.validate() {
+                        anyhow::bail!("{where_}: models.{name}.{e}");
+                    }
+                }
             }
         }
         for (i, step) in self.steps.iter().enumerate() {
@@ -201,6 +305,14 @@ impl Manifest {
                             );
                         }
                     }
+                    for m in &c.models {
+                        let ModelForm::Spec(spec) = &self.models[m].model else {
+                            continue;
+                        };
+                        for s in c.fits.values().flatten().chain(&c.predict) {
+                            self.check_predicts(where_.to_string(), &at, m, spec, s)?;
+                        }
+                    }
                     for r in &c.residuals {
                         if !["absolute", "relative", "normalised"].contains(&r.as_str()) {
                             anyhow::bail!("{where_}: {at}.residuals: \"{r}\" is not one of absolute, relative, normalised");
@@ -227,8 +339,29 @@ impl Manifest {
                             _ => {}
                         }
                     }
-                    if let Err(e) = d.base.parse::<palpate_material::Law>() {
-                        anyhow::bail!("{where_}: {at}.base = \"{}\": {e}", d.base);
+                    match (&d.base, &d.model) {
+                        (Some(base), None) => {
+                            if let Err(e) = base.parse::<palpate_material::Law>() {
+                                anyhow::bail!("{where_}: {at}.base = \"{base}\": {e}");
+                            }
+                        }
+                        (None, Some(m)) => match self.models.get(m).map(|e| &e.model) {
+                            None => anyhow::bail!(
+                                "{where_}: {at}.model: unknown model \"{m}\" (defined: {})",
+                                keys(&self.models)
+                            ),
+                            Some(ModelForm::Law(_)) => anyhow::bail!(
+                                "{where_}: {at}.model: \"{m}\" is a law alone; give the law as `base` or define models.{m}.c1 / models.{m}.n1_needle"
+                            ),
+                            Some(ModelForm::Spec(spec)) => {
+                                for s in &d.data {
+                                    self.check_predicts(where_.to_string(), &at, m, spec, s)?;
+                                }
+                            }
+                        },
+                        _ => anyhow::bail!(
+                            "{where_}: {at}: give exactly one of `base` (a law) and `model` (a model name)"
+                        ),
                     }
                     for e in d.effects.iter().flatten() {
                         if let Err(m) = e.parse::<palpate_core::Effect>() {
@@ -237,6 +370,31 @@ impl Manifest {
                     }
                 }
             }
+        }
+        Ok(())
+    }
+}
+
+impl Manifest {
+    /// Checks that a model spec predicts the records of data set `data`.
+    fn check_predicts(
+        &self,
+        where_: String,
+        at: &str,
+        model: &str,
+        spec: &ModelSpec,
+        data: &str,
+    ) -> anyhow::Result<()> {
+        let Some(d) = self.data.get(data) else {
+            return Ok(());
+        };
+        let test = crate::calibration::TestKind::parse(&d.test)?;
+        if spec.test().ok() != Some(test) {
+            anyhow::bail!(
+                "{where_}: {at}: model \"{model}\" ({}) does not predict data set \"{data}\" (a {} test)",
+                spec.kind(),
+                d.test
+            );
         }
         Ok(())
     }
@@ -310,6 +468,38 @@ fits = { u = ["uni"] }
         assert!(e.contains("models.nh.law"), "{e}");
         let m = Manifest::parse(&p, GOOD).unwrap();
         m.validate(&p).unwrap();
+    }
+
+    #[test]
+    fn a_diagnose_step_takes_a_base_law_or_a_named_model() {
+        let dir = tempfile::tempdir().unwrap();
+        std::fs::write(dir.path().join("r.csv"), "displacement_mm,force_N\n0,0\n").unwrap();
+        let p = dir.path().join("s.toml");
+        let text = |base: &str| {
+            format!(
+                "[study]\nname = \"t\"\n\n[data.rec]\nfile = \"r.csv\"\ntest = \"N1\"\n\n\
+                 [models.needle.n1_needle]\nlaw = \"neo-hookean\"\n\n\
+                 [models.press.c1]\nlaw = \"neo-hookean\"\n\n\
+                 [[steps]]\n[steps.diagnose]\nname = \"gap\"\ndata = [\"rec\"]\n{base}\n"
+            )
+        };
+        for ok in ["base = \"neo-hookean\"", "model = \"needle\""] {
+            let m = Manifest::parse(&p, &text(ok)).unwrap();
+            m.validate(&p).unwrap();
+        }
+        for (bad, needle) in [
+            ("", "exactly one of `base`"),
+            (
+                "base = \"yeoh\"\nmodel = \"needle\"",
+                "exactly one of `base`",
+            ),
+            ("model = \"nedle\"", "unknown model \"nedle\""),
+            ("model = \"press\"", "does not predict data set \"rec\""),
+        ] {
+            let m = Manifest::parse(&p, &text(bad)).unwrap();
+            let e = m.validate(&p).unwrap_err().to_string();
+            assert!(e.contains("steps[0].diagnose") && e.contains(needle), "{e}");
+        }
     }
 
     #[test]

@@ -7,9 +7,11 @@
 //! * `provenance.json` — hashes, git commit, crate versions, seed, threads, timings.
 
 use crate::calibration::{calibrate, parse_method, Calibration, Request, TestData, TestKind};
-use crate::manifest::{CalibrateStep, DiagnoseStep, Manifest, Step};
+use crate::manifest::{CalibrateStep, DiagnoseStep, Manifest, ModelForm, Step};
+use crate::models::{build, default_effects, gap_base, parse_effects};
 use crate::output::{write_atomic, write_json};
 use crate::provenance::{crate_versions, git_state, hash_file, Provenance};
+use crate::report::{fit_plot, gap_svg};
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
@@ -114,7 +116,7 @@ pub fn run_study(
                 results.steps.push(r);
             }
             Step::Diagnose(d) => {
-                let r = run_diagnose(d, &data, &out, observer, &mut report)?;
+                let r = run_diagnose(&manifest, d, &data, &out, observer, &mut report)?;
                 results.steps.push(r);
             }
         }
@@ -155,11 +157,15 @@ fn run_calibrate(
     let predict: Vec<TestData> = step.predict.iter().map(|n| data[n].clone()).collect();
     let mut fits = Vec::new();
     for model_name in &step.models {
-        let spec = &manifest.models[model_name];
-        let law: Law = spec
-            .law
+        let entry = &manifest.models[model_name];
+        let law: Law = entry
+            .law_text()
             .parse()
             .map_err(|e| anyhow::anyhow!("models.{model_name}.law: {e}"))?;
+        let spec = match &entry.model {
+            ModelForm::Law(_) => None,
+            ModelForm::Spec(s) => Some(s),
+        };
         for (group, sets) in &step.fits {
             let fitted: Vec<TestData> = sets.iter().map(|n| data[n].clone()).collect();
             for residual in &step.residuals {
@@ -170,11 +176,12 @@ fn run_calibrate(
                 ));
                 let calibration = calibrate(Request {
                     law,
+                    model: spec,
                     fitted: &fitted,
                     predict: &predict,
                     residual: kind,
                     method,
-                    fixed: spec.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+                    fixed: entry.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
                     observer: None,
                 })
                 .with_context(|| {
@@ -183,7 +190,7 @@ fn run_calibrate(
                         step.name
                     )
                 })?;
-                let plot = crate::cli::calibrate::fit_plot(&calibration);
+                let plot = fit_plot(&calibration);
                 let file = format!("{}-{model_name}-{group}-{residual}.svg", step.name);
                 write_atomic(&out.join("plots").join(&file), plot.to_svg().as_bytes())?;
                 fits.push(FitEntry {
@@ -289,36 +296,51 @@ fn write_calibrate_report(step: &CalibrateStep, fits: &[FitEntry], r: &mut Strin
 }
 
 fn run_diagnose(
+    manifest: &Manifest,
     step: &DiagnoseStep,
     data: &BTreeMap<String, TestData>,
     out: &Path,
     observer: &dyn RunObserver,
     report: &mut String,
 ) -> anyhow::Result<StepResult> {
-    let law: Law = step
-        .base
-        .parse()
-        .map_err(|e| anyhow::anyhow!("step `{}`: base: {e}", step.name))?;
+    // The base model: a named model spec, or the base law in the gap base
+    // model of each record's test (models::gap_base).
+    let (base_name, named) = match (&step.base, &step.model) {
+        (Some(base), _) => (base.clone(), None),
+        (None, Some(m)) => match &manifest.models[m].model {
+            ModelForm::Spec(s) => (m.clone(), Some(s)),
+            ModelForm::Law(_) => anyhow::bail!("step `{}`: model `{m}` is a law alone", step.name),
+        },
+        (None, None) => anyhow::bail!("step `{}`: no base model", step.name),
+    };
     let mut cases = Vec::new();
     let _ = writeln!(
         report,
         "## Gap diagnosis `{}` (base `{}`)\n",
-        step.name, step.base
+        step.name, base_name
     );
     let _ = writeln!(report, "| data | verdict | noise SD (N) | base misfit (N) | best effect | misfit after (N) | held-out before / after (N) |");
     let _ = writeln!(report, "|---|---|---|---|---|---|---|");
     for name in &step.data {
         observer.message(&format!("{}: diagnosing {name}", step.name));
         let d = &data[name];
-        let benchmark = if d.test == TestKind::N1 { "N1" } else { "C1" };
-        let model = crate::cli::diagnose::base_model(benchmark, law)?;
+        let spec = match named {
+            Some(s) => s.clone(),
+            None => {
+                let law: Law = base_name
+                    .parse()
+                    .map_err(|e| anyhow::anyhow!("step `{}`: base: {e}", step.name))?;
+                gap_base(d.test, law).with_context(|| format!("step `{}`: `{name}`", step.name))?
+            }
+        };
+        let model = build(&spec).map_err(|e| anyhow::anyhow!("step `{}`: {e}", step.name))?;
         let options = palpate_uq::gap::GapOptions {
             effects: match &step.effects {
                 Some(list) => Some(
-                    crate::cli::diagnose::parse_effects(list)
+                    parse_effects(list)
                         .with_context(|| format!("step `{}`: effects", step.name))?,
                 ),
-                None => crate::cli::diagnose::default_effects(benchmark),
+                None => default_effects(&spec),
             },
             ..Default::default()
         };
@@ -342,7 +364,7 @@ fn run_diagnose(
             best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))
                 .unwrap_or_default(),
         );
-        let svg = crate::cli::diagnose::gap_svg(&gap, name);
+        let svg = gap_svg(&gap, name);
         write_atomic(
             &out.join("plots").join(format!("{}-{name}.svg", step.name)),
             svg.as_bytes(),

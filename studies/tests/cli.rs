@@ -168,3 +168,36 @@ fn run_check_reports_misspelled_manifest_field_with_line() {
     let o = palpate(&["run", "--check", m.to_str().unwrap()]);
     assert_clean_failure(&o, &["s.toml", "line 3", "seeed"]);
 }
+
+#[test]
+fn mesh_zero_is_an_error_in_simulate_and_doe() {
+    let o = palpate(&[
+        "simulate",
+        "--benchmark",
+        "N1",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.001101295",
+        "--mesh",
+        "0",
+    ]);
+    assert_clean_failure(&o, &["--mesh", "`0`", "1..12"]);
+    // doe used to run level 0 as level 1; every run's model is now checked
+    // before any run starts.
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("ref.csv"),
+        "displacement_mm,force_N\n0,0\n1,0.1\n2,0.3\n",
+    )
+    .unwrap();
+    let m = dir.path().join("d.toml");
+    std::fs::write(
+        &m,
+        "[[factors]]\nname = \"mesh\"\nlevels = [\"0\", \"coarse\"]\n\n\
+         [response.simulation]\nbenchmark = \"N1\"\nmetric = \"r2\"\nreference = \"ref.csv\"\n",
+    )
+    .unwrap();
+    let o = palpate(&["doe", "--manifest", m.to_str().unwrap()]);
+    assert_clean_failure(&o, &["n1_needle.mesh", "\"0\"", "1..12"]);
+}

@@ -1,9 +1,9 @@
 //! `palpate calibrate`: fit a hyperelastic law to homogeneous-test data or a
 //! C1 force record, print a table, optionally write JSON and an SVG plot.
 
-use crate::calibration::{calibrate, parse_method, Calibration, Request, TestData, TestKind};
+use crate::calibration::{calibrate, parse_method, Request, TestData, TestKind};
 use crate::output::{write_atomic, write_json};
-use crate::plot::{Plot, Series};
+use crate::report::{calibration_table, fit_plot};
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
@@ -117,6 +117,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let data = read_data(&args.data, args.benchmark.as_deref())?;
     let result = calibrate(Request {
         law,
+        model: None,
         fitted: &data,
         predict: &[],
         residual,
@@ -124,7 +125,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fixed,
         observer: None,
     })?;
-    print!("{}", table(&result));
+    print!("{}", calibration_table(&result));
     if let Some(p) = &args.json {
         write_json(p, &result)?;
         eprintln!("wrote {}", p.display());
@@ -134,118 +135,4 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
-}
-
-/// A readable table of a calibration.
-pub fn table(c: &Calibration) -> String {
-    use std::fmt::Write;
-    let mut s = String::new();
-    let _ = writeln!(
-        s,
-        "law {} fitted to {} ({} residuals, {})",
-        c.law,
-        c.data.join(" + "),
-        c.residual,
-        c.estimator
-    );
-    let _ = writeln!(
-        s,
-        "{:<10} {:>14} {:>14} {:>8}",
-        "parameter", "value", "std. error", "unit"
-    );
-    for (name, p) in c.params.iter() {
-        let se = match (p.fixed, p.standard_error) {
-            (true, _) => "fixed".to_string(),
-            (false, Some(e)) => format!("{e:.6e}"),
-            (false, None) => "n/a".to_string(),
-        };
-        let _ = writeln!(
-            s,
-            "{:<10} {:>14.6e} {:>14} {:>8}",
-            name, p.value, se, p.unit
-        );
-    }
-    let _ = writeln!(
-        s,
-        "R^2 {:.6}  RMS {:.4e}  SSE {:.6e}  iterations {}  evaluations {}  converged {}",
-        c.r2, c.rms, c.sse, c.iterations, c.evaluations, c.converged
-    );
-    if !c.identifiable {
-        let _ = writeln!(
-            s,
-            "NOT IDENTIFIABLE from these data: {} (condition number {:.2e}); values above are one of many equally good fits",
-            c.fit.identifiability.involved.join(", "),
-            c.fit.identifiability.condition_number
-        );
-    }
-    let d = &c.drucker;
-    let _ = writeln!(
-        s,
-        "Drucker stable stretch ranges: uniaxial [{:.3}, {:.3}]  biaxial [{:.3}, {:.3}]  planar [{:.3}, {:.3}]",
-        d.uniaxial.lower, d.uniaxial.upper, d.biaxial.lower, d.biaxial.upper, d.planar.lower, d.planar.upper
-    );
-    for p in &c.predictions {
-        let _ = writeln!(
-            s,
-            "  {:<12} {:<10} R^2 {:.5}  RMS {:.4e}",
-            p.data,
-            if p.fitted { "fitted" } else { "predicted" },
-            p.r2,
-            p.rms
-        );
-    }
-    s
-}
-
-/// Data (markers) against the fitted law (lines), one colour per data set.
-pub fn fit_plot(c: &Calibration) -> Plot {
-    let homogeneous = c
-        .predictions
-        .iter()
-        .all(|p| p.data != "C1" && p.data != "N1");
-    let (xl, yl) = if homogeneous {
-        ("stretch", "nominal stress (MPa)")
-    } else {
-        ("displacement (mm)", "force (N)")
-    };
-    let mut plot = Plot::new(
-        format!(
-            "{} fitted to {} ({} residuals)",
-            c.law,
-            c.data.join(" + "),
-            c.residual
-        ),
-        xl,
-        yl,
-    );
-    const COLOURS: [&str; 6] = [
-        "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b",
-    ];
-    for (k, p) in c.predictions.iter().enumerate() {
-        let col = COLOURS[k % COLOURS.len()];
-        plot.push(
-            Series::markers(
-                format!("{} data", p.data),
-                &p.stretch_or_displacement,
-                &p.observed,
-            )
-            .color(col),
-        );
-        let (x, y) = (&p.stretch_or_displacement, &p.predicted);
-        let label = format!(
-            "{} {} (R^2 {:.4})",
-            p.data,
-            if p.fitted { "fit" } else { "prediction" },
-            p.r2
-        );
-        plot.push(
-            if p.fitted {
-                Series::line(label, x, y)
-            } else {
-                Series::dashed(label, x, y)
-            }
-            .color(col),
-        );
-    }
-    plot
 }

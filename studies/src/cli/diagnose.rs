@@ -3,10 +3,10 @@
 //! shrinks once that effect is added (GAP.md).
 
 use crate::calibration::{TestData, TestKind};
+use crate::models::{build, default_effects, gap_base, parse_effects};
 use crate::output::{write_atomic, write_json};
-use crate::plot::{grid_svg, Band, Plot, Series};
+use crate::report::{gap_summary, gap_svg};
 use anyhow::Context;
-use palpate_core::{Effect, ForwardModel};
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
 use std::path::{Path, PathBuf};
@@ -63,42 +63,6 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
-/// The base forward model of a benchmark: C1 (analytic, lubricated
-/// platens) or N1 (axisymmetric FE needle indentation with a frictionless
-/// needle on the coarse mesh, so that `friction` and `boundary_condition`
-/// are effects to find).
-pub fn base_model(benchmark: &str, law: Law) -> anyhow::Result<Box<dyn ForwardModel>> {
-    if benchmark.eq_ignore_ascii_case("c1") {
-        Ok(Box::new(palpate_analytic::C1Compression::new(law)))
-    } else if benchmark.eq_ignore_ascii_case("n1") {
-        let mut m = palpate_fe::N1Needle::new(law);
-        m.friction = 0.0;
-        m.mesh = palpate_fe::MeshDensity::COARSE;
-        Ok(Box::new(m))
-    } else {
-        anyhow::bail!("--benchmark {benchmark}: the gap diagnosis supports C1 (analytic) and N1 (finite elements)")
-    }
-}
-
-/// The default candidate effects of a benchmark (`None`: every effect the
-/// base model offers). N1: GAP.md's `friction` and `boundary_condition`;
-/// the N1 model also offers `material_form` and `zero_offset`, but on one
-/// force-depth curve friction and a stiffening law are confounded
-/// (docs/gap-diagnosis.md), so they are candidates on request only.
-pub fn default_effects(benchmark: &str) -> Option<Vec<Effect>> {
-    benchmark
-        .eq_ignore_ascii_case("n1")
-        .then(|| vec![Effect::Friction, Effect::BoundaryCondition])
-}
-
-/// Effect names (GAP.md) parsed, the error naming the bad one.
-pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
-    names
-        .iter()
-        .map(|e| e.parse::<Effect>().map_err(|m| anyhow::anyhow!("{m}")))
-        .collect()
-}
-
 /// Diagnoses one record (shared with the manifest step).
 pub fn diagnose_file(
     benchmark: &str,
@@ -109,12 +73,15 @@ pub fn diagnose_file(
     let law: Law = base
         .parse()
         .map_err(|e| anyhow::anyhow!("base law `{base}`: {e}"))?;
-    let model = base_model(benchmark, law)?;
+    let spec = TestKind::parse(benchmark)
+        .and_then(|test| gap_base(test, law))
+        .with_context(|| format!("--benchmark {benchmark}"))?;
+    let model = build(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
     // C1 and N1 records share the columns displacement_mm, force_N[, time_s].
     let record = TestData::read("record", TestKind::C1, data)?;
     let mut options = options.clone();
     if options.effects.is_none() {
-        options.effects = default_effects(benchmark);
+        options.effects = default_effects(&spec);
     }
     diagnose(model.as_ref(), &record.loading, &record.observed, &options)
         .with_context(|| format!("diagnosing {}", data.display()))
@@ -131,7 +98,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         options.effects = Some(parse_effects(&args.effects).context("--effects")?);
     }
     let report = diagnose_file(&args.benchmark, &args.base, &args.data, &options)?;
-    println!("{}", summary(&report));
+    println!("{}", gap_summary(&report));
     if let Some(p) = &args.json {
         write_json(p, &report)?;
         eprintln!("wrote {}", p.display());
@@ -148,84 +115,4 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
-}
-
-/// A few lines for the terminal.
-pub fn summary(r: &GapReport) -> String {
-    use std::fmt::Write;
-    let mut s = String::new();
-    let _ = writeln!(s, "verdict: {}", r.verdict);
-    if !r.confounded.is_empty() {
-        let _ = writeln!(s, "cannot be told apart from: {}", r.confounded.join(", "));
-    }
-    let _ = writeln!(
-        s,
-        "noise SD {:.4} (estimated from the data); base misfit RMS {:.4}, held-out {:.4}",
-        r.noise_sd, r.base.misfit, r.base.heldout
-    );
-    for w in &r.where_ {
-        let _ = writeln!(
-            s,
-            "  misfit window {} {:.3} .. {:.3}: RMS {:.4}",
-            w.axis, w.from, w.to, w.misfit_rms
-        );
-    }
-    let _ = writeln!(
-        s,
-        "{:<18} {:>10} {:>10} {:>10} {:>10}  identifiable",
-        "effect", "fit before", "after", "held-out", "after"
-    );
-    for e in &r.ranking {
-        let _ = writeln!(
-            s,
-            "{:<18} {:>10.4} {:>10.4} {:>10.4} {:>10.4}  {}",
-            e.effect,
-            e.misfit_before,
-            e.misfit_after,
-            e.heldout_before,
-            e.heldout_after,
-            e.identifiable
-        );
-    }
-    let _ = write!(s, "{}", r.explanation);
-    s
-}
-
-/// Two panels: data with base and enriched fits; residuals with the
-/// discrepancy band and the flagged windows.
-pub fn gap_svg(r: &GapReport, title: &str) -> String {
-    let p = &r.plot;
-    let windows: Vec<(f64, f64)> = r.where_.iter().map(|w| (w.from, w.to)).collect();
-    let mut top = Plot::new("data and fits", &p.axis, "force (N)");
-    top.width = 760.0;
-    top.windows = windows.clone();
-    top.push(Series::markers("data", &p.x, &p.observed).color("#888888"));
-    top.push(Series::line("base fit", &p.x, &p.base_fit).color("#d62728"));
-    if let (Some(e), Some(f)) = (&p.enriched_effect, &p.enriched_fit) {
-        top.push(Series::line(format!("base + {e}"), &p.x, f).color("#2ca02c"));
-    }
-    let mut bottom = Plot::new(
-        "residuals (flagged windows shaded)",
-        &p.axis,
-        "residual (N)",
-    );
-    bottom.width = 760.0;
-    bottom.windows = windows;
-    bottom.hlines = vec![0.0];
-    bottom.bands.push(Band {
-        label: "running mean +- 2 sigma/sqrt(w)".into(),
-        x: p.x.clone(),
-        lower: p.band_lower.clone(),
-        upper: p.band_upper.clone(),
-        color: "#1f77b4".into(),
-    });
-    bottom.push(Series::markers("base residual", &p.x, &p.base_residual).color("#d62728"));
-    if let (Some(e), Some(res)) = (&p.enriched_effect, &p.enriched_residual) {
-        bottom.push(Series::markers(format!("base + {e} residual"), &p.x, res).color("#2ca02c"));
-    }
-    grid_svg(
-        &[Some(top), Some(bottom)],
-        1,
-        &format!("gap diagnosis of {title}: verdict {}", r.verdict),
-    )
 }

@@ -72,7 +72,7 @@ struct Manifest {
     analysis: AnalysisSpec,
 }
 
-#[derive(Debug, Default, Deserialize)]
+#[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct DesignSpec {
     seed: Option<u64>,
@@ -84,6 +84,18 @@ struct DesignSpec {
 
 fn one() -> usize {
     1
+}
+
+/// A manifest without `[design]`: one replicate in standard order (a derived
+/// Default would give 0 replicates, rejected by the design).
+impl Default for DesignSpec {
+    fn default() -> Self {
+        DesignSpec {
+            seed: None,
+            replicates: one(),
+            generators: Vec::new(),
+        }
+    }
 }
 
 #[derive(Debug, Default, Deserialize)]
@@ -120,9 +132,11 @@ struct SimulationResponse {
     /// Score only the reference samples up to this depth (mm); default: the
     /// whole reference curve.
     max_depth_mm: Option<f64>,
-    /// Defaults for settings that are not factors.
+    /// Defaults for settings that are not factors (absent: neo-hookean and
+    /// the N1 model's defaults, friction 0.8 and the medium mesh).
     law: Option<String>,
     friction: Option<f64>,
+    #[serde(default, deserialize_with = "crate::models::text_or_number")]
     mesh: Option<String>,
 }
 
@@ -377,6 +391,7 @@ fn run_calibrations(
             };
             let c = calibrate(Request {
                 law,
+                model: None,
                 fitted: &fitted,
                 predict: &[],
                 residual,
@@ -398,8 +413,8 @@ fn run_calibrations(
 /// One N1 simulation per run (in parallel over runs; each run's numbers do
 /// not depend on the thread count), scored against the reference curve.
 fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow::Result<Vec<f64>> {
+    use crate::models::{ModelSpec, N1NeedleSpec};
     use palpate_core::{data::Table, Drive, ForwardModel, Loading};
-    use palpate_fe::{MeshDensity, N1Needle};
     if !spec.benchmark.eq_ignore_ascii_case("n1") {
         anyhow::bail!(
             "response.simulation.benchmark = `{}`: only N1 is supported",
@@ -448,6 +463,64 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
             .position(|f| f.name == factor)
             .map(|k| d.level_name(run, k).to_string())
     };
+    // Every run's model is built and checked before anything runs.
+    let models: Vec<(Box<dyn ForwardModel>, Vec<f64>)> = d
+        .runs
+        .iter()
+        .map(|run| {
+            let at = || {
+                format!(
+                    "run {} (standard order {})",
+                    run.run_order, run.standard_order
+                )
+            };
+            let law_text = setting(run, "law")
+                .or_else(|| spec.law.clone())
+                .unwrap_or_else(|| "neo-hookean".into());
+            let friction = match setting(run, "friction") {
+                Some(t) => Some(t.parse::<f64>().map_err(|_| {
+                    anyhow::anyhow!("{}: friction level `{t}` is not a number", at())
+                })?),
+                None => spec.friction,
+            };
+            let model_spec = ModelSpec::N1Needle(N1NeedleSpec {
+                law: law_text.clone(),
+                friction,
+                mesh: setting(run, "mesh").or_else(|| spec.mesh.clone()),
+                ..Default::default()
+            });
+            let checked = model_spec
+                .validate()
+                .map_err(|e| anyhow::anyhow!("{}: {e}", at()))?;
+            let law = model_spec
+                .law()
+                .map_err(|e| anyhow::anyhow!("{}: {e}", at()))?;
+            let model = checked.into_forward();
+            let theta: Vec<f64> = match spec.params.get(&law_text) {
+                Some(p) => model
+                    .space()
+                    .names()
+                    .iter()
+                    .map(|n| {
+                        p.get(n).copied().ok_or_else(|| {
+                            anyhow::anyhow!(
+                                "response.simulation.params.\"{law_text}\": parameter `{n}` missing"
+                            )
+                        })
+                    })
+                    .collect::<anyhow::Result<_>>()?,
+                None => {
+                    let p = default_params(&law).ok_or_else(|| {
+                        anyhow::anyhow!(
+                            "law `{law_text}`: give its parameters in response.simulation.params"
+                        )
+                    })?;
+                    p.into_iter().map(|(_, v)| v).collect()
+                }
+            };
+            Ok((model, theta))
+        })
+        .collect::<anyhow::Result<_>>()?;
     let bar = indicatif::ProgressBar::new(d.runs.len() as u64);
     bar.set_style(
         indicatif::ProgressStyle::with_template(
@@ -458,42 +531,15 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
     let out = d
         .runs
         .par_iter()
-        .map(|run| {
-            let at = || format!("run {} (standard order {})", run.run_order, run.standard_order);
-            let law_text = setting(run, "law").or_else(|| spec.law.clone()).unwrap_or_else(|| "neo-hookean".into());
-            let law: Law = law_text.parse().map_err(|e| anyhow::anyhow!("{}: law `{law_text}`: {e}", at()))?;
-            let friction_text = setting(run, "friction").or_else(|| spec.friction.map(|f| f.to_string())).unwrap_or_else(|| "0.8".into());
-            let friction: f64 = friction_text
-                .parse()
-                .map_err(|_| anyhow::anyhow!("{}: friction level `{friction_text}` is not a number", at()))?;
-            let mesh_text = setting(run, "mesh").or_else(|| spec.mesh.clone()).unwrap_or_else(|| "coarse".into());
-            let mesh = match mesh_text.as_str() {
-                "coarse" => MeshDensity::COARSE,
-                "medium" => MeshDensity::MEDIUM,
-                "fine" => MeshDensity::FINE,
-                other => MeshDensity {
-                    level: other
-                        .parse()
-                        .map_err(|_| anyhow::anyhow!("{}: mesh level `{other}`: expected coarse, medium, fine or a refinement level", at()))?,
-                },
+        .zip(&models)
+        .map(|(run, (model, theta))| {
+            let at = || {
+                format!(
+                    "run {} (standard order {})",
+                    run.run_order, run.standard_order
+                )
             };
-            let mut model = N1Needle::new(law);
-            model.friction = friction;
-            model.mesh = mesh;
-            let theta: Vec<f64> = match spec.params.get(&law_text) {
-                Some(p) => model
-                    .space()
-                    .names()
-                    .iter()
-                    .map(|n| p.get(n).copied().ok_or_else(|| anyhow::anyhow!("response.simulation.params.\"{law_text}\": parameter `{n}` missing")))
-                    .collect::<anyhow::Result<_>>()?,
-                None => {
-                    let p = default_params(&law)
-                        .ok_or_else(|| anyhow::anyhow!("law `{law_text}`: give its parameters in response.simulation.params"))?;
-                    p.into_iter().map(|(_, v)| v).collect()
-                }
-            };
-            let f = model.predict(&theta, &loading).with_context(at)?;
+            let f = model.predict(theta, &loading).with_context(at)?;
             bar.inc(1);
             let (r2, rms) = crate::calibration::r2_rms(&y, &f);
             Ok(if spec.metric == "r2" { r2 } else { rms })

@@ -126,15 +126,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let sets: Vec<DataSet> = data
         .iter()
-        .map(|t| {
+        .map(|t| -> anyhow::Result<DataSet> {
             let peak = t
                 .observed
                 .iter()
                 .fold(0.0f64, |m, v| m.max(v.abs()))
                 .max(1e-12);
-            DataSet {
+            Ok(DataSet {
                 name: t.name.clone(),
-                model: t.test.model(law),
+                model: t.test.model(law)?,
                 loading: t.loading.clone(),
                 observed: t.observed.clone(),
                 noise: NoiseModel {
@@ -151,9 +151,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                         Correlation::Independent
                     },
                 },
-            }
+            })
         })
-        .collect();
+        .collect::<anyhow::Result<_>>()?;
     let space = sets[0].model.space().clone();
     let mut priors = vec![Prior::Flat; space.len()];
     for p in &args.prior {

@@ -5,12 +5,12 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Context};
 use indicatif::{ProgressBar, ProgressStyle};
+use palpate_core::ForwardModel;
 use palpate_core::{Drive, Loading};
-use palpate_fe::{
-    Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens, Progress, Simulation, ToolShape,
-};
+use palpate_fe::{Progress, Simulation};
 use palpate_material::Law;
 
+use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec};
 use crate::output::write_atomic;
 use crate::plot::{Plot, Series};
 
@@ -26,30 +26,30 @@ pub struct Args {
     /// A law parameter in MPa (or 1), e.g. --param C10=0.001101295; repeat for each parameter of the law.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     pub params: Vec<String>,
-    /// N1: Coulomb friction coefficient between needle and material (default 0.8).
-    #[arg(long, default_value_t = 0.8)]
-    pub friction: f64,
+    /// N1: Coulomb friction coefficient between needle and material [default: 0.8].
+    #[arg(long)]
+    pub friction: Option<f64>,
     /// C1: bonded (no-slip) platens instead of frictionless ones.
     #[arg(long)]
     pub bonded: bool,
     /// N1: bottom face free to slide radially instead of fixed.
     #[arg(long)]
     pub sliding_base: bool,
-    /// N1 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen.
-    #[arg(long, default_value = "needle")]
-    pub tool: String,
+    /// N1 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
+    #[arg(long)]
+    pub tool: Option<String>,
     /// Final tool displacement in mm (default: 10 for N1, 2 for C1).
     #[arg(long)]
     pub depth: Option<f64>,
     /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1).
     #[arg(long)]
     pub step: Option<f64>,
-    /// Mesh density: coarse, medium, fine or a refinement level N (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements).
-    #[arg(long, default_value = "medium")]
-    pub mesh: String,
-    /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000.
-    #[arg(long, default_value = "exact")]
-    pub bulk: String,
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements) [default: medium].
+    #[arg(long)]
+    pub mesh: Option<String>,
+    /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
+    #[arg(long)]
+    pub bulk: Option<String>,
     /// Write the force curve as CSV (columns displacement_mm,force_N).
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
@@ -99,67 +99,43 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
     Ok(p)
 }
 
-fn parse_mesh(s: &str) -> anyhow::Result<usize> {
-    match s {
-        "coarse" => Ok(1),
-        "medium" => Ok(2),
-        "fine" => Ok(3),
-        n => match n.parse::<usize>() {
-            Ok(k) if (1..=12).contains(&k) => Ok(k),
-            _ => bail!("--mesh `{s}`: expected coarse, medium, fine or a level 1..12"),
-        },
-    }
-}
-
-fn parse_bulk(s: &str) -> anyhow::Result<Bulk> {
-    if s == "exact" {
-        return Ok(Bulk::Exact);
-    }
-    match s.parse::<f64>() {
-        Ok(r) if r > 0.0 && r.is_finite() => Ok(Bulk::Ratio(r)),
-        _ => bail!("--bulk `{s}`: expected `exact` or a positive ratio K/mu such as 1000"),
-    }
-}
-
-fn parse_tool(s: &str) -> anyhow::Result<ToolShape> {
-    let num = |v: &str| -> anyhow::Result<f64> {
-        v.parse::<f64>()
-            .ok()
-            .filter(|r| *r > 0.0 && r.is_finite())
-            .ok_or_else(|| anyhow!("--tool `{s}`: `{v}` is not a positive radius in mm"))
-    };
-    match s.split_once(':') {
-        None if s == "needle" => Ok(ToolShape::n1_needle()),
-        None if s == "platen" => Ok(ToolShape::Platen),
-        Some(("sphere", r)) => Ok(ToolShape::Sphere { radius: num(r)? }),
-        Some(("punch", r)) => {
-            let radius = num(r)?;
-            Ok(ToolShape::FlatPunch {
-                radius,
-                edge_radius: (0.1f64).min(0.5 * radius),
-            })
-        }
-        _ => bail!("--tool `{s}`: expected needle, sphere:RADIUS, punch:RADIUS or platen"),
+/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`
+/// (the settings a benchmark does not have are ignored).
+pub fn model_spec(args: &Args) -> ModelSpec {
+    if args.benchmark.eq_ignore_ascii_case("n1") {
+        ModelSpec::N1Needle(N1NeedleSpec {
+            law: args.law.clone(),
+            friction: args.friction,
+            mesh: args.mesh.clone(),
+            bulk: args.bulk.clone(),
+            base: args.sliding_base.then(|| "sliding".into()),
+            tool: args.tool.clone(),
+        })
+    } else {
+        ModelSpec::C1Fe(C1FeSpec {
+            law: args.law.clone(),
+            platens: args.bonded.then(|| "bonded".into()),
+            mesh: args.mesh.clone(),
+            bulk: args.bulk.clone(),
+        })
     }
 }
 
 /// Runs `palpate simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    let model = model_spec(&args)
+        .validate()
+        .map_err(|e| anyhow!("{}", e.as_option()))?;
     let law: Law = args
         .law
         .parse()
         .map_err(|e| anyhow!("--law `{}`: {e}", args.law))?;
     let theta = parse_params(&law, &args.params)?;
-    let level = parse_mesh(&args.mesh)?;
-    let bulk = parse_bulk(&args.bulk)?;
     let n1 = args.benchmark.eq_ignore_ascii_case("n1");
     let depth = args.depth.unwrap_or(if n1 { 10.0 } else { 2.0 });
     let step = args.step.unwrap_or(if n1 { 0.25 } else { 0.1 });
     if !(depth > 0.0 && depth.is_finite() && step > 0.0 && step.is_finite()) {
         bail!("--depth and --step must be positive (got {depth} and {step})");
-    }
-    if !(args.friction >= 0.0 && args.friction.is_finite()) {
-        bail!("--friction must be >= 0 (got {})", args.friction);
     }
     let n = (depth / step).ceil() as usize;
     let drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
@@ -180,34 +156,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             p.iterations
         ));
     };
-    let (title, result) = if n1 {
-        let mut m = N1Needle::new(law);
-        m.friction = args.friction;
-        m.bulk = bulk;
-        m.mesh = MeshDensity { level };
-        m.tool = parse_tool(&args.tool)?;
-        if args.sliding_base {
-            m.base = Base::Sliding;
-        }
-        (
-            palpate_core::ForwardModel::name(&m),
-            m.simulate(&theta, &loading, Some(&mut cb)),
-        )
-    } else {
-        let mut m = C1Fe::new(
-            law,
-            if args.bonded {
-                Platens::Bonded
-            } else {
-                Platens::Frictionless
-            },
-        );
-        m.bulk = bulk;
-        m.elements = (19 * level, 9 * level);
-        (
-            palpate_core::ForwardModel::name(&m),
-            m.simulate(&theta, &loading, Some(&mut cb)),
-        )
+    let (title, result) = match &model {
+        Model::N1Needle(m) => (m.name(), m.simulate(&theta, &loading, Some(&mut cb))),
+        Model::C1Fe(m) => (m.name(), m.simulate(&theta, &loading, Some(&mut cb))),
+        _ => bail!("--benchmark {}: expected N1 or C1", args.benchmark),
     };
     bar.finish_and_clear();
     let (sim, solver): (Simulation, _) = match result {

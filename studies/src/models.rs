@@ -1,0 +1,496 @@
+//! One description of a forward model ([`ModelSpec`]) and one factory
+//! ([`build`]) shared by `simulate`, `calibrate`, `sample`, `doe`,
+//! `diagnose` and the study runner.
+//!
+//! A spec is plain serde data, externally tagged by the kind of model, as in
+//! a study manifest:
+//!
+//! ```toml
+//! [models.needle.n1_needle]   # N1 needle indentation (finite elements)
+//! law = "neo-hookean"
+//! friction = 0.8              # Coulomb coefficient needle/material
+//! mesh = "coarse"             # coarse | medium | fine | N (N = 1..12)
+//! bulk = "exact"              # exact | K/mu ratio such as 1000
+//! base = "bonded"             # bonded | sliding
+//! tool = "needle"             # needle | sphere:R | punch:R | platen
+//!
+//! [models.press.c1_fe]        # C1 compression (finite elements)
+//! law = "neo-hookean"
+//! platens = "frictionless"    # frictionless | bonded
+//! mesh = "medium"             # level N: 19N x 9N elements
+//!
+//! [models.press-analytic.c1]  # C1 compression (analytic, lubricated)
+//! law = "neo-hookean"
+//!
+//! [models.tension.homogeneous] # homogeneous test (analytic)
+//! law = "mooney-rivlin"
+//! mode = "uniaxial"           # uniaxial | biaxial | planar
+//! ```
+//!
+//! Every optional setting has one default, the same from a manifest and from
+//! the command line ([`DEFAULT_FRICTION`], [`DEFAULT_MESH`], `bulk = exact`,
+//! `base = bonded`, `tool = needle`, `platens = frictionless`).
+//! [`ModelSpec::validate`] turns a spec into a checked [`Model`] and names
+//! the offending field when a value is wrong.
+//!
+//! The legacy form of a manifest model, `law = "..."` alone, means "this law
+//! in the model of each data set's test" ([`for_test`]); the gap diagnosis's
+//! `base = "..."` means the base model of [`gap_base`].
+
+use crate::calibration::TestKind;
+use palpate_analytic::{C1Compression, Homogeneous, Mode};
+use palpate_core::{Effect, ForwardModel};
+use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens, ToolShape};
+use palpate_material::Law;
+use serde::Deserialize;
+use std::fmt;
+
+/// Default Coulomb friction between the N1 needle and the material (BENCHMARKS.md).
+pub const DEFAULT_FRICTION: f64 = 0.8;
+/// Default mesh of the FE models (level 2: N1 0.2 mm elements under the
+/// tool, C1 38 x 18 elements).
+pub const DEFAULT_MESH: &str = "medium";
+/// The finest mesh level accepted.
+pub const MAX_MESH_LEVEL: usize = 12;
+
+/// A forward model, by kind.
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ModelSpec {
+    /// A homogeneous test of a law (analytic).
+    Homogeneous(HomogeneousSpec),
+    /// Benchmark C1, lubricated compression (analytic).
+    C1(C1Spec),
+    /// Benchmark C1 by finite elements.
+    C1Fe(C1FeSpec),
+    /// Benchmark N1, needle indentation by finite elements.
+    N1Needle(N1NeedleSpec),
+}
+
+/// `[... .homogeneous]`
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HomogeneousSpec {
+    pub law: String,
+    /// `uniaxial`, `biaxial` or `planar`.
+    pub mode: String,
+}
+
+/// `[... .c1]`
+#[derive(Debug, Clone, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct C1Spec {
+    pub law: String,
+}
+
+/// `[... .c1_fe]`
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct C1FeSpec {
+    pub law: String,
+    /// `frictionless` (default) or `bonded`.
+    #[serde(default)]
+    pub platens: Option<String>,
+    /// `coarse`, `medium` (default), `fine` or a level 1..12: 19N x 9N elements.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub mesh: Option<String>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub bulk: Option<String>,
+}
+
+/// `[... .n1_needle]`
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct N1NeedleSpec {
+    pub law: String,
+    /// Coulomb friction coefficient (default 0.8).
+    #[serde(default)]
+    pub friction: Option<f64>,
+    /// `coarse`, `medium` (default), `fine` or a level 1..12: elements of 0.4/N mm under the tool.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub mesh: Option<String>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub bulk: Option<String>,
+    /// `bonded` (default) or `sliding`.
+    #[serde(default)]
+    pub base: Option<String>,
+    /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
+    #[serde(default)]
+    pub tool: Option<String>,
+}
+
+/// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
+pub fn text_or_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum V {
+        Int(i64),
+        Float(f64),
+        Text(String),
+    }
+    Ok(Some(match V::deserialize(d)? {
+        V::Int(i) => i.to_string(),
+        V::Float(x) => x.to_string(),
+        V::Text(s) => s,
+    }))
+}
+
+/// A value of a spec that is wrong: the kind, the field, the value given and
+/// what was expected.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[error("{kind}.{field} = \"{value}\": {expected}")]
+pub struct ModelError {
+    pub kind: &'static str,
+    pub field: &'static str,
+    pub value: String,
+    pub expected: String,
+}
+
+impl ModelError {
+    fn new(
+        kind: &'static str,
+        field: &'static str,
+        value: impl fmt::Display,
+        expected: impl Into<String>,
+    ) -> Self {
+        ModelError {
+            kind,
+            field,
+            value: value.to_string(),
+            expected: expected.into(),
+        }
+    }
+
+    /// The error in command-line terms (`--mesh 0: ...`).
+    pub fn as_option(&self) -> String {
+        format!(
+            "--{} `{}`: {}",
+            self.field.replace('_', "-"),
+            self.value,
+            self.expected
+        )
+    }
+}
+
+/// A checked model, ready to run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Model {
+    Homogeneous(Homogeneous),
+    C1(C1Compression),
+    C1Fe(C1Fe),
+    N1Needle(N1Needle),
+}
+
+impl Model {
+    /// The model behind the common forward-model seam.
+    pub fn into_forward(self) -> Box<dyn ForwardModel> {
+        match self {
+            Model::Homogeneous(m) => Box::new(m),
+            Model::C1(m) => Box::new(m),
+            Model::C1Fe(m) => Box::new(m),
+            Model::N1Needle(m) => Box::new(m),
+        }
+    }
+}
+
+/// Builds the forward model a spec describes (the one factory).
+pub fn build(spec: &ModelSpec) -> Result<Box<dyn ForwardModel>, ModelError> {
+    Ok(spec.validate()?.into_forward())
+}
+
+impl ModelSpec {
+    /// The kinds, as spelled in manifests.
+    pub const KINDS: [&'static str; 4] = ["homogeneous", "c1", "c1_fe", "n1_needle"];
+
+    /// The kind, as spelled in manifests.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            ModelSpec::Homogeneous(_) => "homogeneous",
+            ModelSpec::C1(_) => "c1",
+            ModelSpec::C1Fe(_) => "c1_fe",
+            ModelSpec::N1Needle(_) => "n1_needle",
+        }
+    }
+
+    /// The law as written.
+    pub fn law_text(&self) -> &str {
+        match self {
+            ModelSpec::Homogeneous(s) => &s.law,
+            ModelSpec::C1(s) => &s.law,
+            ModelSpec::C1Fe(s) => &s.law,
+            ModelSpec::N1Needle(s) => &s.law,
+        }
+    }
+
+    /// The parsed law.
+    pub fn law(&self) -> Result<Law, ModelError> {
+        let t = self.law_text();
+        t.parse::<Law>()
+            .map_err(|e| ModelError::new(self.kind(), "law", t, e.to_string()))
+    }
+
+    /// The test whose records this model predicts.
+    pub fn test(&self) -> Result<TestKind, ModelError> {
+        Ok(match self {
+            ModelSpec::Homogeneous(s) => TestKind::Homogeneous(parse_mode(&s.mode)?),
+            ModelSpec::C1(_) | ModelSpec::C1Fe(_) => TestKind::C1,
+            ModelSpec::N1Needle(_) => TestKind::N1,
+        })
+    }
+
+    /// Checks every field and builds the model; errors name the field.
+    pub fn validate(&self) -> Result<Model, ModelError> {
+        let law = self.law()?;
+        Ok(match self {
+            ModelSpec::Homogeneous(s) => {
+                Model::Homogeneous(Homogeneous::new(law, parse_mode(&s.mode)?))
+            }
+            ModelSpec::C1(_) => Model::C1(C1Compression::new(law)),
+            ModelSpec::C1Fe(s) => {
+                const K: &str = "c1_fe";
+                let platens = match s.platens.as_deref().unwrap_or("frictionless") {
+                    "frictionless" => Platens::Frictionless,
+                    "bonded" => Platens::Bonded,
+                    other => {
+                        return Err(ModelError::new(
+                            K,
+                            "platens",
+                            other,
+                            "expected frictionless or bonded",
+                        ))
+                    }
+                };
+                let mut m = C1Fe::new(law, platens);
+                let level = parse_mesh(K, s.mesh.as_deref())?;
+                m.elements = (19 * level, 9 * level);
+                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+                Model::C1Fe(m)
+            }
+            ModelSpec::N1Needle(s) => {
+                const K: &str = "n1_needle";
+                let mut m = N1Needle::new(law);
+                let friction = s.friction.unwrap_or(DEFAULT_FRICTION);
+                if !(friction >= 0.0 && friction.is_finite()) {
+                    return Err(ModelError::new(
+                        K,
+                        "friction",
+                        friction,
+                        "expected a coefficient >= 0",
+                    ));
+                }
+                m.friction = friction;
+                m.mesh = MeshDensity {
+                    level: parse_mesh(K, s.mesh.as_deref())?,
+                };
+                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+                m.base = match s.base.as_deref().unwrap_or("bonded") {
+                    "bonded" => Base::Bonded,
+                    "sliding" => Base::Sliding,
+                    other => {
+                        return Err(ModelError::new(
+                            K,
+                            "base",
+                            other,
+                            "expected bonded or sliding",
+                        ))
+                    }
+                };
+                m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
+                Model::N1Needle(m)
+            }
+        })
+    }
+}
+
+fn parse_mode(s: &str) -> Result<Mode, ModelError> {
+    s.parse::<Mode>().map_err(|_| {
+        ModelError::new(
+            "homogeneous",
+            "mode",
+            s,
+            "expected uniaxial, biaxial or planar",
+        )
+    })
+}
+
+/// The mesh level of `coarse` (1), `medium` (2), `fine` (3) or `N` (1..=12);
+/// absent: [`DEFAULT_MESH`]. The one mesh parser of every command.
+pub fn parse_mesh(kind: &'static str, s: Option<&str>) -> Result<usize, ModelError> {
+    let s = s.unwrap_or(DEFAULT_MESH);
+    match s {
+        "coarse" => Ok(MeshDensity::COARSE.level),
+        "medium" => Ok(MeshDensity::MEDIUM.level),
+        "fine" => Ok(MeshDensity::FINE.level),
+        n => match n.parse::<usize>() {
+            Ok(k) if (1..=MAX_MESH_LEVEL).contains(&k) => Ok(k),
+            _ => Err(ModelError::new(
+                kind,
+                "mesh",
+                s,
+                format!("expected coarse, medium, fine or a level 1..{MAX_MESH_LEVEL}"),
+            )),
+        },
+    }
+}
+
+fn parse_bulk(kind: &'static str, s: Option<&str>) -> Result<Bulk, ModelError> {
+    let s = s.unwrap_or("exact");
+    if s == "exact" {
+        return Ok(Bulk::Exact);
+    }
+    match s.parse::<f64>() {
+        Ok(r) if r > 0.0 && r.is_finite() => Ok(Bulk::Ratio(r)),
+        _ => Err(ModelError::new(
+            kind,
+            "bulk",
+            s,
+            "expected `exact` or a positive ratio K/mu such as 1000",
+        )),
+    }
+}
+
+fn parse_tool(kind: &'static str, s: &str) -> Result<ToolShape, ModelError> {
+    let num = |v: &str| -> Result<f64, ModelError> {
+        v.parse::<f64>()
+            .ok()
+            .filter(|r| *r > 0.0 && r.is_finite())
+            .ok_or_else(|| {
+                ModelError::new(
+                    kind,
+                    "tool",
+                    s,
+                    format!("`{v}` is not a positive radius in mm"),
+                )
+            })
+    };
+    match s.split_once(':') {
+        None if s == "needle" => Ok(ToolShape::n1_needle()),
+        None if s == "platen" => Ok(ToolShape::Platen),
+        Some(("sphere", r)) => Ok(ToolShape::Sphere { radius: num(r)? }),
+        Some(("punch", r)) => {
+            let radius = num(r)?;
+            Ok(ToolShape::FlatPunch {
+                radius,
+                edge_radius: (0.1f64).min(0.5 * radius),
+            })
+        }
+        _ => Err(ModelError::new(
+            kind,
+            "tool",
+            s,
+            "expected needle, sphere:RADIUS, punch:RADIUS or platen",
+        )),
+    }
+}
+
+/// The model of a data set's test for a law (the legacy manifest form
+/// `law = "..."` and the commands' `--benchmark`): the analytic homogeneous
+/// test, analytic C1, or N1 with the BENCHMARKS.md needle (friction 0.8) on
+/// the coarse mesh, since every evaluation of a fit is a full FE run.
+pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
+    let law = law.to_string();
+    match test {
+        TestKind::Homogeneous(mode) => ModelSpec::Homogeneous(HomogeneousSpec {
+            law,
+            mode: mode.name().to_string(),
+        }),
+        TestKind::C1 => ModelSpec::C1(C1Spec { law }),
+        TestKind::N1 => ModelSpec::N1Needle(N1NeedleSpec {
+            law,
+            mesh: Some("coarse".into()),
+            ..Default::default()
+        }),
+    }
+}
+
+/// The base model of the gap diagnosis for a record of `test`: C1 analytic
+/// (lubricated platens), or N1 with a frictionless needle on the coarse mesh
+/// and a bonded base, so that `friction` and `boundary_condition` are
+/// effects to find.
+pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
+    let law = law.to_string();
+    match test {
+        TestKind::C1 => Ok(ModelSpec::C1(C1Spec { law })),
+        TestKind::N1 => Ok(ModelSpec::N1Needle(N1NeedleSpec {
+            law,
+            friction: Some(0.0),
+            mesh: Some("coarse".into()),
+            ..Default::default()
+        })),
+        TestKind::Homogeneous(_) => anyhow::bail!(
+            "the gap diagnosis supports C1 (analytic) and N1 (finite elements) force records"
+        ),
+    }
+}
+
+/// The default candidate effects of the gap diagnosis for a base model
+/// (`None`: every effect the model offers). N1: GAP.md's `friction` and
+/// `boundary_condition`; the N1 model also offers `material_form` and
+/// `zero_offset`, but on one force-depth curve friction and a stiffening law
+/// are confounded (docs/gap-diagnosis.md), so they are candidates on request only.
+pub fn default_effects(base: &ModelSpec) -> Option<Vec<Effect>> {
+    matches!(base, ModelSpec::N1Needle(_))
+        .then(|| vec![Effect::Friction, Effect::BoundaryCondition])
+}
+
+/// Effect names (GAP.md) parsed, the error naming the bad one.
+pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
+    names
+        .iter()
+        .map(|e| e.parse::<Effect>().map_err(|m| anyhow::anyhow!("{m}")))
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_spec_reads_from_its_own_toml_table() {
+        let s: ModelSpec = toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nmesh = 4\n").unwrap();
+        assert_eq!(
+            s,
+            ModelSpec::C1Fe(C1FeSpec {
+                law: "yeoh".into(),
+                mesh: Some("4".into()),
+                ..Default::default()
+            })
+        );
+        assert!(matches!(s.validate(), Ok(Model::C1Fe(m)) if m.elements == (76, 36)));
+        let e = toml::from_str::<ModelSpec>("[c1]\nlaw = \"yeoh\"\nmesh = 4\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("mesh"), "{e}");
+    }
+
+    #[test]
+    fn the_one_mesh_parser() {
+        for (s, level) in [("coarse", 1), ("medium", 2), ("fine", 3), ("12", 12)] {
+            assert_eq!(parse_mesh("n1_needle", Some(s)), Ok(level));
+        }
+        assert_eq!(parse_mesh("n1_needle", None), Ok(2));
+        for bad in ["0", "13", "-1", "1.5", "Coarse"] {
+            let e = parse_mesh("n1_needle", Some(bad)).unwrap_err();
+            assert_eq!((e.field, e.value.as_str()), ("mesh", bad));
+        }
+    }
+
+    #[test]
+    fn bad_values_name_their_field() {
+        let n1 = |f: fn(&mut N1NeedleSpec)| {
+            let mut s = N1NeedleSpec {
+                law: "neo-hookean".into(),
+                ..Default::default()
+            };
+            f(&mut s);
+            ModelSpec::N1Needle(s).validate().unwrap_err().to_string()
+        };
+        assert!(n1(|s| s.law = "neo".into()).starts_with("n1_needle.law = \"neo\""));
+        assert!(n1(|s| s.friction = Some(-0.1)).starts_with("n1_needle.friction"));
+        assert!(n1(|s| s.bulk = Some("0".into())).starts_with("n1_needle.bulk"));
+        assert!(n1(|s| s.base = Some("glued".into())).starts_with("n1_needle.base"));
+        assert!(n1(|s| s.tool = Some("sphere:-1".into())).starts_with("n1_needle.tool"));
+    }
+}
