@@ -1,0 +1,324 @@
+//! The assembled global tangent (bodies and contact, stick and slip, every
+//! kinematics) against finite differences of the global residual, and the
+//! exactness of a rollback.
+
+use std::sync::Arc;
+
+use palpate_material::Volumetric;
+
+use super::*;
+use crate::body::{RegionMaterial, SolidBody};
+use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::dofs::Dirichlet;
+use crate::kernel::{kernel_for, PressureSpace};
+use crate::kinematics::Kinematics;
+use crate::material::NeoHookeanIso;
+use crate::mesh::{CellType, Grading};
+use crate::motion::ToolMotion;
+use crate::stepper::{self, LoadPath};
+use crate::surface::{Profile2d, Revolution3d, RigidSurface, Wheel2d};
+use crate::tool::ToolShape;
+
+struct Case {
+    kin: Kinematics,
+    cell: CellType,
+    exact: bool,
+    friction: f64,
+}
+
+/// A 4 x 2 block (2D) or 2 x 2 x 2 box (3D), bottom fixed, a rigid tool
+/// pressed into the top by channel 0 and moved sideways by channel 1.
+fn system(c: &Case) -> System {
+    let dim = c.kin.dim();
+    let mut mesh = if dim == 2 {
+        Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2))
+            .unwrap()
+    } else {
+        Mesh::graded_box(
+            2.0,
+            2.0,
+            2.0,
+            Grading::uniform(2.0, 2),
+            Grading::uniform(2.0, 2),
+            Grading::uniform(2.0, 2),
+        )
+        .unwrap()
+    };
+    if c.cell == CellType::Quad9 {
+        mesh = mesh.to_quadratic().unwrap();
+    }
+    let pressure = if !c.kin.needs_pressure() {
+        PressureSpace::None
+    } else if c.cell == CellType::Quad9 {
+        PressureSpace::P1
+    } else {
+        PressureSpace::P0
+    };
+    let mut body = SolidBody::new(
+        "body",
+        &mesh,
+        &["body"],
+        kernel_for(c.cell, c.kin, pressure).unwrap(),
+        c.exact,
+    )
+    .unwrap();
+    let mu = 1.0;
+    body.set_material(
+        "body",
+        RegionMaterial {
+            material: Arc::new(NeoHookeanIso { c10: 0.5 * mu }),
+            volumetric: if c.exact {
+                Volumetric::Incompressible
+            } else {
+                Volumetric::D1(0.1)
+            },
+        },
+    )
+    .unwrap();
+    let (surface, origin, bcs): (Box<dyn RigidSurface>, [f64; 3], Vec<Dirichlet>) = match c.kin {
+        Kinematics::ThreeD => (
+            Box::new(Revolution3d(ToolShape::Sphere { radius: 1.5 })),
+            [0.3, 0.4, 2.0],
+            (0..3).map(|k| Dirichlet::fixed("bottom", k)).collect(),
+        ),
+        Kinematics::Axisymmetric => (
+            Box::new(Profile2d(ToolShape::n1_needle())),
+            [0.0, 2.0, 0.0],
+            vec![
+                Dirichlet::fixed("axis", 0),
+                Dirichlet::fixed("bottom", 0),
+                Dirichlet::fixed("bottom", 1),
+            ],
+        ),
+        _ => (
+            Box::new(Wheel2d { radius: 1.5 }),
+            [1.7, 2.0, 0.0],
+            vec![Dirichlet::fixed("bottom", 0), Dirichlet::fixed("bottom", 1)],
+        ),
+    };
+    let sideways = if c.kin == Kinematics::Axisymmetric {
+        // an axisymmetric tool can only move along the axis: rotate it instead
+        [0.0, 0.0, 0.0]
+    } else {
+        [1.0, 0.0, 0.0]
+    };
+    let mut translation = vec![(0, [0.0, 0.0, -1.0])];
+    if dim == 2 {
+        translation[0].1 = [0.0, -1.0, 0.0];
+    }
+    if sideways != [0.0; 3] {
+        translation.push((1, sideways));
+    }
+    let motion = ToolMotion::translating(origin, translation);
+    let contact = RigidContact::new(
+        "tool",
+        surface,
+        motion,
+        &mesh,
+        "top",
+        c.kin,
+        ContactOptions {
+            friction: c.friction,
+            penalty_normal: 20.0,
+            penalty_tangent: 20.0,
+            penetration_tol: 1e-6,
+            points: ContactPoints::EdgeGauss,
+        },
+        2,
+    )
+    .unwrap();
+    let mut sys = System::new(mesh, dim, vec![Box::new(body), Box::new(contact)], &bcs, 2).unwrap();
+    sys.force_floor = 1e-6;
+    sys
+}
+
+fn pressed(sys: &mut System, sideways: f64) {
+    let path = LoadPath {
+        tau: vec![0.1, 0.2, 0.2 + sideways],
+        values: vec![vec![0.1, 0.0], vec![0.2, 0.0], vec![0.2, sideways]],
+        time: vec![0.0; 3],
+    };
+    let opts = SolverOptions {
+        max_step: 0.05,
+        first_step: 0.05,
+        ..SolverOptions::default()
+    };
+    let mut observe = |s: &System| {
+        vec![s.contributions[1]
+            .tool_force([0.0, -1.0, 0.0])
+            .unwrap_or(0.0)]
+    };
+    stepper::run(sys, &path, &opts, &mut observe, None).unwrap();
+}
+
+/// Dense global tangent from the sparse values.
+fn dense(sys: &System) -> Vec<Vec<f64>> {
+    let n = sys.dofs.equations;
+    let mut k = vec![vec![0.0; n]; n];
+    for c in 0..n {
+        let (first, rows) = sys.pattern.column(c);
+        for (i, &r) in rows.iter().enumerate() {
+            k[r][c] = sys.values[first + i];
+        }
+    }
+    k
+}
+
+#[test]
+fn global_tangent_equals_finite_differences_of_the_global_residual() {
+    let cases = [
+        Case {
+            kin: Kinematics::Axisymmetric,
+            cell: CellType::Quad4,
+            exact: true,
+            friction: 0.3,
+        },
+        Case {
+            kin: Kinematics::Axisymmetric,
+            cell: CellType::Quad9,
+            exact: false,
+            friction: 50.0,
+        },
+        Case {
+            kin: Kinematics::PlaneStrain { thickness: 2.0 },
+            cell: CellType::Quad9,
+            exact: true,
+            friction: 0.2,
+        },
+        Case {
+            kin: Kinematics::PlaneStrain { thickness: 2.0 },
+            cell: CellType::Quad4,
+            exact: false,
+            friction: 50.0,
+        },
+        Case {
+            kin: Kinematics::PlaneStress { thickness: 0.5 },
+            cell: CellType::Quad4,
+            exact: true,
+            friction: 0.2,
+        },
+        Case {
+            kin: Kinematics::PlaneStress { thickness: 0.5 },
+            cell: CellType::Quad9,
+            exact: false,
+            friction: 0.0,
+        },
+        Case {
+            kin: Kinematics::ThreeD,
+            cell: CellType::Hex8,
+            exact: true,
+            friction: 0.0,
+        },
+        Case {
+            kin: Kinematics::ThreeD,
+            cell: CellType::Hex8,
+            exact: false,
+            friction: 0.0,
+        },
+    ];
+    for c in &cases {
+        let mut sys = system(c);
+        pressed(&mut sys, 0.1);
+        let tool = sys.part::<RigidContact>(1).unwrap();
+        assert!(tool.active() > 0, "{:?} {:?}: no contact", c.kin, c.cell);
+        // an unconverged state off the path: perturb every unknown
+        let target = Target {
+            channels: vec![0.23, 0.12],
+            time: 0.0,
+            dt: 0.0,
+        };
+        sys.prescribe(&target);
+        for (k, u) in sys.u.iter_mut().enumerate() {
+            if sys.dofs.equation(k) != NONE {
+                *u += 1e-3 * ((k as f64) * 0.7).sin();
+            }
+        }
+        sys.assemble(&target, true).unwrap();
+        let k = dense(&sys);
+        let scale = k.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+        let h = 1e-7;
+        let n = sys.dofs.equations;
+        let free: Vec<usize> = (0..sys.u.len())
+            .filter(|&s| sys.dofs.equation(s) != NONE)
+            .collect();
+        let mut worst = 0.0f64;
+        for &s in &free {
+            let e = sys.dofs.equation(s);
+            let u0 = sys.u[s];
+            sys.u[s] = u0 + h;
+            sys.assemble(&target, false).unwrap();
+            let rp = sys.residual.clone();
+            sys.u[s] = u0 - h;
+            sys.assemble(&target, false).unwrap();
+            let rm = sys.residual.clone();
+            sys.u[s] = u0;
+            for r in 0..n {
+                let fd = (rp[r] - rm[r]) / (2.0 * h);
+                worst = worst.max((fd - k[r][e]).abs() / scale);
+            }
+        }
+        assert!(
+            worst < 1e-6,
+            "{:?} {:?} exact {} friction {}: worst {worst:.2e}",
+            c.kin,
+            c.cell,
+            c.exact,
+            c.friction
+        );
+    }
+}
+
+/// A failed attempt (with augmentations changing the contact multipliers,
+/// then an assembly failure) followed by a rollback leaves the system
+/// exactly where a run that never failed is: the retried increment gives
+/// bit-identical state and forces.
+#[test]
+fn rollback_restores_contact_history_exactly() {
+    let c = Case {
+        kin: Kinematics::Axisymmetric,
+        cell: CellType::Quad4,
+        exact: true,
+        friction: 0.3,
+    };
+    let opts = SolverOptions {
+        max_augmentations: 5,
+        ..SolverOptions::default()
+    };
+    let mut a = system(&c);
+    pressed(&mut a, 0.0);
+    let next = Target {
+        channels: vec![0.3, 0.0],
+        time: 0.0,
+        dt: 0.0,
+    };
+    a.solve_increment(&next, &opts).unwrap();
+    a.commit(&next);
+    // b: an attempt at a larger step that augments the multipliers and
+    // then fails (the first failure point after an augmentation)
+    let big = Target {
+        channels: vec![0.45, 0.0],
+        time: 0.0,
+        dt: 0.0,
+    };
+    let mut b = None;
+    for n in (4..400).step_by(4) {
+        let mut s = system(&c);
+        pressed(&mut s, 0.0);
+        let aug0 = s.stats.augmentations;
+        s.fail_after = Some(n);
+        let u_c = s.u.clone();
+        if s.solve_increment(&big, &opts).is_err() && s.stats.augmentations > aug0 {
+            s.u.clone_from(&u_c);
+            b = Some(s);
+            break;
+        }
+    }
+    let mut b = b.expect("an attempt that augments and then fails");
+    b.rollback();
+    b.solve_increment(&next, &opts).unwrap();
+    b.commit(&next);
+    assert_eq!(a.u, b.u, "state after the retry");
+    let fa = a.contributions[1].tool_force([0.0, -1.0, 0.0]).unwrap();
+    let fb = b.contributions[1].tool_force([0.0, -1.0, 0.0]).unwrap();
+    assert_eq!(fa.to_bits(), fb.to_bits());
+}
