@@ -8,6 +8,7 @@ use thiserror::Error;
 /// Forward failures carry the data set and the physical parameter vector of
 /// the evaluation that failed, so a caller can reproduce it.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum InverseError {
     /// A forward evaluation failed at a point the estimator could not avoid
     /// (the starting point, or a finite-difference step).

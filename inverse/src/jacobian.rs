@@ -4,14 +4,16 @@
 
 use crate::{InverseError, Objective};
 use nalgebra::DMatrix;
+use palpate_core::fd::{fd_column, FdRule, FdScheme};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 /// Finite-difference settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct FdOptions {
-    /// Step `h_j = relative_step * max(|z_j|, 1)` in the unbounded space.
-    /// Default `eps^(1/3) ~ 6e-6`, the optimum for central differences.
+    /// Step `h_j = relative_step * max(|z_j|, 1)` in the unbounded space
+    /// (the rule of `palpate_core::fd`). Default `eps^(1/3) ~ 6e-6`, the
+    /// optimum for central differences.
     pub relative_step: f64,
     /// Central (2 evaluations per column, error O(h^2)) or forward
     /// (1 per column, error O(h)) differences.
@@ -25,7 +27,7 @@ pub struct FdOptions {
 impl Default for FdOptions {
     fn default() -> Self {
         FdOptions {
-            relative_step: f64::EPSILON.cbrt(),
+            relative_step: FdRule::default().relative_step,
             central: true,
             parallel: true,
         }
@@ -74,42 +76,28 @@ pub fn jacobian_unbounded(
             Some(owned_r0.as_slice())
         }
     };
-    // One column and the evaluations it cost. When one side of a central
-    // difference fails (e.g. the step leaves the law's admissible domain),
-    // the other side is used as a one-sided difference.
+    // One column and the evaluations it cost, by palpate-core's finite
+    // differences (step `relative_step * max(|z_j|, 1)`, no bounds in the
+    // unbounded space). When one side of a central difference fails (e.g. the
+    // step leaves the law's admissible domain), the other side is used as a
+    // one-sided difference.
+    let rule = FdRule {
+        relative_step: options.relative_step,
+        scheme: if options.central {
+            FdScheme::Central
+        } else {
+            FdScheme::Forward
+        },
+    };
     let column =
         |evs: &mut crate::Evaluators<'_>, j: usize| -> Result<(Vec<f64>, usize), InverseError> {
-            let h = options.relative_step * z[j].abs().max(1.0);
-            let mut zp = z.to_vec();
-            zp[j] += h;
-            let mut zm = z.to_vec();
-            zm[j] -= h;
-            let diff = |a: &[f64], b: &[f64], span: f64| {
-                a.iter()
-                    .zip(b)
-                    .map(|(x, y)| (x - y) / span)
-                    .collect::<Vec<f64>>()
+            let mut f = |zz: &[f64], out: &mut [f64]| -> Result<(), InverseError> {
+                out.copy_from_slice(&objective.residuals(evs, zz, "finite-difference step")?);
+                Ok(())
             };
-            let rp = objective.residuals(evs, &zp, "finite-difference step");
-            if let (Some(r0), Ok(rp)) = (r0, &rp) {
-                return Ok((diff(rp, r0, zp[j] - z[j]), 1));
-            }
-            let rm = objective.residuals(evs, &zm, "finite-difference step");
-            match (rp, rm) {
-                (Ok(rp), Ok(rm)) => Ok((diff(&rp, &rm, zp[j] - zm[j]), 2)),
-                (Ok(rp), Err(_)) => {
-                    let base = objective.residuals(evs, z, "finite-difference base point")?;
-                    Ok((diff(&rp, &base, zp[j] - z[j]), 3))
-                }
-                (Err(_), Ok(rm)) => {
-                    let base = match r0 {
-                        Some(r0) => r0.to_vec(),
-                        None => objective.residuals(evs, z, "finite-difference base point")?,
-                    };
-                    Ok((diff(&base, &rm, z[j] - zm[j]), 3))
-                }
-                (Err(e), Err(_)) => Err(e),
-            }
+            let mut col = vec![0.0; m];
+            let n = fd_column(&mut f, z, j, rule.unbounded_step(z[j]), r0, &mut col)?;
+            Ok((col, n))
         };
     let columns: Vec<(Vec<f64>, usize)> = if options.parallel {
         (0..q)

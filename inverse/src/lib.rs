@@ -10,11 +10,28 @@
 //!
 //! Depends on `palpate-core` only: estimators see `dyn ForwardModel`.
 //!
-//! ```ignore
-//! let set = DataSet::new("uniaxial", model, loading, observed);
+//! A Levenberg-Marquardt fit of C1 (closed-form neo-Hookean compression)
+//! to noise-free data recovers the modulus that made them:
+//!
+//! ```
+//! use palpate_analytic::C1Compression;
+//! use palpate_core::{Drive, ForwardModel, Loading};
+//! use palpate_inverse::{fit, DataSet, FitOptions, Objective, ResidualKind};
+//! use palpate_material::Law;
+//! use std::sync::Arc;
+//!
+//! let model = Arc::new(C1Compression::new(Law::NeoHookean));
+//! let loading = Loading::quasi_static(
+//!     Drive::DisplacementMm,
+//!     (1..=20).map(|i| 0.1 * i as f64).collect(),
+//! );
+//! let observed = model.predict(&[0.025], &loading)?;
+//! let set = DataSet::new("c1", model, loading, observed);
 //! let objective = Objective::new(vec![set], ResidualKind::Absolute, &[])?;
 //! let report = fit(&objective, &FitOptions::default())?;
-//! println!("{}", serde_json::to_string_pretty(&report)?);
+//! assert!(report.converged);
+//! assert!((report.parameters[0].value - 0.025).abs() < 1e-8);
+//! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
 pub mod boundary_polish;

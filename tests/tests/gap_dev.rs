@@ -8,8 +8,9 @@
 //! * a confounded case (a series spring against relaxation on one ramp), reported as such;
 //! * the JSON contract of GAP.md and errors instead of panics.
 
-use palpate_analytic::{C1Compression, Compressible, ToolCompliance, Viscoelastic, ZeroOffset};
+use palpate_analytic::{C1Compression, Compressible};
 use palpate_core::{Drive, ForwardModel, Loading, Table};
+use palpate_enrich::{ToolCompliance, Viscoelastic, ZeroOffset};
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapError, GapOptions, GapReport, RankedEffect};
 use std::path::{Path, PathBuf};

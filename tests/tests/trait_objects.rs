@@ -4,6 +4,7 @@
 //! bit-identical predictions to serial evaluation.
 
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
+use palpate_core::enrichable::{effects_of, embed, enrich};
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_material::Law;
 use rayon::prelude::*;
@@ -63,11 +64,12 @@ fn every_declared_enrichment_is_off_at_its_embedding() {
     for (m, loading) in analytic_models() {
         let theta = m.space().initial();
         let base = m.predict(&theta, &loading).unwrap();
-        for effect in m.effects() {
-            let enriched = m
-                .enrich(effect)
+        // every analytic model has the capability, reached through the trait object
+        assert!(m.as_enrichable().is_some(), "{}", m.name());
+        for effect in effects_of(m.as_ref()) {
+            let enriched = enrich(m.as_ref(), effect)
                 .unwrap_or_else(|e| panic!("{} + {effect}: {e}", m.name()));
-            let off = enriched.embed(&theta);
+            let off = embed(enriched.as_ref(), &theta);
             assert_eq!(off.len(), enriched.space().len(), "{} + {effect}", m.name());
             let f = enriched
                 .predict(&off, &loading)

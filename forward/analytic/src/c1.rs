@@ -1,11 +1,13 @@
 //! Benchmark C1: homogeneous compression of a cylinder between lubricated platens.
 
 use crate::convert::{check_law_params, check_loading, law_space};
-use crate::homogeneous::not_applicable;
-use crate::{Compressible, MaterialForm};
+use crate::Compressible;
+use palpate_core::enrichable::not_applicable;
 use palpate_core::{
-    Drive, Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
+    ParamSpace,
 };
+use palpate_enrich::{richer_law, wrap, MaterialForm};
 use palpate_material::{homogeneous, Law};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -140,11 +142,17 @@ impl ForwardModel for C1Compression {
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(C1Evaluator { model: self })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for C1Compression {
     /// material_form (when a richer law exists), viscoelasticity,
     /// zero_offset, compressibility, tool_compliance.
     fn effects(&self) -> Vec<Effect> {
         let mut e = Vec::new();
-        if crate::richer_law(&self.law).is_some() {
+        if richer_law(&self.law).is_some() {
             e.push(Effect::MaterialForm);
         }
         e.extend([
@@ -158,8 +166,8 @@ impl ForwardModel for C1Compression {
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
             Effect::MaterialForm => {
-                let richer = crate::richer_law(&self.law)
-                    .ok_or_else(|| not_applicable(effect, &self.name()))?;
+                let richer =
+                    richer_law(&self.law).ok_or_else(|| not_applicable(effect, &self.name()))?;
                 Ok(Box::new(MaterialForm::new(
                     Box::new(C1Compression::with_geometry(richer.law, self.geometry)),
                     richer.embed_law_params,
@@ -172,7 +180,7 @@ impl ForwardModel for C1Compression {
                 self.geometry,
             ))),
             Effect::Viscoelasticity | Effect::ZeroOffset | Effect::ToolCompliance => {
-                crate::wrap::wrap(effect, Arc::new(self.clone()))
+                wrap(effect, Arc::new(self.clone()))
             }
             _ => Err(not_applicable(effect, &self.name())),
         }

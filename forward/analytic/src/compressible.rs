@@ -2,12 +2,12 @@
 
 use crate::c1::{c1_area_mm2, C1Geometry};
 use crate::convert::{check_law_params, check_loading, law_space, split};
-use crate::homogeneous::not_applicable;
-use crate::wrap::{wrap, WRAPPER_EFFECTS};
+use palpate_core::enrichable::not_applicable;
 use palpate_core::{
-    Drive, Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
-    ParamSpec,
+    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
+    ParamSpace, ParamSpec,
 };
+use palpate_enrich::{wrap, WRAPPER_EFFECTS};
 use palpate_material::{homogeneous, Law};
 use std::sync::Arc;
 
@@ -196,6 +196,12 @@ impl ForwardModel for Compressible {
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(CompressibleEvaluator { model: self })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for Compressible {
     fn effects(&self) -> Vec<Effect> {
         WRAPPER_EFFECTS.to_vec()
     }

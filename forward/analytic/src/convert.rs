@@ -1,18 +1,9 @@
 //! Small shared helpers: material parameters as a [`ParamSpace`], checks of
 //! parameters and loading histories that return [`ForwardError`]s.
 
-use palpate_core::{Drive, ForwardError, Loading, ParamSpace, ParamSpec};
+use palpate_core::{Drive, ForwardError, Loading, ParamSpace};
+pub(crate) use palpate_enrich::law_space;
 use palpate_material::Law;
-
-/// The law's parameters (names, units, bounds, starting values) as a space.
-pub(crate) fn law_space(law: &Law) -> ParamSpace {
-    ParamSpace::new(
-        law.params()
-            .into_iter()
-            .map(|m| ParamSpec::new(m.name, m.unit, m.lower, m.upper, m.initial))
-            .collect(),
-    )
-}
 
 /// Bounds of the space, then the law's own sign rules.
 pub(crate) fn check_law_params(

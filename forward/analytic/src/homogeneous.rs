@@ -1,10 +1,13 @@
 //! Homogeneous uniaxial, equibiaxial and planar tests of an incompressible law.
 
 use crate::convert::{check_law_params, check_loading, law_space};
-use crate::{MaterialForm, Mode, Viscoelastic};
+use crate::Mode;
+use palpate_core::enrichable::not_applicable;
 use palpate_core::{
-    Drive, Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
+    ParamSpace,
 };
+use palpate_enrich::{richer_law, MaterialForm, Viscoelastic, DEFAULT_PRONY_TERMS};
 use palpate_material::{homogeneous, Law};
 
 /// Nominal (first Piola-Kirchhoff) stress along the loading direction of a
@@ -90,9 +93,15 @@ impl ForwardModel for Homogeneous {
     fn evaluator(&self) -> Box<dyn Evaluator + '_> {
         Box::new(HomogeneousEvaluator { model: self })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for Homogeneous {
     fn effects(&self) -> Vec<Effect> {
         let mut e = Vec::new();
-        if crate::richer_law(&self.law).is_some() {
+        if richer_law(&self.law).is_some() {
             e.push(Effect::MaterialForm);
         }
         e.push(Effect::Viscoelasticity);
@@ -101,8 +110,8 @@ impl ForwardModel for Homogeneous {
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
             Effect::MaterialForm => {
-                let richer = crate::richer_law(&self.law)
-                    .ok_or_else(|| not_applicable(effect, &self.name()))?;
+                let richer =
+                    richer_law(&self.law).ok_or_else(|| not_applicable(effect, &self.name()))?;
                 Ok(Box::new(MaterialForm::new(
                     Box::new(Homogeneous::new(richer.law, self.mode)),
                     richer.embed_law_params,
@@ -110,15 +119,11 @@ impl ForwardModel for Homogeneous {
                     richer.space,
                 )))
             }
-            Effect::Viscoelasticity => Ok(Box::new(Viscoelastic::new(Box::new(self.clone()), 2))),
+            Effect::Viscoelasticity => Ok(Box::new(Viscoelastic::new(
+                Box::new(self.clone()),
+                DEFAULT_PRONY_TERMS,
+            ))),
             _ => Err(not_applicable(effect, &self.name())),
         }
-    }
-}
-
-pub(crate) fn not_applicable(effect: Effect, name: &str) -> ForwardError {
-    ForwardError::InvalidConfig {
-        field: "effect".into(),
-        reason: format!("`{effect}` does not apply to {name}"),
     }
 }

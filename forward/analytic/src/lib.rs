@@ -1,37 +1,45 @@
 //! # palpate-analytic
 //!
-//! Closed-form (homogeneous-deformation) forward models and the enrichments
-//! that the sim-to-real gap diagnosis switches on (`GAP.md`):
+//! Closed-form (homogeneous-deformation) forward models, and the
+//! enrichments of C1 that change the model itself (`GAP.md`):
 //!
 //! * [`Homogeneous`] — uniaxial, equibiaxial and planar (pure-shear) nominal
 //!   stress of any incompressible law, driven by the principal stretch.
 //! * [`C1Compression`] — benchmark C1 (38 x 9 mm cylinder between lubricated
 //!   platens): homogeneous uniaxial compression, force against platen travel.
-//! * [`Viscoelastic`] — quasi-linear viscoelasticity (Fung) with a Prony
-//!   series wrapped around any model, by the exact recursive convolution.
-//! * [`ZeroOffset`], [`ToolCompliance`], [`Compressible`] and
-//!   [`MaterialForm`] — the other enrichments of C1, each zero ("off") at a
-//!   reachable parameter value, so a score test can differentiate there.
+//! * [`Compressible`] — C1 with a finite bulk modulus (`compressibility`),
+//!   zero ("off") at D1 = 0.
 //!
+//! The enrichments that wrap any model (zero offset, tool compliance,
+//! quasi-linear viscoelasticity, the richer law) live in `palpate-enrich`.
 //! Every model implements palpate-core's [`ForwardModel`](palpate_core::ForwardModel)
-//! and declares the effects it can be enriched with.
+//! and [`Enrichable`](palpate_core::Enrichable).
+//!
+//! ```
+//! use palpate_analytic::C1Compression;
+//! use palpate_core::{Drive, ForwardModel, Loading};
+//! use palpate_material::Law;
+//!
+//! // C1 of a neo-Hookean with C10 = 0.03 MPa: F = -2 C10 (l - l^-2) A, l = 1 - d / 9 mm.
+//! let model = C1Compression::new(Law::NeoHookean);
+//! let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.0, 0.9]);
+//! let force = model.predict(&[0.03], &loading)?;
+//! let l: f64 = 0.9;
+//! let area = std::f64::consts::PI * 0.25 * 38.0 * 38.0;
+//! assert_eq!(force[0], 0.0);
+//! assert!((force[1] - (-2.0 * 0.03 * (l - l.powi(-2)) * area)).abs() < 1e-9 * force[1].abs());
+//! // A parameter outside its bounds is an error, not a clamp.
+//! assert!(model.predict(&[-1.0], &loading).is_err());
+//! # Ok::<(), palpate_core::ForwardError>(())
+//! ```
 
 mod c1;
 mod compressible;
 mod convert;
 mod homogeneous;
-mod material_form;
 mod mode;
-mod tool_compliance;
-mod viscoelastic;
-mod wrap;
-mod zero_offset;
 
 pub use c1::{c1_area_mm2, C1Compression, C1Geometry};
 pub use compressible::{lateral_stress_free, Compressible};
 pub use homogeneous::Homogeneous;
-pub use material_form::{richer_law, MaterialForm, RicherLaw};
 pub use mode::Mode;
-pub use tool_compliance::ToolCompliance;
-pub use viscoelastic::{qlv_convolve, Viscoelastic};
-pub use zero_offset::ZeroOffset;

@@ -27,6 +27,7 @@ impl Column {
 
 /// Why a data file could not be read. Every variant names the file.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum DataError {
     #[error("{file}: cannot read: {source}")]
     Io {

@@ -7,6 +7,7 @@ use thiserror::Error;
 /// `NotConverged` carries the samples that did converge, so a caller keeps the
 /// part of the curve that was computed (standard 8 of STYLE.md).
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum ForwardError {
     /// A parameter value is outside what the model accepts.
     #[error("parameter `{name}` = {value}: {reason}")]

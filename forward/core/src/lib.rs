@@ -8,7 +8,9 @@
 //! * [`ParamSpace`] — named physical parameters with bounds and the transform
 //!   to the unbounded space that estimators and samplers move in.
 //! * [`Loading`] — the loading history (time and drive samples).
-//! * [`Effect`] — the canonical names of unmodelled effects (see `GAP.md`).
+//! * [`Effect`] — the canonical names of unmodelled effects (see `GAP.md`);
+//!   [`Enrichable`] — the capability of a model that can add them.
+//! * [`fd`] — finite-difference Jacobians (one step rule for every crate).
 //! * [`data`] — reading the project's CSV data files with errors naming file,
 //!   line and column.
 //!
@@ -17,13 +19,16 @@
 
 pub mod data;
 pub mod effect;
+pub mod enrichable;
 pub mod error;
+pub mod fd;
 pub mod loading;
 pub mod model;
 pub mod param;
 
 pub use data::{Column, DataError, Table, TextTable};
 pub use effect::Effect;
+pub use enrichable::Enrichable;
 pub use error::ForwardError;
 pub use loading::{Drive, Loading, Observable};
 pub use model::{Evaluator, ForwardModel, ModelExt};

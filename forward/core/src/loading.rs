@@ -49,6 +49,26 @@ impl Drive {
 /// dependent, the time of each sample (s, non-decreasing).
 ///
 /// Models treat the history as piecewise linear between samples.
+///
+/// ```
+/// use palpate_core::{Drive, Loading};
+///
+/// // A ramp to 2 mm in 4 s, then a hold.
+/// let ramp = Loading::timed(
+///     Drive::DisplacementMm,
+///     vec![0.0, 2.0, 4.0, 10.0],
+///     vec![0.0, 1.0, 2.0, 2.0],
+/// );
+/// assert_eq!(ramp.len(), 4);
+/// assert!(ramp.validate().is_ok());
+/// // A zero offset shifts the drive and keeps the times.
+/// let shifted = ramp.with_drive(ramp.drive.iter().map(|d| (d - 0.5f64).max(0.0)).collect());
+/// assert_eq!(shifted.drive, [0.0, 0.5, 1.5, 1.5]);
+/// assert_eq!(shifted.time, ramp.time);
+/// // Time running backwards is an error naming the sample.
+/// let bad = Loading::timed(Drive::DisplacementMm, vec![0.0, 2.0, 1.0], vec![0.0, 1.0, 2.0]);
+/// assert!(bad.validate().is_err());
+/// ```
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Loading {
     pub drive_kind: Drive,

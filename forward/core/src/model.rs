@@ -5,7 +5,8 @@
 //! per-thread [`Evaluator`] that owns scratch space, factorisations and
 //! history variables (STYLE.md 2). Estimators see nothing else.
 
-use crate::{Effect, ForwardError, Loading, Observable, ParamSpace};
+use crate::fd::{fd_jacobian, FdRule};
+use crate::{Enrichable, ForwardError, Loading, Observable, ParamSpace};
 
 /// A per-thread evaluator. It may keep state between calls (a symbolic
 /// factorisation, a mesh) but every call starts the loading history afresh,
@@ -35,37 +36,11 @@ pub trait ForwardModel: Send + Sync {
     /// A fresh evaluator for one thread.
     fn evaluator(&self) -> Box<dyn Evaluator + '_>;
 
-    /// Effects (GAP.md) for which [`ForwardModel::enrich`] gives an enriched
-    /// model. Default: none.
-    fn effects(&self) -> Vec<Effect> {
-        Vec::new()
-    }
-
-    /// The model with `effect` added. The enriched model's parameters are this
-    /// model's parameters followed by (or, for `material_form`, replacing the
-    /// law's with) the effect's own; [`ForwardModel::embed`] maps a parameter
-    /// vector of this model to the enriched model's "effect off" point.
-    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        Err(ForwardError::InvalidConfig {
-            field: "effect".into(),
-            reason: format!("`{effect}` does not apply to {}", self.name()),
-        })
-    }
-
-    /// For an enriched model: the parameter vector that reproduces the base
-    /// model with parameters `base_theta` (the effect switched off).
-    /// Default: `base_theta` followed by the initial values of the remaining
-    /// parameters.
-    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
-        let mut v = base_theta.to_vec();
-        v.extend(
-            self.space()
-                .params
-                .iter()
-                .skip(base_theta.len())
-                .map(|p| p.initial),
-        );
-        v
+    /// The [`Enrichable`] capability (effects for the gap diagnosis), when
+    /// the model has it. Default: `None`; a model that implements
+    /// [`Enrichable`] returns `Some(self)`.
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        None
     }
 
     /// Whether one prediction is expensive (a nonlinear finite-element
@@ -74,6 +49,11 @@ pub trait ForwardModel: Send + Sync {
     /// a linearised refit instead of one refit per left-out block. A
     /// property of the model, not a timing, so that results do not depend on
     /// the machine. Default: `false`.
+    ///
+    /// This stays on the base trait (unlike [`Enrichable`]) because it is a
+    /// hint every estimator may read, about any model, and wrappers must
+    /// forward it: it is a property of cost, not an optional capability with
+    /// methods of its own.
     fn expensive(&self) -> bool {
         false
     }
@@ -88,37 +68,27 @@ pub trait ForwardModel: Send + Sync {
 
 /// Conveniences on any forward model.
 pub trait ModelExt: ForwardModel {
-    /// Finite-difference sensitivities d prediction / d theta (central
-    /// differences with a relative step), column-major: `jac[j][i]` is
-    /// d out_i / d theta_j. Steps stay inside the bounds (one-sided there).
-    fn fd_jacobian(&self, theta: &[f64], loading: &Loading) -> Result<Vec<Vec<f64>>, ForwardError> {
+    /// Finite-difference sensitivities d prediction / d theta by
+    /// [`crate::fd`] with `rule` (steps relative to
+    /// [`crate::fd::param_scale`], kept inside the bounds, one-sided there),
+    /// column-major: `jac[j][i]` is d out_i / d theta_j.
+    fn fd_jacobian(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+        rule: &FdRule,
+    ) -> Result<Vec<Vec<f64>>, ForwardError> {
+        self.space().check(theta)?;
         let mut ev = self.evaluator();
-        let n = loading.len();
-        let mut plus = vec![0.0; n];
-        let mut minus = vec![0.0; n];
-        let mut cols = Vec::with_capacity(theta.len());
-        for (j, spec) in self.space().params.iter().enumerate() {
-            let h = 1e-6 * theta[j].abs().max(1e-3 * spec.initial.abs()).max(1e-12);
-            let mut tp = theta.to_vec();
-            let mut tm = theta.to_vec();
-            let (up, down) = (theta[j] + h <= spec.upper, theta[j] - h >= spec.lower);
-            if up {
-                tp[j] += h;
-            }
-            if down {
-                tm[j] -= h;
-            }
-            ev.predict_into(&tp, loading, &mut plus)?;
-            ev.predict_into(&tm, loading, &mut minus)?;
-            let span = tp[j] - tm[j];
-            cols.push(
-                plus.iter()
-                    .zip(&minus)
-                    .map(|(a, b)| (a - b) / span)
-                    .collect(),
-            );
-        }
-        Ok(cols)
+        let steps: Vec<_> = self
+            .space()
+            .params
+            .iter()
+            .zip(theta)
+            .map(|(spec, &x)| rule.param_step(spec, x))
+            .collect();
+        let mut f = |t: &[f64], out: &mut [f64]| ev.predict_into(t, loading, out);
+        Ok(fd_jacobian(&mut f, theta, &steps, None, loading.len())?.0)
     }
 }
 

@@ -121,6 +121,25 @@ impl ParamSpec {
 }
 
 /// An ordered list of named parameters.
+///
+/// ```
+/// use palpate_core::{ParamSpace, ParamSpec, Transform};
+///
+/// let space = ParamSpace::new(vec![
+///     ParamSpec::new("C10", "MPa", 0.0, f64::INFINITY, 0.1),
+///     ParamSpec::new("g1", "1", 0.0, 1.0, 0.5),
+/// ]);
+/// assert_eq!(space.names(), ["C10", "g1"]);
+/// assert_eq!(space.params[0].transform(), Transform::LogShift);
+/// // Estimators move in the unbounded space: C10 = exp(z0), g1 = logistic(z1).
+/// let z = space.to_unbounded(&[1.0, 0.5]);
+/// assert_eq!(z, [0.0, 0.0]);
+/// assert_eq!(space.from_unbounded(&[0.0, 0.0]), [1.0, 0.5]);
+/// // Checks name the first offender.
+/// let err = space.check(&[0.1, 1.5]).unwrap_err();
+/// assert!(err.to_string().contains("g1"), "{err}");
+/// assert!(space.check(&[0.1]).is_err());
+/// ```
 #[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
 pub struct ParamSpace {
     pub params: Vec<ParamSpec>,

@@ -5,6 +5,7 @@ use thiserror::Error;
 /// Why a finite element operation failed. Converted to
 /// [`palpate_core::ForwardError`] at the forward-model boundary.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum FeError {
     /// A mesh description is unusable.
     #[error("mesh `{field}`: {reason}")]

@@ -15,14 +15,15 @@
 //!   whose stiffness spans many decades, badly conditioned near "bonded";
 //!   the switch answers the same question.)
 //! * `material_form` — the next richer law (neo-Hookean -> reduced
-//!   polynomial N=2 with a stiffening C20 >= 0, ...; `palpate_analytic::richer_law`).
+//!   polynomial N=2 with a stiffening C20 >= 0, ...; `palpate_enrich::richer_law`).
 //! * `zero_offset` — contact starts at a recorded displacement d0
-//!   (`palpate_analytic::ZeroOffset`, the same wrapper as for C1).
+//!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
 
-use palpate_analytic::{richer_law, MaterialForm, ZeroOffset};
 use palpate_core::{
-    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    ParamSpec,
 };
+use palpate_enrich::{richer_law, MaterialForm, ZeroOffset};
 use palpate_material::Law;
 use std::sync::Arc;
 
@@ -297,6 +298,12 @@ impl ForwardModel for N1Needle {
     fn expensive(&self) -> bool {
         true
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for N1Needle {
     fn effects(&self) -> Vec<Effect> {
         let mut v = Vec::new();
         if !self.friction_is_parameter {

@@ -4,6 +4,7 @@ use serde::{Deserialize, Serialize};
 
 /// What can go wrong when naming a law, checking its parameters or solving a homogeneous state.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, thiserror::Error)]
+#[non_exhaustive]
 pub enum MaterialError {
     /// The law name is not one of the known spellings.
     #[error("unknown material law `{text}` (expected neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce or ogden:N)")]

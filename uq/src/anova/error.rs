@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Why the ANOVA inputs are unusable.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum AnovaError {
     #[error("the model needs at least one factor")]
     NoFactors,

@@ -13,6 +13,7 @@ use thiserror::Error;
 
 /// Why a runs table could not be read or a column used.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum RunsTableError {
     /// The text layer (file, comments, header, field counts) and numeric
     /// columns: palpate-core's errors, naming file, line and column.

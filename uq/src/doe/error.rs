@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Why a design specification is invalid.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum DoeError {
     #[error("a design needs at least one factor")]
     NoFactors,

@@ -36,6 +36,7 @@ use thiserror::Error;
 
 /// Why an emulator could not be trained.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum EmulatorError {
     #[error("parameter box: {reason}")]
     InvalidBox { reason: String },

@@ -12,6 +12,7 @@ use super::structure::{
 };
 use super::{GapError, GapOptions};
 use nalgebra::DMatrix;
+use palpate_core::enrichable::{effects_of, embed, enrich};
 use palpate_core::{Effect, ForwardError, ForwardModel, Loading};
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -72,7 +73,7 @@ fn base_proxy(base: &dyn ForwardModel, loading: &Loading) -> Result<Proxy, GapEr
         Effect::MaterialForm,
         Effect::Viscoelasticity,
     ];
-    let offered = base.effects();
+    let offered = effects_of(base);
     let p = base.space().len();
     let theta0 = base.space().initial();
     let want = base.predict(&theta0, loading)?;
@@ -80,10 +81,10 @@ fn base_proxy(base: &dyn ForwardModel, loading: &Loading) -> Result<Proxy, GapEr
         if !offered.contains(effect) {
             continue;
         }
-        let Ok(rich) = base.enrich(*effect) else {
+        let Ok(rich) = enrich(base, *effect) else {
             continue;
         };
-        let off = rich.embed(&theta0);
+        let off = embed(rich.as_ref(), &theta0);
         if rich.space().names()[..p] != base.space().names()[..] {
             continue;
         }
@@ -415,7 +416,7 @@ fn assess(effect: Effect, rich: Arc<dyn ForwardModel>, ctx: &Context<'_>) -> Ass
     let (n, p) = (ctx.observed.len(), ctx.p);
     let specs = rich.space().params.clone();
     let q = specs.len() - p;
-    let off = rich.embed(&ctx.base_theta);
+    let off = embed(rich.as_ref(), &ctx.base_theta);
     let jac = sensitivities(rich.as_ref(), &off, ctx.loading)?;
     let at_lower: Vec<bool> = (p..specs.len()).map(|j| off[j] <= specs[j].lower).collect();
     let at_upper: Vec<bool> = (p..specs.len()).map(|j| off[j] >= specs[j].upper).collect();
@@ -650,7 +651,7 @@ pub fn diagnose(
     let (proxy, fixed) = base_proxy(base, loading)?;
     let starts: Vec<Vec<f64>> = base_starts(base, loading, observed)
         .iter()
-        .map(|s| proxy.embed(s))
+        .map(|s| embed(proxy.as_ref(), s))
         .collect();
     let expensive = base.expensive();
     let linearised = options.cross_validation.linearised(expensive);
@@ -718,15 +719,18 @@ pub fn diagnose(
         Some(list) => list
             .iter()
             .copied()
-            .filter(|e| base.effects().contains(e))
+            .filter(|e| effects_of(base).contains(e))
             .collect(),
-        None => base.effects(),
+        None => effects_of(base),
     };
     let mut enriched: Vec<(Effect, Arc<dyn ForwardModel>)> = Vec::new();
     for e in effects {
-        if let Ok(rich) = base.enrich(e) {
+        if let Ok(rich) = enrich(base, e) {
             // Skip enrichments that cannot run on this history (e.g. no time for QLV).
-            if rich.predict(&rich.embed(&base_theta), loading).is_ok() {
+            if rich
+                .predict(&embed(rich.as_ref(), &base_theta), loading)
+                .is_ok()
+            {
                 enriched.push((e, Arc::from(rich)));
             }
         }
@@ -962,7 +966,7 @@ mod tests {
     //! The diagnosis on a toy model defined here (a linear spring with a zero
     //! offset), so that this crate tests it without any physics crate.
     use super::*;
-    use palpate_core::{Drive, Evaluator, Observable, ParamSpace, ParamSpec};
+    use palpate_core::{Drive, Enrichable, Evaluator, Observable, ParamSpace, ParamSpec};
     use rand::SeedableRng;
     use rand_distr::{Distribution, Normal};
 
@@ -1015,6 +1019,12 @@ mod tests {
         fn evaluator(&self) -> Box<dyn Evaluator + '_> {
             Box::new(SpringEval(self.offset))
         }
+        fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+            Some(self)
+        }
+    }
+
+    impl Enrichable for Spring {
         fn effects(&self) -> Vec<Effect> {
             if self.offset {
                 Vec::new()

@@ -6,6 +6,7 @@ use thiserror::Error;
 
 /// Why a diagnosis could not be made.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum GapError {
     /// Too few samples for the noise estimate and the tests.
     #[error("{got} samples; the diagnosis needs at least {needed}")]

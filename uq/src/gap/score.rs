@@ -2,15 +2,23 @@
 //! finite-difference sensitivities that respect the bounds.
 
 use nalgebra::DMatrix;
+use palpate_core::fd::{fd_column, FdRule, FdStep};
 use palpate_core::{ForwardError, ForwardModel, Loading};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+/// Relative finite-difference step of the sensitivities. Larger than the
+/// optimum for exact arithmetic (`eps^(1/3)`) because a finite-element
+/// prediction is only accurate to its Newton tolerance.
+pub const RELATIVE_STEP: f64 = 1e-4;
+
 /// Finite-difference sensitivities d prediction / d theta_j at `theta`
 /// (physical parameters), one column per parameter: central where both
 /// neighbours are inside the bounds, one-sided into the interior otherwise
-/// (e.g. at g = 0 or c = 0). The step is 1e-4 of a scale that does not
-/// vanish at an "off" point: max(|theta_j|, |initial_j|, 1e-3 x finite range, 1e-8).
+/// (e.g. at g = 0 or c = 0), and one-sided through `theta` when a step
+/// fails. The rule is palpate-core's `fd` with [`RELATIVE_STEP`]: 1e-4 of a
+/// scale that does not vanish at an "off" point,
+/// max(|theta_j|, |initial_j|, 1e-3 x finite range, 1e-8).
 pub fn sensitivities(
     model: &dyn ForwardModel,
     theta: &[f64],
@@ -31,36 +39,20 @@ pub(crate) fn sensitivities_of(
     wanted: &[bool],
 ) -> Result<DMatrix<f64>, ForwardError> {
     let n = loading.len();
-    let specs = &model.space().params;
-    let steps: Vec<Option<(f64, f64)>> = specs
+    let rule = FdRule::central(RELATIVE_STEP);
+    let steps: Vec<Option<FdStep>> = model
+        .space()
+        .params
         .iter()
         .enumerate()
-        .map(|(j, spec)| {
-            if !wanted[j] {
-                return None;
-            }
-            let range = spec.upper - spec.lower;
-            let range_scale = if range.is_finite() { 1e-3 * range } else { 0.0 };
-            let scale = theta[j]
-                .abs()
-                .max(spec.initial.abs())
-                .max(range_scale)
-                .max(1e-8);
-            let h = 1e-4 * scale;
-            let up = theta[j] + h <= spec.upper;
-            let down = theta[j] - h >= spec.lower;
-            match (up, down) {
-                (true, true) => Some((theta[j] + h, theta[j] - h)),
-                (true, false) => Some((theta[j] + h, theta[j])),
-                (false, true) => Some((theta[j], theta[j] - h)),
-                (false, false) => None,
-            }
-        })
+        .map(|(j, spec)| wanted[j].then(|| rule.param_step(spec, theta[j])))
         .collect();
+    // The prediction at `theta` is shared by every column that is one-sided
+    // at a bound (e.g. at g = 0 or c = 0).
     let one_sided = steps
         .iter()
         .enumerate()
-        .any(|(j, s)| s.is_some_and(|(tp, tm)| tp == theta[j] || tm == theta[j]));
+        .any(|(j, s)| s.is_some_and(|s| theta[j] + s.h > s.upper || theta[j] - s.h < s.lower));
     let centre = if one_sided {
         Some(model.predict(theta, loading)?)
     } else {
@@ -70,28 +62,14 @@ pub(crate) fn sensitivities_of(
         .par_iter()
         .enumerate()
         .map(|(j, step)| {
-            let Some((tp, tm)) = *step else {
+            let Some(step) = *step else {
                 return Ok(None);
             };
             let mut ev = model.evaluator();
-            let mut at = |x: f64| -> Result<Vec<f64>, ForwardError> {
-                if x == theta[j] {
-                    return Ok(centre.clone().expect("centre computed for one-sided steps"));
-                }
-                let mut t = theta.to_vec();
-                t[j] = x;
-                let mut out = vec![0.0; n];
-                ev.predict_into(&t, loading, &mut out)?;
-                Ok(out)
-            };
-            let plus = at(tp)?;
-            let minus = at(tm)?;
-            Ok(Some(
-                plus.iter()
-                    .zip(&minus)
-                    .map(|(a, b)| (a - b) / (tp - tm))
-                    .collect(),
-            ))
+            let mut f = |t: &[f64], out: &mut [f64]| ev.predict_into(t, loading, out);
+            let mut col = vec![0.0; n];
+            fd_column(&mut f, theta, j, step, centre.as_deref(), &mut col)?;
+            Ok(Some(col))
         })
         .collect();
     let mut jac = DMatrix::zeros(n, theta.len());

@@ -12,6 +12,7 @@ use thiserror::Error;
 
 /// Why the start could not be found.
 #[derive(Debug, Error)]
+#[non_exhaustive]
 pub enum StartError {
     #[error("least-squares fit: {0}")]
     Fit(#[from] InverseError),

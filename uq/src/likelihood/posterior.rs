@@ -22,6 +22,7 @@ use thiserror::Error;
 
 /// Why a posterior could not be set up.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum LikelihoodError {
     #[error("no data set")]
     NoData,

@@ -10,6 +10,9 @@
 //! `-inf`) means "outside the support / the model failed": samplers reject
 //! such points.
 
+use palpate_core::fd::{fd_column, FdRule};
+use std::convert::Infallible;
+
 /// A log-density on R^d, up to an additive constant.
 pub trait LogDensity: Sync {
     /// Dimension d.
@@ -20,9 +23,9 @@ pub trait LogDensity: Sync {
 
 /// Per-thread evaluation of a [`LogDensity`].
 ///
-/// The gradient has a finite-difference default (central differences, step
-/// `h_k = 1e-5 max(1, |z_k|)`), acceptable for cheap analytic models; a model
-/// with exact sensitivities overrides [`DensityWorker::value_and_gradient`]
+/// The gradient has a finite-difference default ([`fd_value_and_gradient`]:
+/// central differences, step `h_k = 1e-5 max(1, |z_k|)`), acceptable for
+/// cheap analytic models; a model with exact sensitivities overrides [`DensityWorker::value_and_gradient`]
 /// (the layered-capability hook of STYLE.md 3).
 pub trait DensityWorker {
     /// log p(z).
@@ -35,26 +38,37 @@ pub trait DensityWorker {
     }
 }
 
-/// Central finite-difference gradient of `f` (step 1e-5 max(1, |z_k|)):
-/// the default of [`DensityWorker::value_and_gradient`], for overrides that
-/// fall back to it. Returns the value and the evaluations spent (2 d + 1).
+/// Relative step of the finite-difference gradient: `h_k = 1e-5 max(1, |z_k|)`.
+pub const FD_RELATIVE_STEP: f64 = 1e-5;
+
+/// Central finite-difference gradient of `f` by palpate-core's `fd` (step
+/// [`FD_RELATIVE_STEP`] `max(1, |z_k|)`): the default of
+/// [`DensityWorker::value_and_gradient`], for overrides that fall back to
+/// it. Returns the value and the evaluations spent (2 d + 1).
 pub fn fd_value_and_gradient(
     f: &mut dyn FnMut(&[f64]) -> f64,
     z: &[f64],
     grad: &mut [f64],
 ) -> (f64, u64) {
     let f0 = f(z);
-    let mut zz = z.to_vec();
+    let rule = FdRule::central(FD_RELATIVE_STEP);
+    let mut g = |zz: &[f64], out: &mut [f64]| -> Result<(), Infallible> {
+        out[0] = f(zz);
+        Ok(())
+    };
     let mut evals = 1;
-    for k in 0..z.len() {
-        let h = 1e-5 * z[k].abs().max(1.0);
-        zz[k] = z[k] + h;
-        let fp = f(&zz);
-        zz[k] = z[k] - h;
-        let fm = f(&zz);
-        zz[k] = z[k];
-        evals += 2;
-        grad[k] = (fp - fm) / (2.0 * h);
+    for (k, gk) in grad.iter_mut().enumerate().take(z.len()) {
+        let mut col = [0.0];
+        let Ok(n) = fd_column(
+            &mut g,
+            z,
+            k,
+            rule.unbounded_step(z[k]),
+            Some(&[f0]),
+            &mut col,
+        );
+        evals += n as u64;
+        *gk = col[0];
     }
     (f0, evals)
 }

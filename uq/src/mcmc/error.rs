@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Errors of the samplers and the Laplace approximation.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum McmcError {
     /// The start point has the wrong length.
     #[error("start point has {got} coordinates, the density has {expected}")]

@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Why a test statistic is undefined for the given data.
 #[derive(Debug, Error, Clone, PartialEq)]
+#[non_exhaustive]
 pub enum StatsError {
     /// Too few observations (in total or in one group).
     #[error("{test}: needs at least {needed} observations{}, got {got}", group.map(|g| format!(" in group {g}")).unwrap_or_default())]

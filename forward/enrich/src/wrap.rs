@@ -2,23 +2,23 @@
 //! tool compliance): which effects a wrapped model still offers, and how to
 //! add one.
 
-use crate::homogeneous::not_applicable;
 use crate::{ToolCompliance, Viscoelastic, ZeroOffset};
+use palpate_core::enrichable::{effects_of, not_applicable};
 use palpate_core::{Effect, ForwardError, ForwardModel};
 use std::sync::Arc;
 
 /// Effects that are added by wrapping a model (rather than by changing its law).
-pub(crate) const WRAPPER_EFFECTS: [Effect; 3] = [
+pub const WRAPPER_EFFECTS: [Effect; 3] = [
     Effect::Viscoelasticity,
     Effect::ZeroOffset,
     Effect::ToolCompliance,
 ];
 
 /// Number of Prony terms an enrichment with `viscoelasticity` adds.
-pub(crate) const DEFAULT_PRONY_TERMS: usize = 2;
+pub const DEFAULT_PRONY_TERMS: usize = 2;
 
-/// `model` enriched with one wrapper effect.
-pub(crate) fn wrap(
+/// `model` enriched with one wrapper effect (one of [`WRAPPER_EFFECTS`]).
+pub fn wrap(
     effect: Effect,
     model: Arc<dyn ForwardModel>,
 ) -> Result<Box<dyn ForwardModel>, ForwardError> {
@@ -33,9 +33,8 @@ pub(crate) fn wrap(
 /// Effects a wrapper around `inner` offers: the inner model's wrapper
 /// effects, minus the wrapper's own (each is added at most once; law
 /// changes are only offered by the bare models).
-pub(crate) fn wrapper_effects(inner: &dyn ForwardModel, own: Effect) -> Vec<Effect> {
-    inner
-        .effects()
+pub fn wrapper_effects(inner: &dyn ForwardModel, own: Effect) -> Vec<Effect> {
+    effects_of(inner)
         .into_iter()
         .filter(|e| WRAPPER_EFFECTS.contains(e) && *e != own)
         .collect()

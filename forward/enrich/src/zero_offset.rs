@@ -4,7 +4,8 @@
 use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
-    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    ParamSpec,
 };
 use std::sync::Arc;
 
@@ -74,6 +75,12 @@ impl ForwardModel for ZeroOffset {
             base: self.base.evaluator(),
         })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for ZeroOffset {
     fn effects(&self) -> Vec<Effect> {
         wrapper_effects(self.base.as_ref(), Effect::ZeroOffset)
     }

@@ -3,7 +3,8 @@
 use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
-    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    ParamSpec,
 };
 use std::sync::Arc;
 
@@ -204,6 +205,12 @@ impl ForwardModel for Viscoelastic {
             fe: Vec::new(),
         })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for Viscoelastic {
     fn effects(&self) -> Vec<Effect> {
         wrapper_effects(self.base.as_ref(), Effect::Viscoelasticity)
     }

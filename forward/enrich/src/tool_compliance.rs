@@ -4,7 +4,8 @@
 use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
-    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    ParamSpec,
 };
 use std::sync::Arc;
 
@@ -145,6 +146,12 @@ impl ForwardModel for ToolCompliance {
             shifted: Vec::new(),
         })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for ToolCompliance {
     fn effects(&self) -> Vec<Effect> {
         wrapper_effects(self.base.as_ref(), Effect::ToolCompliance)
     }

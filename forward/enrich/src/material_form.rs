@@ -2,8 +2,9 @@
 //! base law as a special case.
 
 use crate::convert::law_space;
+use palpate_core::enrichable::{effects_of, enrich};
 use palpate_core::{
-    Effect, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
 };
 use palpate_material::Law;
 
@@ -133,11 +134,17 @@ impl ForwardModel for MaterialForm {
             inner: self.inner.evaluator(),
         })
     }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for MaterialForm {
     fn effects(&self) -> Vec<Effect> {
-        self.inner.effects()
+        effects_of(self.inner.as_ref())
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        self.inner.enrich(effect)
+        enrich(self.inner.as_ref(), effect)
     }
     fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
         let mut v = base_theta.to_vec();
