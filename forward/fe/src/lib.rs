@@ -4,7 +4,7 @@
 //! contact, for the N1 needle-indentation and C1 compression benchmarks
 //! (`BENCHMARKS.md`).
 //!
-//! * [`mesh`] — structured graded quadrilateral meshes with named sets.
+//! See docs/architecture.md for the module map and how to add a model, kernel, surface or effect.
 //! * [`kinematics`] — the kinematic idealisation (an enum owned by the element).
 //! * [`element`] — the Q1/P0 (Simo-Taylor-Pister) mixed element.
 //! * [`surface`] — rigid tool surfaces for 2D and 3D models behind one
