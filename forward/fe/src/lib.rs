@@ -1,24 +1,25 @@
 //! # palpate-fe
 //!
-//! Axisymmetric large-deformation finite elements with frictional rigid-tool
-//! contact, for the N1 needle-indentation and C1 compression benchmarks
-//! (`BENCHMARKS.md`).
+//! Large-deformation finite elements with frictional rigid-tool contact, as
+//! one composable layer (docs/architecture.md has the map and how to add a
+//! model, kernel, surface or effect), and the forward models built on it:
+//! N1 needle indentation and C1 compression (`BENCHMARKS.md`).
 //!
-//! See docs/architecture.md for the module map and how to add a model, kernel, surface or effect.
-//! * [`kinematics`] — the kinematic idealisation (an enum owned by the element).
-//! * [`element`] — the Q1/P0 (Simo-Taylor-Pister) mixed element.
-//! * [`surface`] — rigid tool surfaces for 2D and 3D models behind one
-//!   trait (revolved profiles, wheels, platens).
-//! * [`motion`] — rigid tool motion (translation, rotation, rolling
-//!   without slip) driven by loading channels, and the global projection.
-//! * [`tool`] / [`contact`] — analytic rigid tools and augmented-Lagrangian
-//!   Coulomb contact at surface nodes or edge Gauss points, with
-//!   trial/commit history.
-//! * [`material`] — the pointwise material seen by the element, with a
-//!   five-component fast path for the laws written in invariants.
-//! * [`solver`] — Newton-Raphson (modified: the LU is reused while it
-//!   contracts the residual) with line search and automatic increments on a
-//!   faer sparse LU that keeps its symbolic factorisation.
+//! * [`mesh`] — meshes of any cell type with node sets, facet sets and
+//!   regions; generators, a Gmsh reader, VTU output.
+//! * [`kinematics`] — the kinematic idealisation (3D, axisymmetric, plane
+//!   strain, plane stress) owning F and its variations.
+//! * [`kernel`] — element kernels behind one trait (Q1/P0, Q2/P1, hex
+//!   Q1/P0, plane-stress quads), [`shape`] and [`quadrature`] per cell type.
+//! * [`material`] — the pointwise material seen by the kernels.
+//! * [`dofs`], [`contribution`], [`body`], [`contact`] — boundary
+//!   conditions as data and the contributions a step sums, with
+//!   trial/commit/rollback history.
+//! * [`surface`], [`motion`], [`tool`] — rigid tool surfaces in 2D and 3D
+//!   and their motion along loading channels.
+//! * [`system`], [`stepper`] — Newton (chord steps, line search) on a faer
+//!   sparse LU that keeps its symbolic factorisation, apart from the
+//!   stepper (channels along a path with time, cut-back, partial results).
 //! * [`n1`], [`c1`] — the forward models.
 
 // Index loops mirror the index notation of the equations; negated comparisons
