@@ -1,6 +1,6 @@
 //! The pointwise material seen by the elements: isochoric stress and tangent
 //! from a deformation gradient. The volumetric part is the element's business
-//! (mean dilatation penalty or an exact constraint, see [`crate::element`]).
+//! (mean dilatation penalty or an exact constraint, see [`crate::kernel`]).
 
 use nalgebra::{Matrix3, SMatrix};
 use palpate_material::invariant_kinematics::InvariantKinematics;

@@ -16,8 +16,8 @@
 //! * [`vtu`] — VTK XML UnstructuredGrid output of a mesh or a facet set,
 //!   any cell type, with point and cell data.
 //!
-//! The old solver still runs on [`crate::mesh2d`] and writes with
-//! [`crate::vtu`]; those stay until it moves onto this mesh.
+//! [`crate::vtu`] writes a solved system (displacements, pressures,
+//! stresses) on top of [`vtu`].
 
 pub mod gmsh;
 pub mod grading;
