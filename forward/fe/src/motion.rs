@@ -80,7 +80,7 @@
 //!
 //! Without a rotation the local point is computed as
 //! `(x - origin) - u`, in that order and with `u` summed from its first
-//! term, which is exactly what the legacy [`crate::contact::RigidTool::local`]
+//! term, which is exactly what the original axisymmetric contact code (`RigidTool::local`, before the layer)
 //! computes (`x - origin - travel * direction`); and the local projection is
 //! returned unchanged (no multiplications by the identity). The N1 needle
 //! therefore gives the same numbers through a [`ToolMotion`]. (Forming
