@@ -57,6 +57,30 @@ pub struct ElementOutput {
     pub ref_volume: f64,
     /// Pressure (mean stress, MPa, tension positive) at the cell centre.
     pub pressure: f64,
+    /// Work space of the kernel, kept between calls.
+    pub(crate) scratch: Scratch,
+}
+
+/// Work space of a kernel evaluation: the volume gradients of the pressure
+/// modes, their psi-weighted second derivatives, and the pressure functions
+/// and weights at the quadrature points.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub(crate) struct Scratch {
+    pub gv: Vec<[f64; 4]>,
+    pub d2v: Vec<f64>,
+    pub points: Vec<([f64; 4], f64)>,
+}
+
+impl Scratch {
+    /// Zeroed for `nu` displacement dofs and `np` pressure modes (second
+    /// derivatives only when `np > 0`).
+    pub fn reset(&mut self, nu: usize, np: usize) {
+        self.gv.clear();
+        self.gv.resize(nu, [0.0; 4]);
+        self.d2v.clear();
+        self.d2v.resize(np * nu * nu, 0.0);
+        self.points.clear();
+    }
 }
 
 impl ElementOutput {

@@ -21,7 +21,7 @@
 use nalgebra::{Matrix3, SMatrix, SVector};
 use palpate_material::Volumetric;
 
-use super::{ElementInput, ElementKernel, ElementOutput, PressureSpace};
+use super::{ElementInput, ElementKernel, ElementOutput, PressureSpace, Scratch};
 use crate::kinematics::{jacobian_derivs_3d, Kinematics};
 use crate::mesh::CellType;
 use crate::quadrature::QuadratureRule;
@@ -136,6 +136,201 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
             x: xp,
             dv: self.kin.volume_factor(xp[0]) * det * w,
         })
+    }
+
+    /// [`ElementKernel::evaluate`] with caller-owned scratch.
+    fn evaluate_with(
+        &self,
+        input: &ElementInput,
+        tangent: bool,
+        out: &mut ElementOutput,
+        scratch: &mut Scratch,
+    ) -> Result<(), FeError> {
+        let e = input.element;
+        let nu = N * D;
+        let np = self.pressure.len(D);
+        let exact = matches!(input.volumetric, Volumetric::Incompressible) && np > 0;
+        let nloc = nu + if exact { np } else { 0 };
+        out.reset(nloc, tangent);
+        let comps = self.kin.components();
+        let (centre, h) = self.centre_and_size(input.x);
+        // volume gradients G_m (per local dof) and the psi-weighted
+        // B^T (d2J/dF2) B of each pressure mode
+        scratch.reset(nu, if tangent { np } else { 0 });
+        let Scratch { gv, d2v, points } = scratch;
+        let (mut v, mut vref) = ([0.0; 4], [0.0; 4]);
+        let mut mass = SMatrix::<f64, 4, 4>::identity();
+        for m in 0..np {
+            mass[(m, m)] = 0.0;
+        }
+        let (mut vol, mut vol_ref) = (0.0, 0.0);
+        for (s, &w) in self.shape.iter().zip(&self.weights) {
+            let p = self
+                .geometry(input.x, s, w)
+                .map_err(|det| FeError::InvalidMesh {
+                    field: format!("element {e}"),
+                    reason: format!(
+                        "reference Jacobian {det:.3e} <= 0 (corners must be counter-clockwise)"
+                    ),
+                })?;
+            let (mut f, cols) = self.gradient(&p, input.u);
+            let det2 = f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)];
+            if D == 2 && !(det2 > 0.0) {
+                return Err(FeError::InvertedElement {
+                    element: e,
+                    det_f: det2,
+                });
+            }
+            let Some((ps, amat)) =
+                self.kin
+                    .stress_tangent(input.material, input.volumetric, &mut f, tangent)
+            else {
+                return Err(FeError::NonFiniteStress { element: e });
+            };
+            let (j, cof, hj) = jacobian_derivs_3d(&f);
+            if !(j > 0.0) {
+                return Err(FeError::InvertedElement {
+                    element: e,
+                    det_f: j,
+                });
+            }
+            vol += j * p.dv;
+            vol_ref += p.dv;
+            let psi = self.pressure.eval(D, &p.x, &centre, h);
+            points.push((psi, p.dv));
+            for m in 0..np {
+                v[m] += psi[m] * j * p.dv;
+                vref[m] += psi[m] * p.dv;
+                for n in 0..np {
+                    mass[(m, n)] += psi[m] * psi[n] * p.dv;
+                }
+            }
+            for a in 0..N {
+                for c in 0..D {
+                    let col = &cols[a][c];
+                    let i = a * D + c;
+                    out.residual[i] += dot(col, &ps) * p.dv;
+                    if np > 0 {
+                        let dj = dot(col, &cof) * p.dv;
+                        for m in 0..np {
+                            gv[i][m] += psi[m] * dj;
+                        }
+                    }
+                }
+            }
+            if !tangent {
+                continue;
+            }
+            for a in 0..N {
+                for c in 0..D {
+                    let col = &cols[a][c];
+                    let i = a * D + c;
+                    let ta = row(col, &amat, comps);
+                    let th = if np > 0 {
+                        row(col, &hj, comps)
+                    } else {
+                        [0.0; 9]
+                    };
+                    for b in 0..N {
+                        for d in 0..D {
+                            let col2 = &cols[b][d];
+                            let jx = b * D + d;
+                            out.tangent[i * nloc + jx] += dot(col2, &ta) * p.dv;
+                            if np > 0 {
+                                let hv = dot(col2, &th) * p.dv;
+                                for m in 0..np {
+                                    d2v[(m * nu + i) * nu + jx] += psi[m] * hv;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        out.volume = vol;
+        out.ref_volume = vol_ref;
+        if np == 0 {
+            return Ok(());
+        }
+        // pressure coefficients p_m (and the penalty's Q)
+        let mut pc = [0.0; 4];
+        let mut penalty_q = None;
+        match input.volumetric {
+            Volumetric::Incompressible => {
+                for m in 0..np {
+                    pc[m] = input.scale * input.q[m];
+                    out.residual[nu + m] = input.scale * (v[m] - vref[m]);
+                }
+            }
+            Volumetric::D1(_) => {
+                let chol = mass.cholesky().ok_or(FeError::InvertedElement {
+                    element: e,
+                    det_f: 0.0,
+                })?;
+                let theta = chol.solve(&SVector::<f64, 4>::from_fn(|m, _| v[m]));
+                let mut rhs = SVector::<f64, 4>::zeros();
+                let mut q = SMatrix::<f64, 4, 4>::zeros();
+                for (psi, dv) in points.iter() {
+                    let th: f64 = (0..np).map(|m| psi[m] * theta[m]).sum();
+                    let (du, d2u) = (input.volumetric.du(th), input.volumetric.d2u(th));
+                    for m in 0..np {
+                        rhs[m] += du * psi[m] * dv;
+                        for n in 0..np {
+                            q[(m, n)] += d2u * psi[m] * psi[n] * dv;
+                        }
+                    }
+                }
+                let p = chol.solve(&rhs);
+                for m in 0..np {
+                    pc[m] = p[m];
+                }
+                if tangent {
+                    // M^-1 Q M^-1
+                    let mq = chol.solve(&q);
+                    penalty_q = Some(chol.solve(&mq.transpose()));
+                }
+            }
+        }
+        out.pressure = pc[0];
+        for i in 0..nu {
+            for m in 0..np {
+                out.residual[i] += pc[m] * gv[i][m];
+            }
+        }
+        if !tangent {
+            return Ok(());
+        }
+        for i in 0..nu {
+            for jx in 0..nu {
+                let mut s = 0.0;
+                for m in 0..np {
+                    s += pc[m] * d2v[(m * nu + i) * nu + jx];
+                }
+                out.tangent[i * nloc + jx] += s;
+            }
+        }
+        if exact {
+            for i in 0..nu {
+                for m in 0..np {
+                    let k = input.scale * gv[i][m];
+                    out.tangent[i * nloc + nu + m] = k;
+                    out.tangent[(nu + m) * nloc + i] = k;
+                }
+            }
+        } else if let Some(q) = penalty_q {
+            for i in 0..nu {
+                for jx in 0..nu {
+                    let mut s = 0.0;
+                    for m in 0..np {
+                        for n in 0..np {
+                            s += gv[i][m] * q[(m, n)] * gv[jx][n];
+                        }
+                    }
+                    out.tangent[i * nloc + jx] += s;
+                }
+            }
+        }
+        Ok(())
     }
 
     /// Centroid of the corner nodes and the cell size `h` (square root of
@@ -277,196 +472,12 @@ impl<const N: usize, const D: usize> ElementKernel for SolidKernel<N, D> {
         tangent: bool,
         out: &mut ElementOutput,
     ) -> Result<(), FeError> {
-        let e = input.element;
-        let nu = N * D;
-        let np = self.pressure.len(D);
-        let exact = matches!(input.volumetric, Volumetric::Incompressible) && np > 0;
-        let nloc = nu + if exact { np } else { 0 };
-        out.reset(nloc, tangent);
-        let comps = self.kin.components();
-        let (centre, h) = self.centre_and_size(input.x);
-        // volume gradients G_m (per local dof) and the psi-weighted
-        // B^T (d2J/dF2) B of each pressure mode
-        let mut gv = vec![[0.0; 4]; nu];
-        let mut d2v = if tangent && np > 0 {
-            vec![0.0; np * nu * nu]
-        } else {
-            Vec::new()
-        };
-        let (mut v, mut vref) = ([0.0; 4], [0.0; 4]);
-        let mut mass = SMatrix::<f64, 4, 4>::identity();
-        for m in 0..np {
-            mass[(m, m)] = 0.0;
-        }
-        let mut points: Vec<([f64; 4], f64)> = Vec::with_capacity(self.weights.len());
-        let (mut vol, mut vol_ref) = (0.0, 0.0);
-        for (s, &w) in self.shape.iter().zip(&self.weights) {
-            let p = self
-                .geometry(input.x, s, w)
-                .map_err(|det| FeError::InvalidMesh {
-                    field: format!("element {e}"),
-                    reason: format!(
-                        "reference Jacobian {det:.3e} <= 0 (corners must be counter-clockwise)"
-                    ),
-                })?;
-            let (mut f, cols) = self.gradient(&p, input.u);
-            let det2 = f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)];
-            if D == 2 && !(det2 > 0.0) {
-                return Err(FeError::InvertedElement {
-                    element: e,
-                    det_f: det2,
-                });
-            }
-            let Some((ps, amat)) =
-                self.kin
-                    .stress_tangent(input.material, input.volumetric, &mut f, tangent)
-            else {
-                return Err(FeError::NonFiniteStress { element: e });
-            };
-            let (j, cof, hj) = jacobian_derivs_3d(&f);
-            if !(j > 0.0) {
-                return Err(FeError::InvertedElement {
-                    element: e,
-                    det_f: j,
-                });
-            }
-            vol += j * p.dv;
-            vol_ref += p.dv;
-            let psi = self.pressure.eval(D, &p.x, &centre, h);
-            points.push((psi, p.dv));
-            for m in 0..np {
-                v[m] += psi[m] * j * p.dv;
-                vref[m] += psi[m] * p.dv;
-                for n in 0..np {
-                    mass[(m, n)] += psi[m] * psi[n] * p.dv;
-                }
-            }
-            for a in 0..N {
-                for c in 0..D {
-                    let col = &cols[a][c];
-                    let i = a * D + c;
-                    out.residual[i] += dot(col, &ps) * p.dv;
-                    if np > 0 {
-                        let dj = dot(col, &cof) * p.dv;
-                        for m in 0..np {
-                            gv[i][m] += psi[m] * dj;
-                        }
-                    }
-                }
-            }
-            if !tangent {
-                continue;
-            }
-            for a in 0..N {
-                for c in 0..D {
-                    let col = &cols[a][c];
-                    let i = a * D + c;
-                    let ta = row(col, &amat, comps);
-                    let th = if np > 0 {
-                        row(col, &hj, comps)
-                    } else {
-                        [0.0; 9]
-                    };
-                    for b in 0..N {
-                        for d in 0..D {
-                            let col2 = &cols[b][d];
-                            let jx = b * D + d;
-                            out.tangent[i * nloc + jx] += dot(col2, &ta) * p.dv;
-                            if np > 0 {
-                                let hv = dot(col2, &th) * p.dv;
-                                for m in 0..np {
-                                    d2v[(m * nu + i) * nu + jx] += psi[m] * hv;
-                                }
-                            }
-                        }
-                    }
-                }
-            }
-        }
-        out.volume = vol;
-        out.ref_volume = vol_ref;
-        if np == 0 {
-            return Ok(());
-        }
-        // pressure coefficients p_m (and the penalty's Q)
-        let mut pc = [0.0; 4];
-        let mut penalty_q = None;
-        match input.volumetric {
-            Volumetric::Incompressible => {
-                for m in 0..np {
-                    pc[m] = input.scale * input.q[m];
-                    out.residual[nu + m] = input.scale * (v[m] - vref[m]);
-                }
-            }
-            Volumetric::D1(_) => {
-                let chol = mass.cholesky().ok_or(FeError::InvertedElement {
-                    element: e,
-                    det_f: 0.0,
-                })?;
-                let theta = chol.solve(&SVector::<f64, 4>::from_fn(|m, _| v[m]));
-                let mut rhs = SVector::<f64, 4>::zeros();
-                let mut q = SMatrix::<f64, 4, 4>::zeros();
-                for (psi, dv) in &points {
-                    let th: f64 = (0..np).map(|m| psi[m] * theta[m]).sum();
-                    let (du, d2u) = (input.volumetric.du(th), input.volumetric.d2u(th));
-                    for m in 0..np {
-                        rhs[m] += du * psi[m] * dv;
-                        for n in 0..np {
-                            q[(m, n)] += d2u * psi[m] * psi[n] * dv;
-                        }
-                    }
-                }
-                let p = chol.solve(&rhs);
-                for m in 0..np {
-                    pc[m] = p[m];
-                }
-                if tangent {
-                    // M^-1 Q M^-1
-                    let mq = chol.solve(&q);
-                    penalty_q = Some(chol.solve(&mq.transpose()));
-                }
-            }
-        }
-        out.pressure = pc[0];
-        for i in 0..nu {
-            for m in 0..np {
-                out.residual[i] += pc[m] * gv[i][m];
-            }
-        }
-        if !tangent {
-            return Ok(());
-        }
-        for i in 0..nu {
-            for jx in 0..nu {
-                let mut s = 0.0;
-                for m in 0..np {
-                    s += pc[m] * d2v[(m * nu + i) * nu + jx];
-                }
-                out.tangent[i * nloc + jx] += s;
-            }
-        }
-        if exact {
-            for i in 0..nu {
-                for m in 0..np {
-                    let k = input.scale * gv[i][m];
-                    out.tangent[i * nloc + nu + m] = k;
-                    out.tangent[(nu + m) * nloc + i] = k;
-                }
-            }
-        } else if let Some(q) = penalty_q {
-            for i in 0..nu {
-                for jx in 0..nu {
-                    let mut s = 0.0;
-                    for m in 0..np {
-                        for n in 0..np {
-                            s += gv[i][m] * q[(m, n)] * gv[jx][n];
-                        }
-                    }
-                    out.tangent[i * nloc + jx] += s;
-                }
-            }
-        }
-        Ok(())
+        // scratch kept in the output buffer between calls (no allocation
+        // on the assembly's hot path once every cell has been seen)
+        let mut scratch = std::mem::take(&mut out.scratch);
+        let r = self.evaluate_with(input, tangent, out, &mut scratch);
+        out.scratch = scratch;
+        r
     }
 
     fn mean_cauchy_stress(&self, input: &ElementInput, pressure: f64) -> [f64; 6] {
