@@ -335,6 +335,10 @@ impl Contribution for RigidContact {
         self
     }
 
+    fn channels(&self) -> Vec<usize> {
+        self.motion.channels()
+    }
+
     fn couplings(&self, dim: usize) -> Vec<Vec<usize>> {
         self.facets
             .iter()

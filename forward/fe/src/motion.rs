@@ -231,6 +231,18 @@ impl ToolMotion {
         }
     }
 
+    /// The channels the motion follows (translation, then an explicit
+    /// rotation's), sorted and without repeats.
+    pub fn channels(&self) -> Vec<usize> {
+        let mut c: Vec<usize> = self.translation.iter().map(|t| t.0).collect();
+        if let Some(Rotation::About { channel, .. }) = self.rotation {
+            c.push(channel);
+        }
+        c.sort_unstable();
+        c.dedup();
+        c
+    }
+
     /// Checks that every channel index is below `channels`, the origin is
     /// finite, the translation directions are finite and non-zero, and the
     /// rotation is well posed (unit axis and finite rate; unit, orthogonal
