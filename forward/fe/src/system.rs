@@ -121,6 +121,12 @@ impl System {
         channels: usize,
     ) -> Result<System, FeError> {
         mesh.validate()?;
+        if dim != mesh.dim {
+            return Err(FeError::InvalidConfig {
+                field: "dim".into(),
+                reason: format!("{dim} components per node on a {}D mesh", mesh.dim),
+            });
+        }
         let mut first = mesh.nodes.len() * dim;
         for c in contributions.iter_mut() {
             c.bind(first);
