@@ -930,4 +930,29 @@ mod tests {
         };
         assert!(tilted.check(1).is_ok() && tilted.check_dim(2).is_err());
     }
+
+    #[test]
+    fn channels_are_the_translations_and_an_explicit_rotation() {
+        let rolling = ToolMotion::rolling(
+            [0.0; 3],
+            (2, [0.0, -1.0, 0.0]),
+            (0, [1.0, 0.0, 0.0]),
+            2.0,
+            2,
+        );
+        assert_eq!(rolling.channels(), vec![0, 2]);
+        let turning = ToolMotion {
+            origin: [0.0; 3],
+            translation: vec![(1, [0.0, -1.0, 0.0]), (1, [1.0, 0.0, 0.0])],
+            rotation: Some(Rotation::About {
+                channel: 3,
+                axis: [0.0, 0.0, 1.0],
+                rate: 1.0,
+            }),
+        };
+        assert_eq!(turning.channels(), vec![1, 3]);
+        assert!(ToolMotion::translating([0.0; 3], vec![])
+            .channels()
+            .is_empty());
+    }
 }
