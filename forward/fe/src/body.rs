@@ -10,6 +10,7 @@ use rayon::prelude::*;
 use crate::contribution::{Assembly, AssemblyContext, Contribution};
 use crate::kernel::{solid::cell_size, ElementInput, ElementKernel, ElementOutput};
 use crate::material::PointMaterial;
+use crate::mesh::jacobian::corner_jacobians;
 use crate::mesh::Mesh;
 use crate::FeError;
 
@@ -47,6 +48,11 @@ impl SolidBody {
     /// regions takes the material of the first). `exact` makes the pressure
     /// a Lagrange multiplier per cell (the laws must then be incompressible);
     /// otherwise a penalty `D1` is condensed in the element.
+    ///
+    /// Errors name what is wrong: a mesh that fails [`Mesh::validate`] (a
+    /// missing node), an unknown region, a kernel for another cell type, or
+    /// an inverted cell (a corner Jacobian determinant `<= 0` in 2D, `< 0`
+    /// in 3D, or a non-positive reference volume), never a panic.
     pub fn new(
         name: &str,
         mesh: &Mesh,
@@ -64,6 +70,7 @@ impl SolidBody {
                 ),
             });
         }
+        mesh.validate()?;
         let mut region_of = vec![usize::MAX; mesh.cell_count()];
         for (r, region) in regions.iter().enumerate() {
             for &c in mesh.region(region)? {
@@ -81,11 +88,39 @@ impl SolidBody {
             .map(|ns| ns.iter().map(|&n| mesh.nodes[n]).collect())
             .collect();
         for (k, xs) in x.iter().enumerate() {
+            // The corner test catches what the quadrature points can miss
+            // (a quadratic cell folded at a corner by a misplaced mid-node);
+            // the same rule as the Gmsh reader's.
+            let jac = corner_jacobians(mesh.cell_type, xs);
+            let bad = jac.iter().position(|&j| {
+                if mesh.dim == 2 {
+                    !(j > 0.0)
+                } else {
+                    !(j >= 0.0)
+                }
+            });
+            if let Some(c) = bad {
+                return Err(FeError::InvalidMesh {
+                    field: format!("cell {}", cells[k]),
+                    reason: format!(
+                        "inverted: Jacobian determinant {:.3e} at corner {c} ({})",
+                        jac[c],
+                        if mesh.dim == 2 {
+                            "corners must turn counter-clockwise"
+                        } else {
+                            "the bottom face 0-1-2-3 must turn counter-clockwise seen from the top face"
+                        }
+                    ),
+                });
+            }
             let v = kernel
                 .reference_volume(xs)
-                .map_err(|_| FeError::InvalidMesh {
+                .map_err(|e| FeError::InvalidMesh {
                     field: format!("cell {}", cells[k]),
-                    reason: "zero or negative area (corners must be counter-clockwise)".into(),
+                    reason: match e {
+                        FeError::InvalidMesh { reason, .. } => format!("inverted: {reason}"),
+                        other => other.to_string(),
+                    },
                 })?;
             if !(v > 0.0) {
                 return Err(FeError::InvalidMesh {

@@ -120,8 +120,9 @@ pub struct RigidContact {
 
 impl RigidContact {
     /// Contact between `surface` moving by `motion` and facet set `facets`
-    /// of `mesh`. Errors: unknown set, bad tool dimensions, friction in 3D,
-    /// a tool that starts inside the body (naming tool, node and position).
+    /// of `mesh`. Errors: unknown set, bad tool dimensions, a surface,
+    /// motion or kinematics of another dimension than the mesh, friction in
+    /// 3D, a tool that starts inside the body (naming tool, node and position).
     // (the tool, its motion, the body's surface and the options are all
     // independent inputs; a builder would only rename them)
     #[allow(clippy::too_many_arguments)]
@@ -150,6 +151,14 @@ impl RigidContact {
         if kinematics.dim() == 3 && options.friction != 0.0 {
             return Err(bad("3D contact is frictionless for now".into()));
         }
+        if mesh.dim != kinematics.dim() {
+            return Err(bad(format!(
+                "{kinematics:?} kinematics on a {}D mesh",
+                mesh.dim
+            )));
+        }
+        motion.check_dim(kinematics.dim()).map_err(bad)?;
+        mesh.validate()?;
         let set = mesh.facet_set(facets)?;
         let points = contact_points(mesh, set, kinematics, options.points)?;
         let facets: Vec<Vec<usize>> = set.iter().map(|f| f.to_vec()).collect();
@@ -333,6 +342,10 @@ impl Contribution for RigidContact {
 
     fn as_any_mut(&mut self) -> &mut dyn std::any::Any {
         self
+    }
+
+    fn channels(&self) -> Vec<usize> {
+        self.motion.channels()
     }
 
     fn couplings(&self, dim: usize) -> Vec<Vec<usize>> {

@@ -117,6 +117,12 @@ pub trait Contribution: Send + std::any::Any {
     /// The state index of the first owned unknown (called once, before
     /// [`Contribution::couplings`]).
     fn bind(&mut self, _first: usize) {}
+    /// The loading channels this contribution follows (a tool's motion);
+    /// [`crate::system::System::new`] refuses a channel that no boundary
+    /// condition and no contribution uses.
+    fn channels(&self) -> Vec<usize> {
+        Vec::new()
+    }
     /// Groups of state entries that the tangent couples (one per element
     /// or contact facet) for a state with `dim` components per node, for
     /// the sparsity pattern; their order is the order of

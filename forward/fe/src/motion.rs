@@ -231,6 +231,18 @@ impl ToolMotion {
         }
     }
 
+    /// The channels the motion follows (translation, then an explicit
+    /// rotation's), sorted and without repeats.
+    pub fn channels(&self) -> Vec<usize> {
+        let mut c: Vec<usize> = self.translation.iter().map(|t| t.0).collect();
+        if let Some(Rotation::About { channel, .. }) = self.rotation {
+            c.push(channel);
+        }
+        c.sort_unstable();
+        c.dedup();
+        c
+    }
+
     /// Checks that every channel index is below `channels`, the origin is
     /// finite, the translation directions are finite and non-zero, and the
     /// rotation is well posed (unit axis and finite rate; unit, orthogonal
@@ -917,5 +929,30 @@ mod tests {
             }),
         };
         assert!(tilted.check(1).is_ok() && tilted.check_dim(2).is_err());
+    }
+
+    #[test]
+    fn channels_are_the_translations_and_an_explicit_rotation() {
+        let rolling = ToolMotion::rolling(
+            [0.0; 3],
+            (2, [0.0, -1.0, 0.0]),
+            (0, [1.0, 0.0, 0.0]),
+            2.0,
+            2,
+        );
+        assert_eq!(rolling.channels(), vec![0, 2]);
+        let turning = ToolMotion {
+            origin: [0.0; 3],
+            translation: vec![(1, [0.0, -1.0, 0.0]), (1, [1.0, 0.0, 0.0])],
+            rotation: Some(Rotation::About {
+                channel: 3,
+                axis: [0.0, 0.0, 1.0],
+                rate: 1.0,
+            }),
+        };
+        assert_eq!(turning.channels(), vec![1, 3]);
+        assert!(ToolMotion::translating([0.0; 3], vec![])
+            .channels()
+            .is_empty());
     }
 }

@@ -109,7 +109,10 @@ pub struct System {
 impl System {
     /// Binds the owned unknowns of `contributions` after the node
     /// displacements, numbers the equations from `bcs` (in `dofs`'s
-    /// arguments), and builds the pattern and the symbolic LU.
+    /// arguments), and builds the pattern and the symbolic LU. Every loading
+    /// channel `0..channels` must be used by a condition or a contribution
+    /// (an unused one is a mistake in the model, and its reaction would be
+    /// silently zero); the error names the channel.
     pub fn new(
         mesh: Mesh,
         dim: usize,
@@ -118,6 +121,12 @@ impl System {
         channels: usize,
     ) -> Result<System, FeError> {
         mesh.validate()?;
+        if dim != mesh.dim {
+            return Err(FeError::InvalidConfig {
+                field: "dim".into(),
+                reason: format!("{dim} components per node on a {}D mesh", mesh.dim),
+            });
+        }
         let mut first = mesh.nodes.len() * dim;
         for c in contributions.iter_mut() {
             c.bind(first);
@@ -125,6 +134,16 @@ impl System {
         }
         let extra = first - mesh.nodes.len() * dim;
         let dofs = DofMap::new(&mesh, dim, extra, bcs, channels)?;
+        let used: Vec<usize> = contributions.iter().flat_map(|c| c.channels()).collect();
+        if let Some(c) = (0..channels).find(|&c| !dofs.uses_channel(c) && !used.contains(&c)) {
+            return Err(FeError::InvalidConfig {
+                field: "channels".into(),
+                reason: format!(
+                    "loading channel {c} is used by no boundary condition and no tool \
+                     ({channels} channels)"
+                ),
+            });
+        }
         let mut groups: Vec<Vec<usize>> = Vec::new();
         let mut first_group = Vec::with_capacity(contributions.len());
         for c in &contributions {

@@ -109,6 +109,8 @@ fn system(c: &Case) -> System {
     if sideways != [0.0; 3] {
         translation.push((1, sideways));
     }
+    // an unused channel is refused: the axisymmetric case has only channel 0
+    let channels = translation.len();
     let motion = ToolMotion::translating(origin, translation);
     let contact = RigidContact::new(
         "tool",
@@ -124,18 +126,38 @@ fn system(c: &Case) -> System {
             penetration_tol: 1e-6,
             points: ContactPoints::EdgeGauss,
         },
-        2,
+        channels,
     )
     .unwrap();
-    let mut sys = System::new(mesh, dim, vec![Box::new(body), Box::new(contact)], &bcs, 2).unwrap();
+    let mut sys = System::new(
+        mesh,
+        dim,
+        vec![Box::new(body), Box::new(contact)],
+        &bcs,
+        channels,
+    )
+    .unwrap();
     sys.force_floor = 1e-6;
     sys
 }
 
+/// The loading state with channel values `values`, cut to the channels `sys` has.
+fn target(sys: &System, values: &[f64]) -> Target {
+    Target {
+        channels: values[..sys.committed.channels.len()].to_vec(),
+        time: 0.0,
+        dt: 0.0,
+    }
+}
+
 fn pressed(sys: &mut System, sideways: f64) {
+    let n = sys.committed.channels.len();
     let path = LoadPath {
         tau: vec![0.1, 0.2, 0.2 + sideways],
-        values: vec![vec![0.1, 0.0], vec![0.2, 0.0], vec![0.2, sideways]],
+        values: [[0.1, 0.0], [0.2, 0.0], [0.2, sideways]]
+            .iter()
+            .map(|v| v[..n].to_vec())
+            .collect(),
         time: vec![0.0; 3],
     };
     let opts = SolverOptions {
@@ -222,11 +244,7 @@ fn global_tangent_equals_finite_differences_of_the_global_residual() {
         let tool = sys.part::<RigidContact>(1).unwrap();
         assert!(tool.active() > 0, "{:?} {:?}: no contact", c.kin, c.cell);
         // an unconverged state off the path: perturb every unknown
-        let target = Target {
-            channels: vec![0.23, 0.12],
-            time: 0.0,
-            dt: 0.0,
-        };
+        let target = target(&sys, &[0.23, 0.12]);
         sys.prescribe(&target);
         for (k, u) in sys.u.iter_mut().enumerate() {
             if sys.dofs.equation(k) != NONE {
@@ -286,20 +304,12 @@ fn rollback_restores_contact_history_exactly() {
     };
     let mut a = system(&c);
     pressed(&mut a, 0.0);
-    let next = Target {
-        channels: vec![0.3, 0.0],
-        time: 0.0,
-        dt: 0.0,
-    };
+    let next = target(&a, &[0.3, 0.0]);
     a.solve_increment(&next, &opts).unwrap();
     a.commit(&next);
     // b: an attempt at a larger step that augments the multipliers and
     // then fails (the first failure point after an augmentation)
-    let big = Target {
-        channels: vec![0.45, 0.0],
-        time: 0.0,
-        dt: 0.0,
-    };
+    let big = target(&a, &[0.45, 0.0]);
     let mut b = None;
     for n in (4..400).step_by(4) {
         let mut s = system(&c);
