@@ -3,7 +3,8 @@
 //! the force every 0.25 mm, on 1 and 2 threads, against CalculiX on the
 //! reference deck `../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp`.
 //!
-//! Meshes: the benchmark mesh ([`MeshDensity::BENCH_GRADING`], the cheapest
+//! Meshes: the Q2/P1 benchmark mesh ([`Q9_GRADING`], 9-node cells with a
+//! discontinuous linear pressure), the Q1/P0 benchmark mesh ([`MeshDensity::BENCH_GRADING`], the cheapest
 //! found as accurate as level 2) with the default 0.25 mm increments and
 //! with 0.125 mm increments (the increment error is ~0.1 % at 10 mm), and,
 //! for context, levels 1 and 2 (or the levels given as arguments). Each row
@@ -24,7 +25,7 @@ use std::time::Instant;
 
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
-use palpate_fe::{MeshDensity, N1Needle, RunStats};
+use palpate_fe::{MeshDensity, N1Element, N1Needle, RunStats};
 
 const C10: f64 = 1101.295e-6;
 const AT: [f64; 3] = [2.0, 5.0, 10.0];
@@ -48,6 +49,16 @@ const MARGIN_GRADING: Grading = Grading {
     fine_length: 3.0,
     growth: 1.08,
 };
+/// The Q2/P1 bench mesh: 9-node cells of 0.5 mm (nodes every 0.25 mm) in a
+/// 2 mm zone under the needle, growing by 1.25 beyond it (320 cells, 3560
+/// unknowns). Chosen from the gradings tried with `examples/q9_try`-style
+/// runs (docs/validation/fe.md, "N1 speed"): inside CalculiX's 0.5 %
+/// budget at 2, 5 and 10 mm with the default 0.25 mm increments.
+const Q9_GRADING: Grading = Grading {
+    h_fine: 0.5,
+    fine_length: 2.0,
+    growth: 1.25,
+};
 #[path = "common/cpu.rs"]
 mod cpu;
 use cpu::cpu_seconds;
@@ -61,6 +72,8 @@ const CCX_README_WALL: f64 = 586.0;
 enum MeshChoice {
     Level(usize),
     Graded(&'static str, Grading),
+    /// 9-node Q2/P1 cells on this grading (each graded cell one quadratic cell).
+    Quadratic(&'static str, Grading),
 }
 
 /// One row of the table: a mesh and the largest increment (mm; `None`: the
@@ -75,7 +88,7 @@ impl Case {
     fn label(&self) -> String {
         let mesh = match self.mesh {
             MeshChoice::Level(l) => format!("level {l}"),
-            MeshChoice::Graded(name, g) => {
+            MeshChoice::Graded(name, g) | MeshChoice::Quadratic(name, g) => {
                 let h = (g.h_fine * 1e4).round() / 1e4;
                 format!("{name} ({h}/{}/{})", g.fine_length, g.growth)
             }
@@ -102,6 +115,10 @@ fn run(case: Case, threads: usize) -> Run {
     match case.mesh {
         MeshChoice::Level(level) => m.mesh = MeshDensity { level },
         MeshChoice::Graded(_, g) => m.grading = Some(g),
+        MeshChoice::Quadratic(_, g) => {
+            m.grading = Some(g);
+            m.element = N1Element::Quad9;
+        }
     }
     if let Some(s) = case.max_step {
         m.options.max_step = s;
@@ -174,6 +191,10 @@ fn main() {
     let bench = MeshChoice::Graded("bench", MeshDensity::BENCH_GRADING);
     let mut cases = vec![
         Case {
+            mesh: MeshChoice::Quadratic("Q2/P1 bench", Q9_GRADING),
+            max_step: None,
+        },
+        Case {
             mesh: bench,
             max_step: None,
         },
@@ -232,7 +253,7 @@ fn main() {
                     "forces differ between 1 and 2 threads"
                 ),
             }
-            if let MeshChoice::Graded(..) = case.mesh {
+            if let MeshChoice::Graded(..) | MeshChoice::Quadratic(..) = case.mesh {
                 bench_runs.push((case.label(), threads, r));
             }
         }

@@ -58,7 +58,7 @@ pub use contact::ContactPoints;
 pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
-pub use n1::{Base, MeshDensity, N1Needle};
+pub use n1::{Base, MeshDensity, N1Element, N1Needle};
 pub use stepper::{LoadPath, Progress};
 pub use surface::{Cylinder3d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};
 pub use system::{RunStats, SolverOptions, System};

@@ -87,6 +87,16 @@ impl MeshDensity {
     }
 }
 
+/// The element of the N1 mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum N1Element {
+    /// 4-node quadrilateral, constant pressure (Q1/P0).
+    Quad4,
+    /// 9-node quadrilateral, discontinuous linear pressure (Q2/P1).
+    Quad9,
+}
+
 /// Base (bottom face) condition.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -128,6 +138,10 @@ pub struct N1Needle {
     /// (with contact at the nodes, frictionless neo-Hookean localises in one
     /// surface element and stalls near 7.6 mm; docs/validation/fe.md).
     pub contact_points: ContactPoints,
+    /// The element: 4-node Q1/P0 (default, the validated one) or 9-node
+    /// Q2/P1 on the same grading made quadratic (each cell of the grading
+    /// becomes one 9-node cell: twice the nodes per direction).
+    pub element: N1Element,
     pub options: SolverOptions,
     friction_is_parameter: bool,
     space: ParamSpace,
@@ -153,6 +167,7 @@ impl N1Needle {
             penalty: 100.0,
             penetration_tol: 2e-3,
             contact_points: ContactPoints::EdgeGauss,
+            element: N1Element::Quad4,
             options: SolverOptions {
                 max_step: 0.25,
                 first_step: 0.05,
@@ -169,7 +184,11 @@ impl N1Needle {
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
-        Mesh::graded_rectangle(self.radius, self.height, g, g)
+        let m = Mesh::graded_rectangle(self.radius, self.height, g, g)?;
+        match self.element {
+            N1Element::Quad4 => Ok(m),
+            N1Element::Quad9 => m.to_quadratic(),
+        }
     }
 
     fn effective_grading(&self) -> Grading {
@@ -214,7 +233,10 @@ impl Setup for N1Needle {
             "body",
             &mesh,
             &["body"],
-            kernel_for(CellType::Quad4, kin, PressureSpace::P0)?,
+            match self.element {
+                N1Element::Quad4 => kernel_for(CellType::Quad4, kin, PressureSpace::P0)?,
+                N1Element::Quad9 => kernel_for(CellType::Quad9, kin, PressureSpace::P1)?,
+            },
             self.bulk.exact(),
         )?;
         let mut bcs = vec![Dirichlet::fixed("axis", 0), Dirichlet::fixed("bottom", 1)];

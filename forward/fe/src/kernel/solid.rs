@@ -221,28 +221,51 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
             if !tangent {
                 continue;
             }
+            // With the exact constraint the pressure is known (p = s q):
+            // fold it into the material tangent, A + p(x) d2J/dF2, and do
+            // one B product. The solid tangent is symmetric: the upper
+            // triangle is computed and mirrored.
+            let folded = exact.then(|| {
+                let pg: f64 = (0..np).map(|m| psi[m] * input.scale * input.q[m]).sum();
+                let mut at = amat;
+                for &k in comps {
+                    for &l in comps {
+                        at[k][l] += pg * hj[k][l];
+                    }
+                }
+                at
+            });
+            let at = folded.as_ref().unwrap_or(&amat);
+            let split = split_of(np, exact);
             for a in 0..N {
                 for c in 0..D {
                     let col = &cols[a][c];
                     let i = a * D + c;
-                    let ta = row(col, &amat, comps);
-                    let th = if np > 0 {
+                    let ta = row(col, at, comps);
+                    let th = if split {
                         row(col, &hj, comps)
                     } else {
                         [0.0; 9]
                     };
-                    for b in 0..N {
-                        for d in 0..D {
-                            let col2 = &cols[b][d];
-                            let jx = b * D + d;
-                            out.tangent[i * nloc + jx] += dot(col2, &ta) * p.dv;
-                            if np > 0 {
-                                let hv = dot(col2, &th) * p.dv;
-                                for m in 0..np {
-                                    d2v[(m * nu + i) * nu + jx] += psi[m] * hv;
-                                }
+                    for jx in i..nu {
+                        let col2 = &cols[jx / D][jx % D];
+                        out.tangent[i * nloc + jx] += dot(col2, &ta) * p.dv;
+                        if split {
+                            let hv = dot(col2, &th) * p.dv;
+                            for m in 0..np {
+                                d2v[(m * nu + i) * nu + jx] += psi[m] * hv;
                             }
                         }
+                    }
+                }
+            }
+        }
+        if tangent {
+            for i in 0..nu {
+                for jx in i + 1..nu {
+                    out.tangent[jx * nloc + i] = out.tangent[i * nloc + jx];
+                    for m in 0..if split_of(np, exact) { np } else { 0 } {
+                        d2v[(m * nu + jx) * nu + i] = d2v[(m * nu + i) * nu + jx];
                     }
                 }
             }
@@ -300,13 +323,15 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
         if !tangent {
             return Ok(());
         }
-        for i in 0..nu {
-            for jx in 0..nu {
-                let mut s = 0.0;
-                for m in 0..np {
-                    s += pc[m] * d2v[(m * nu + i) * nu + jx];
+        if !exact {
+            for i in 0..nu {
+                for jx in 0..nu {
+                    let mut s = 0.0;
+                    for m in 0..np {
+                        s += pc[m] * d2v[(m * nu + i) * nu + jx];
+                    }
+                    out.tangent[i * nloc + jx] += s;
                 }
-                out.tangent[i * nloc + jx] += s;
             }
         }
         if exact {
@@ -412,6 +437,13 @@ pub fn cell_size(cell: CellType, x: &[[f64; 3]]) -> f64 {
             (0.5 * area2).abs().sqrt()
         }
     }
+}
+
+/// Whether the pressure term is kept apart per mode (penalty) rather than
+/// folded into the material tangent (exact constraint).
+#[inline]
+fn split_of(np: usize, exact: bool) -> bool {
+    np > 0 && !exact
 }
 
 /// `t = sum_e v_e X[k_e][.]` over the active components.
