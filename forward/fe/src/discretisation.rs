@@ -45,7 +45,8 @@ pub struct ErrorEstimate {
     /// Error of the fine solution: fine - converged.
     pub error: f64,
     /// `error / converged`; `None` where the force is ~0 (below 1e-6 of the
-    /// largest force of the curve).
+    /// largest force of the curve: round-off, such as the unloaded first
+    /// sample, where the error is set to 0).
     pub relative: Option<f64>,
 }
 
@@ -90,13 +91,14 @@ pub fn richardson(
         .zip(coarse)
         .map(|(&f, &c)| {
             let delta = c - f;
-            let error = if delta.abs() <= AGREEMENT * f.abs().max(c.abs()) {
+            let zero = f.abs() <= 1e-6 * scale;
+            let error = if zero || delta.abs() <= AGREEMENT * f.abs().max(c.abs()) {
                 0.0
             } else {
                 delta / factor
             };
             let converged = f - error;
-            let relative = (f.abs() > 1e-6 * scale && converged != 0.0).then(|| error / converged);
+            let relative = (!zero && converged != 0.0).then(|| error / converged);
             ErrorEstimate {
                 converged,
                 error,
@@ -163,13 +165,17 @@ mod tests {
     #[test]
     fn agreement_to_round_off_and_zero_force_are_guarded() {
         // Meshes agreeing to 1e-12 (C1 frictionless: exact on any mesh).
-        let fine = [0.0, 1.0, 2.0];
-        let coarse = [0.0, 1.0 + 1e-12, 2.0 - 3e-12];
+        let fine = [-4e-14, 1.0, 2.0];
+        let coarse = [3e-14, 1.0 + 1e-12, 2.0 - 3e-12];
         let est = richardson(&fine, &coarse, 2.0, 0.58).unwrap();
         for (e, f) in est.iter().zip(&fine) {
             assert_eq!(e.error, 0.0);
             assert_eq!(e.converged, *f);
         }
+        assert_eq!(
+            richardson(&fine, &[0.0, 1.1, 2.2], 2.0, 1.0).unwrap()[0].error,
+            0.0
+        );
         assert_eq!(est[0].relative, None, "no relative error at zero force");
         assert_eq!(est[1].relative, Some(0.0));
         // A shorter coarse curve (stopped early) covers its samples only.
@@ -220,6 +226,7 @@ mod tests {
         let g = c.model.grading.unwrap();
         assert!((g.h_fine - 0.8).abs() < 1e-15 && (g.growth - 1.4).abs() < 1e-15);
         assert_eq!(c.ratio, 2.0);
+        assert_eq!(c.mesh, "0.8 mm elements under the tool, growth 1.4");
         assert!(!n1.convergence_order().source.contains("not for this tool"));
         n1.tool = crate::ToolShape::Sphere { radius: 2.5 };
         assert!(n1.convergence_order().source.contains("not for this tool"));

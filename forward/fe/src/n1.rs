@@ -197,7 +197,8 @@ impl N1Needle {
             ratio: 2.0,
             mesh: format!(
                 "{} mm elements under the tool, growth {}",
-                coarse.h_fine, coarse.growth
+                round6(coarse.h_fine),
+                round6(coarse.growth)
             ),
         }
     }
@@ -232,6 +233,11 @@ impl N1Needle {
         let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
         Ok((sim, sys))
     }
+}
+
+/// `x` to six decimals, for messages (0.4 rather than 0.4000000000000001).
+fn round6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
 }
 
 impl Setup for N1Needle {
