@@ -211,7 +211,7 @@ impl N1Needle {
     /// estimate errs on the large side.
     pub fn convergence_order(&self) -> ConvergenceOrder {
         let mut source =
-            "docs/validation/fe.md N1 needle (levels 2, 3, 5, friction 0.8, at 10 mm)".to_string();
+            "docs/validation/fe.md N1 speed (levels 2, 3, 5, friction 0.8, at 10 mm)".to_string();
         if self.tool != ToolShape::n1_needle() {
             source.push_str("; measured for the needle, not for this tool");
         }
