@@ -201,3 +201,73 @@ fn mesh_zero_is_an_error_in_simulate_and_doe() {
     let o = palpate(&["doe", "--manifest", m.to_str().unwrap()]);
     assert_clean_failure(&o, &["n1_needle.mesh", "\"0\"", "1..12"]);
 }
+
+/// `simulate` states its discretisation error (one coarser solve,
+/// Richardson with the model's documented order) and its volumetric
+/// treatment, on the terminal and in the CSV's `#` lines, which the
+/// project's reader skips; `--error-estimate off` runs one solve only.
+#[test]
+fn simulate_states_its_discretisation_error() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("c1.csv");
+    let base = [
+        "simulate",
+        "--benchmark",
+        "C1",
+        "--bonded",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.001101295",
+        "--mesh",
+        "coarse",
+        "--step",
+        "1",
+        "--csv",
+        csv.to_str().unwrap(),
+    ];
+    let o = palpate(&base);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    let line = "discretisation error (Richardson, order 0.58 from docs/validation/fe.md C1 bonded";
+    for needle in [
+        line,
+        "coarse mesh 10x5",
+        "% at 2 mm",
+        "estimated converged force",
+    ] {
+        assert!(e.contains(needle), "`{needle}` not in: {e}");
+    }
+    assert!(e.contains("volumetric: exact incompressibility"), "{e}");
+    let t = palpate_core::Table::read(&csv).unwrap();
+    assert!(
+        t.comments.iter().any(|c| c.starts_with(line)),
+        "{:?}",
+        t.comments
+    );
+    assert!(t
+        .comments
+        .iter()
+        .any(|c| c.starts_with("volumetric: exact")));
+    let f = t.column("force_N").unwrap();
+    let err = t.column("error_estimate_N").unwrap();
+    assert_eq!(err.len(), 3);
+    // Bonded platens: the coarse mesh is stiffer, the fine one too.
+    assert!(err[2] > 0.0 && err[2] < 0.1 * f[2], "{err:?} of {f:?}");
+
+    let mut off = base.to_vec();
+    off.extend(["--error-estimate", "off", "--bulk", "1000"]);
+    let o = palpate(&off);
+    let e = stderr(&o);
+    assert!(o.status.success(), "{e}");
+    assert!(!e.contains("Richardson"), "{e}");
+    assert!(e.contains("K = 1000 x mu"), "{e}");
+    let t = palpate_core::Table::read(&csv).unwrap();
+    assert!(t.column("error_estimate_N").is_err());
+    assert!(!t.comments.iter().any(|c| c.contains("Richardson")));
+    assert!(t.comments.iter().any(|c| c.contains("K = 1000 x mu")));
+
+    let mut bad = base.to_vec();
+    bad.extend(["--order", "0"]);
+    assert_clean_failure(&palpate(&bad), &["--order"]);
+}

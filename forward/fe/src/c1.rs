@@ -11,6 +11,7 @@ use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, Observable, P
 use palpate_material::Law;
 
 use crate::body::{RegionMaterial, SolidBody};
+use crate::discretisation::{Coarser, ConvergenceOrder};
 use crate::dofs::Dirichlet;
 use crate::kernel::{kernel_for, PressureSpace};
 use crate::kinematics::Kinematics;
@@ -58,6 +59,50 @@ impl C1Fe {
                 max_step: 0.25,
                 first_step: 0.1,
                 ..SolverOptions::default()
+            },
+        }
+    }
+
+    /// The coarser companion of the discretisation error estimate: half the
+    /// elements each way (rounded up, at least one), element-size ratio the
+    /// square root of the ratio of element counts (2 for even counts;
+    /// 19 x 9 -> 10 x 5: 1.85). A 1 x 1 mesh has none.
+    pub fn coarser(&self) -> Result<Coarser<C1Fe>, FeError> {
+        let (nr, nz) = self.elements;
+        let coarse = (nr.div_ceil(2).max(1), nz.div_ceil(2).max(1));
+        if coarse == self.elements {
+            return Err(FeError::InvalidConfig {
+                field: "elements".into(),
+                reason: format!("{nr} x {nz} has no coarser mesh"),
+            });
+        }
+        let ratio = ((nr * nz) as f64 / (coarse.0 * coarse.1) as f64).sqrt();
+        let mut model = self.clone();
+        model.elements = coarse;
+        Ok(Coarser {
+            model,
+            ratio,
+            mesh: format!("{}x{}", coarse.0, coarse.1),
+        })
+    }
+
+    /// The order of convergence of the force with the element size.
+    /// Bonded: 0.58, observed near the bonded edge on meshes 2 / 4 / 8
+    /// (38 x 18, 76 x 36, 152 x 72), reduced polynomial N = 2, at 2 mm:
+    /// 29.81 / 29.09 / 28.61 N (docs/validation/fe.md, "C1 bonded mesh
+    /// convergence"). Frictionless: the deformation is homogeneous and Q1/P0
+    /// is exact on any mesh (tests/c1_frictionless.rs); the two meshes agree
+    /// to round-off and the estimate is zero whatever the order (2 stated,
+    /// the element's nominal order).
+    pub fn convergence_order(&self) -> ConvergenceOrder {
+        match self.platens {
+            Platens::Bonded => ConvergenceOrder {
+                order: 0.58,
+                source: "docs/validation/fe.md C1 bonded (meshes 2, 4, 8, at 2 mm)".into(),
+            },
+            Platens::Frictionless => ConvergenceOrder {
+                order: 2.0,
+                source: "nominal Q1; frictionless C1 is homogeneous, exact on any mesh".into(),
             },
         }
     }

@@ -20,7 +20,8 @@
 //! * [`system`], [`stepper`] — Newton (chord steps, line search) on a faer
 //!   sparse LU that keeps its symbolic factorisation, apart from the
 //!   stepper (channels along a path with time, cut-back, partial results).
-//! * [`n1`], [`c1`] — the forward models.
+//! * [`n1`], [`c1`] — the forward models; [`discretisation`] — the
+//!   Richardson estimate of their discretisation error from one coarser solve.
 
 // Index loops mirror the index notation of the equations; negated comparisons
 // (`!(x > 0.0)`) deliberately treat NaN as failure.
@@ -35,6 +36,7 @@ pub mod body;
 pub mod c1;
 pub mod contact;
 pub mod contribution;
+pub mod discretisation;
 pub mod dofs;
 pub mod error;
 pub mod kernel;
@@ -55,6 +57,7 @@ pub mod vtu;
 
 pub use c1::{C1Fe, Platens};
 pub use contact::ContactPoints;
+pub use discretisation::{Coarser, ConvergenceOrder, ErrorEstimate};
 pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
