@@ -11,6 +11,7 @@
 //! friction = 0.8              # Coulomb coefficient needle/material
 //! mesh = "coarse"             # coarse | medium | fine | N (N = 1..12)
 //! bulk = "exact"              # exact | K/mu ratio such as 1000
+//! element = "quad4"            # quad4 (Q1/P0) | quad9 (Q2/P1), N1 only
 //! base = "bonded"             # bonded | sliding
 //! tool = "needle"             # needle | sphere:R | punch:R | platen
 //!
@@ -40,7 +41,7 @@
 use crate::calibration::TestKind;
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Effect, ForwardModel};
-use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens, ToolShape};
+use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, ToolShape};
 use palpate_material::Law;
 use serde::Deserialize;
 use std::fmt;
@@ -119,6 +120,10 @@ pub struct N1NeedleSpec {
     /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
     #[serde(default)]
     pub tool: Option<String>,
+    /// `quad4` (default: 4-node Q1/P0) or `quad9` (9-node Q2/P1 on the
+    /// same grading, each cell made quadratic).
+    #[serde(default)]
+    pub element: Option<String>,
 }
 
 /// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
@@ -298,6 +303,18 @@ impl ModelSpec {
                     }
                 };
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
+                m.element = match s.element.as_deref().unwrap_or("quad4") {
+                    "quad4" => N1Element::Quad4,
+                    "quad9" => N1Element::Quad9,
+                    other => {
+                        return Err(ModelError::new(
+                            K,
+                            "element",
+                            other,
+                            "expected quad4 or quad9",
+                        ))
+                    }
+                };
                 Model::N1Needle(m)
             }
         })
@@ -488,6 +505,10 @@ mod tests {
             ModelSpec::N1Needle(s).validate().unwrap_err().to_string()
         };
         assert!(n1(|s| s.law = "neo".into()).starts_with("n1_needle.law = \"neo\""));
+        assert!(
+            n1(|s| s.element = Some("quad8".into())).contains("element"),
+            "a misspelled element is named"
+        );
         assert!(n1(|s| s.friction = Some(-0.1)).starts_with("n1_needle.friction"));
         assert!(n1(|s| s.bulk = Some("0".into())).starts_with("n1_needle.bulk"));
         assert!(n1(|s| s.base = Some("glued".into())).starts_with("n1_needle.base"));

@@ -44,6 +44,9 @@ pub struct Args {
     /// N1 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
+    /// N1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4].
+    #[arg(long, value_name = "quad4|quad9")]
+    pub element: Option<String>,
     /// Final tool displacement in mm (default: 10 for N1, 2 for C1).
     #[arg(long)]
     pub depth: Option<f64>,
@@ -122,6 +125,7 @@ pub fn model_spec(args: &Args) -> ModelSpec {
             bulk: args.bulk.clone(),
             base: args.sliding_base.then(|| "sliding".into()),
             tool: args.tool.clone(),
+            element: args.element.clone(),
         })
     } else {
         ModelSpec::C1Fe(C1FeSpec {
