@@ -7,7 +7,9 @@
 //!   history and turns parameters plus a [`Loading`] into predictions.
 //! * [`ParamSpace`] — named physical parameters with bounds and the transform
 //!   to the unbounded space that estimators and samplers move in.
-//! * [`Loading`] — the loading history (time and drive samples).
+//! * [`Loading`] — the loading history (time and drive samples);
+//!   [`Output`] — one of the quantities a model predicts at each sample
+//!   (most models have one; [`ForwardModel::outputs`]).
 //! * [`Effect`] — the canonical names of unmodelled effects (see `GAP.md`);
 //!   [`Enrichable`] — the capability of a model that can add them.
 //! * [`fd`] — finite-difference Jacobians (one step rule for every crate).
@@ -30,6 +32,6 @@ pub use data::{Column, DataError, Table, TextTable};
 pub use effect::Effect;
 pub use enrichable::Enrichable;
 pub use error::ForwardError;
-pub use loading::{Drive, Loading, Observable};
-pub use model::{Evaluator, ForwardModel, ModelExt};
+pub use loading::{Drive, Loading, Observable, Output};
+pub use model::{check_output_slots, Evaluator, ForwardModel, ModelExt};
 pub use param::{ParamSpace, ParamSpec, Transform};

@@ -34,6 +34,51 @@ impl Observable {
     }
 }
 
+/// One output of a model: what it is ([`Observable`]: quantity, unit and
+/// sign) and the column it goes to in data files and reports.
+///
+/// Conventions (every model and wrapper keeps them):
+///
+/// * A model has at least one output ([`crate::ForwardModel::outputs`]). The
+///   **first** is the one [`crate::Evaluator::predict_into`] gives, whose
+///   observable is [`crate::ForwardModel::observable`]: estimators, studies
+///   and the gap diagnosis, which see one output, see that one. For a tool
+///   driven into the body it is the force along the drive, positive in
+///   compression, so that enrichments acting on the drive (zero offset, tool
+///   compliance) act on it.
+/// * `name` is unique within a model and ends in the unit: `force_N` (the
+///   first output of a one-output model, [`Observable::column`]), `force_x_N`
+///   (a force component along the global x axis, positive along +x),
+///   `force_y_N`.
+/// * Several outputs per sample are laid out samples x outputs, row-major:
+///   output `j` at sample `i` is `out[i * outputs + j]`
+///   ([`crate::Evaluator::predict_outputs_into`]).
+#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Output {
+    /// Column name, e.g. `force_N`, `force_x_N`.
+    pub name: String,
+    /// Quantity, unit and sign convention of the values.
+    pub observable: Observable,
+}
+
+impl Output {
+    /// An output named `name` observing `observable`.
+    pub fn new(name: impl Into<String>, observable: Observable) -> Self {
+        Output {
+            name: name.into(),
+            observable,
+        }
+    }
+}
+
+impl From<Observable> for Output {
+    /// The single output of a one-output model: named by
+    /// [`Observable::column`].
+    fn from(observable: Observable) -> Self {
+        Output::new(observable.column(), observable)
+    }
+}
+
 impl Drive {
     /// Column name used in data files and reports.
     pub fn column(self) -> &'static str {

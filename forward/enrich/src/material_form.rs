@@ -4,7 +4,8 @@
 use crate::convert::law_space;
 use palpate_core::enrichable::{effects_of, enrich};
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
+    ParamSpace,
 };
 use palpate_material::Law;
 
@@ -69,8 +70,8 @@ pub fn richer_law(law: &Law) -> Option<RicherLaw> {
 }
 
 /// A model with a richer law, which knows the "off" point that reproduces
-/// the base law: [`ForwardModel::embed`] appends the vanishing terms. Every
-/// other method delegates to the wrapped model.
+/// the base law: [`Enrichable::embed`] appends the vanishing terms. Every
+/// other method delegates to the wrapped model (its outputs included).
 pub struct MaterialForm {
     inner: Box<dyn ForwardModel>,
     off_tail: Vec<f64>,
@@ -113,6 +114,15 @@ impl Evaluator for MaterialFormEvaluator<'_> {
         self.space.check(theta)?;
         self.inner.predict_into(theta, loading, out)
     }
+    fn predict_outputs_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        self.space.check(theta)?;
+        self.inner.predict_outputs_into(theta, loading, out)
+    }
 }
 
 impl ForwardModel for MaterialForm {
@@ -124,6 +134,9 @@ impl ForwardModel for MaterialForm {
     }
     fn observable(&self) -> Observable {
         self.inner.observable()
+    }
+    fn outputs(&self) -> Vec<Output> {
+        self.inner.outputs()
     }
     fn expensive(&self) -> bool {
         self.inner.expensive()

@@ -4,8 +4,8 @@
 use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
-    ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
+    ParamSpace, ParamSpec,
 };
 use std::sync::Arc;
 
@@ -25,6 +25,11 @@ const MAX_ITERATIONS: usize = 60;
 /// estimated by shifting the whole history; for a rate-independent model
 /// that slope is exact, for a history-dependent one it is an approximation
 /// that still converges (the residual is checked to 1e-10 mm).
+///
+/// The spring is loaded by the wrapped model's first output, the force
+/// along the drive ([`palpate_core::Output`]). A wrapped model with several
+/// outputs keeps them: u is solved with the first, and every output is the
+/// wrapped model's at that u (e.g. the horizontal force at the true travel).
 pub struct ToolCompliance {
     base: Arc<dyn ForwardModel>,
     space: ParamSpace,
@@ -55,37 +60,60 @@ struct ToolComplianceEvaluator<'a> {
     shifted: Vec<f64>,
 }
 
-impl Evaluator for ToolComplianceEvaluator<'_> {
-    fn predict_into(
+impl ToolComplianceEvaluator<'_> {
+    /// The wrapped model on `loading`: its first output (`k == 1`) or its
+    /// `k` outputs per sample.
+    fn base_at(
+        base: &mut (dyn Evaluator + '_),
+        theta: &[f64],
+        loading: &Loading,
+        k: usize,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        if k == 1 {
+            base.predict_into(theta, loading, out)
+        } else {
+            base.predict_outputs_into(theta, loading, out)
+        }
+    }
+
+    /// Solves the travel and writes the wrapped model's `k` outputs at it
+    /// (`out` holds `loading.len() * k` values; the spring takes column 0).
+    fn solve(
         &mut self,
         theta: &[f64],
         loading: &Loading,
+        k: usize,
         out: &mut [f64],
     ) -> Result<(), ForwardError> {
         let (base_theta, own) = split(theta, &self.model.space, 1)?;
         let c = own[0];
-        if c == 0.0 {
-            return self.base.predict_into(base_theta, loading, out);
-        }
         let n = loading.len();
-        if out.len() != n {
-            return Err(ForwardError::InvalidLoading(format!(
-                "output has {} slots for {n} samples",
-                out.len()
-            )));
+        if out.len() != n * k {
+            return Err(ForwardError::InvalidLoading(if k == 1 {
+                format!("output has {} slots for {n} samples", out.len())
+            } else {
+                format!(
+                    "output has {} slots for {n} samples x {k} outputs",
+                    out.len()
+                )
+            }));
+        }
+        let base = self.base.as_mut();
+        if c == 0.0 {
+            return Self::base_at(base, base_theta, loading, k, out);
         }
         let scale = 1.0 + loading.drive.iter().fold(0.0f64, |a, d| a.max(d.abs()));
         let h = 1e-7 * scale;
         let tol = 1e-10 * scale;
         let mut u = loading.drive.clone();
-        self.shifted.resize(n, 0.0);
+        self.shifted.resize(n * k, 0.0);
         let mut worst_sample = 0;
         for _ in 0..MAX_ITERATIONS {
-            self.base
-                .predict_into(base_theta, &loading.with_drive(u.clone()), out)?;
+            Self::base_at(base, base_theta, &loading.with_drive(u.clone()), k, out)?;
             let (mut worst, mut at) = (0.0f64, 0);
             for i in 0..n {
-                let r = (u[i] + c * out[i] - loading.drive[i]).abs();
+                let r = (u[i] + c * out[i * k] - loading.drive[i]).abs();
                 if r > worst {
                     (worst, at) = (r, i);
                 }
@@ -95,23 +123,26 @@ impl Evaluator for ToolComplianceEvaluator<'_> {
                 return Ok(());
             }
             let plus: Vec<f64> = u.iter().map(|x| x + h).collect();
-            self.base
-                .predict_into(base_theta, &loading.with_drive(plus), &mut self.shifted)?;
+            Self::base_at(
+                base,
+                base_theta,
+                &loading.with_drive(plus),
+                k,
+                &mut self.shifted,
+            )?;
             let mut largest_update = 0.0f64;
             for i in 0..n {
-                let slope = (self.shifted[i] - out[i]) / h;
+                let slope = (self.shifted[i * k] - out[i * k]) / h;
                 let denom = 1.0 + c * slope;
                 let denom = if denom > 0.05 { denom } else { 1.0 };
-                let du = (u[i] + c * out[i] - loading.drive[i]) / denom;
+                let du = (u[i] + c * out[i * k] - loading.drive[i]) / denom;
                 u[i] -= du;
                 largest_update = largest_update.max(du.abs());
             }
             // For a stiff specimen (c F'(u) >> 1) the residual cannot fall below
             // c F' x (round-off of u); the travel u itself is then converged.
             if largest_update <= 1e-13 * scale {
-                return self
-                    .base
-                    .predict_into(base_theta, &loading.with_drive(u), out);
+                return Self::base_at(base, base_theta, &loading.with_drive(u), k, out);
             }
         }
         Err(ForwardError::NotConverged {
@@ -126,6 +157,26 @@ impl Evaluator for ToolComplianceEvaluator<'_> {
     }
 }
 
+impl Evaluator for ToolComplianceEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        self.solve(theta, loading, 1, out)
+    }
+    fn predict_outputs_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let k = self.model.base.outputs().len();
+        self.solve(theta, loading, k, out)
+    }
+}
+
 impl ForwardModel for ToolCompliance {
     fn name(&self) -> String {
         format!("{} + tool compliance", self.base.name())
@@ -135,6 +186,9 @@ impl ForwardModel for ToolCompliance {
     }
     fn observable(&self) -> Observable {
         self.base.observable()
+    }
+    fn outputs(&self) -> Vec<Output> {
+        self.base.outputs()
     }
     fn expensive(&self) -> bool {
         self.base.expensive()

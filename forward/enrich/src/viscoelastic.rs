@@ -3,8 +3,8 @@
 use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
-    ParamSpec,
+    check_output_slots, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading,
+    Observable, Output, ParamSpace, ParamSpec,
 };
 use std::sync::Arc;
 
@@ -16,10 +16,13 @@ use std::sync::Arc;
 /// model's prediction at the same samples. For homogeneous tests the force is
 /// proportional to the stress, so this is exact there; for a structure
 /// (indentation) it is the usual QLV approximation applied to the force.
+/// A wrapped model with several outputs (force components) keeps them: the
+/// same relaxation function acts on each, F_j(t) = int G dFe_j, as it does on
+/// each component of a force vector under the force-level approximation.
 ///
 /// Parameters: the wrapped model's, then `g1, tau1_s, g2, tau2_s, ...` with
 /// g_i in [0, 1], sum g_i <= 1 and tau_i > 0 (checked: an error, never a
-/// clamp). g_i = 0 switches the effect off ([`ForwardModel::embed`]). Needs
+/// clamp). g_i = 0 switches the effect off ([`Enrichable::embed`]). Needs
 /// `loading.time`.
 ///
 /// Label switching: the response is symmetric in the terms, so the model
@@ -151,15 +154,20 @@ struct ViscoelasticEvaluator<'a> {
     model: &'a Viscoelastic,
     base: Box<dyn Evaluator + 'a>,
     fe: Vec<f64>,
+    column: Vec<f64>,
+    relaxed: Vec<f64>,
 }
 
-impl Evaluator for ViscoelasticEvaluator<'_> {
-    fn predict_into(
-        &mut self,
-        theta: &[f64],
-        loading: &Loading,
-        out: &mut [f64],
-    ) -> Result<(), ForwardError> {
+/// The wrapped model's part of `theta`, the Prony parameters and the times.
+type Checked<'t, 'l> = (&'t [f64], &'t [f64], &'l [f64]);
+
+impl ViscoelasticEvaluator<'_> {
+    /// Checks the parameters and the history.
+    fn check<'t, 'l>(
+        &self,
+        theta: &'t [f64],
+        loading: &'l Loading,
+    ) -> Result<Checked<'t, 'l>, ForwardError> {
         let m = self.model;
         let (base_theta, prony) = split(theta, &m.space, 2 * m.terms)?;
         if m.terms > 0 {
@@ -171,6 +179,18 @@ impl Evaluator for ViscoelasticEvaluator<'_> {
             )
         })?;
         loading.validate().map_err(ForwardError::InvalidLoading)?;
+        Ok((base_theta, prony, time))
+    }
+}
+
+impl Evaluator for ViscoelasticEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let (base_theta, prony, time) = self.check(theta, loading)?;
         if out.len() != loading.len() {
             return Err(ForwardError::InvalidLoading(format!(
                 "output has {} slots for {} samples",
@@ -181,6 +201,37 @@ impl Evaluator for ViscoelasticEvaluator<'_> {
         self.fe.resize(loading.len(), 0.0);
         self.base.predict_into(base_theta, loading, &mut self.fe)?;
         qlv_convolve(time, &self.fe, prony, out);
+        Ok(())
+    }
+
+    /// Each output column convolved with the same relaxation function.
+    fn predict_outputs_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let k = self.model.base.outputs().len();
+        if k == 1 {
+            return self.predict_into(theta, loading, out);
+        }
+        let (base_theta, prony, time) = self.check(theta, loading)?;
+        let n = loading.len();
+        check_output_slots(out.len(), n, k)?;
+        self.fe.resize(n * k, 0.0);
+        self.base
+            .predict_outputs_into(base_theta, loading, &mut self.fe)?;
+        self.column.resize(n, 0.0);
+        self.relaxed.resize(n, 0.0);
+        for j in 0..k {
+            for i in 0..n {
+                self.column[i] = self.fe[i * k + j];
+            }
+            qlv_convolve(time, &self.column, prony, &mut self.relaxed);
+            for i in 0..n {
+                out[i * k + j] = self.relaxed[i];
+            }
+        }
         Ok(())
     }
 }
@@ -195,6 +246,9 @@ impl ForwardModel for Viscoelastic {
     fn observable(&self) -> Observable {
         self.base.observable()
     }
+    fn outputs(&self) -> Vec<Output> {
+        self.base.outputs()
+    }
     fn expensive(&self) -> bool {
         self.base.expensive()
     }
@@ -203,6 +257,8 @@ impl ForwardModel for Viscoelastic {
             model: self,
             base: self.base.evaluator(),
             fe: Vec::new(),
+            column: Vec::new(),
+            relaxed: Vec::new(),
         })
     }
     fn as_enrichable(&self) -> Option<&dyn Enrichable> {

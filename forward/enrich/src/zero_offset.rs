@@ -4,16 +4,18 @@
 use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
-    ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
+    ParamSpace, ParamSpec,
 };
+use std::borrow::Cow;
 use std::sync::Arc;
 
 /// F(d) = base(max(d - d0, 0)): contact starts at recorded displacement `d0`
 /// (positive: the tool travels `d0` before touching; negative: the specimen
 /// was already pre-compressed by `-d0` at the recorded zero). One parameter
 /// `d0_mm` in [-5, 5] mm, off at d0 = 0 (an interior point, so sensitivities
-/// exist there). The wrapped model sees the shifted history, times unchanged.
+/// exist there). The wrapped model sees the shifted history, times unchanged;
+/// it has the wrapped model's outputs, every one at the shifted history.
 pub struct ZeroOffset {
     base: Arc<dyn ForwardModel>,
     space: ParamSpace,
@@ -39,6 +41,16 @@ struct ZeroOffsetEvaluator<'a> {
     base: Box<dyn Evaluator + 'a>,
 }
 
+/// The history the wrapped model sees: the drive shifted by `d0` (none when
+/// `d0 == 0`, so "off" is the base model exactly).
+fn shifted(loading: &Loading, d0: f64) -> Cow<'_, Loading> {
+    if d0 == 0.0 {
+        Cow::Borrowed(loading)
+    } else {
+        Cow::Owned(loading.with_drive(loading.drive.iter().map(|d| (d - d0).max(0.0)).collect()))
+    }
+}
+
 impl Evaluator for ZeroOffsetEvaluator<'_> {
     fn predict_into(
         &mut self,
@@ -47,12 +59,18 @@ impl Evaluator for ZeroOffsetEvaluator<'_> {
         out: &mut [f64],
     ) -> Result<(), ForwardError> {
         let (base_theta, own) = split(theta, &self.model.space, 1)?;
-        let d0 = own[0];
-        if d0 == 0.0 {
-            return self.base.predict_into(base_theta, loading, out);
-        }
-        let shifted = loading.with_drive(loading.drive.iter().map(|d| (d - d0).max(0.0)).collect());
-        self.base.predict_into(base_theta, &shifted, out)
+        self.base
+            .predict_into(base_theta, &shifted(loading, own[0]), out)
+    }
+    fn predict_outputs_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let (base_theta, own) = split(theta, &self.model.space, 1)?;
+        self.base
+            .predict_outputs_into(base_theta, &shifted(loading, own[0]), out)
     }
 }
 
@@ -65,6 +83,9 @@ impl ForwardModel for ZeroOffset {
     }
     fn observable(&self) -> Observable {
         self.base.observable()
+    }
+    fn outputs(&self) -> Vec<Output> {
+        self.base.outputs()
     }
     fn expensive(&self) -> bool {
         self.base.expensive()

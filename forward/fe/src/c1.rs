@@ -195,6 +195,7 @@ impl ForwardModel for C1Fe {
         Box::new(FeEvaluator {
             setup: self,
             space: &self.space,
+            outputs: self.outputs().len(),
             system: None,
         })
     }

@@ -3,7 +3,9 @@
 //! (mesh, pattern, symbolic factorisation, scratch) between calls, and the
 //! conversion of solver failures into [`ForwardError`].
 
-use palpate_core::{Drive, Evaluator, ForwardError, Loading, ParamSpace, ParamSpec};
+use palpate_core::{
+    check_output_slots, Drive, Evaluator, ForwardError, Loading, ParamSpace, ParamSpec,
+};
 use palpate_material::{Law, Volumetric};
 
 use std::sync::Arc;
@@ -74,8 +76,9 @@ pub(crate) trait Setup: Send + Sync {
         material: RegionMaterial,
         extra: &[f64],
     ) -> Result<(), FeError>;
-    /// The outputs of a converged state; the first is the force a
-    /// single-output model predicts.
+    /// The outputs of a converged state: as many as the model's
+    /// [`palpate_core::ForwardModel::outputs`], in that order (the
+    /// evaluator checks); the first is the force a one-output consumer sees.
     fn observe(&self, sys: &System) -> Vec<f64>;
 }
 
@@ -95,7 +98,9 @@ pub(crate) fn to_forward(e: FeError) -> ForwardError {
     }
 }
 
-fn failure(f: RunFailure) -> ForwardError {
+/// A failed run as a [`ForwardError`]; `completed` holds the first output of
+/// each converged sample, or (`all_outputs`) every output, row-major.
+fn failure(f: RunFailure, all_outputs: bool) -> ForwardError {
     match f.error {
         FeError::InvalidConfig { .. }
         | FeError::InvalidMesh { .. }
@@ -106,12 +111,18 @@ fn failure(f: RunFailure) -> ForwardError {
             drive: f.drive,
             cuts: f.cuts,
             reason: e.to_string(),
-            completed: f.completed.iter().map(|o| o[0]).collect(),
+            completed: if all_outputs {
+                f.completed.concat()
+            } else {
+                f.completed.iter().map(|o| o[0]).collect()
+            },
         },
     }
 }
 
-/// Runs one loading history on `sys` (built by `setup`).
+/// Runs one loading history on `sys` (built by `setup`); a
+/// [`ForwardError::NotConverged`] keeps the first output of the converged
+/// samples.
 pub(crate) fn simulate(
     setup: &dyn Setup,
     space: &ParamSpace,
@@ -119,6 +130,20 @@ pub(crate) fn simulate(
     theta: &[f64],
     loading: &Loading,
     progress: Option<&mut dyn FnMut(&Progress)>,
+) -> Result<Simulation, ForwardError> {
+    simulate_with(setup, space, sys, theta, loading, progress, false)
+}
+
+/// [`simulate`]; with `all_outputs`, a failure keeps every output of the
+/// converged samples (samples x outputs, row-major).
+fn simulate_with(
+    setup: &dyn Setup,
+    space: &ParamSpace,
+    sys: &mut System,
+    theta: &[f64],
+    loading: &Loading,
+    progress: Option<&mut dyn FnMut(&Progress)>,
+    all_outputs: bool,
 ) -> Result<Simulation, ForwardError> {
     space.check(theta)?;
     if loading.drive_kind != Drive::DisplacementMm {
@@ -142,8 +167,8 @@ pub(crate) fn simulate(
         .map_err(to_forward)?;
     let path = LoadPath::from_drive(&loading.drive);
     let mut observe = |s: &System| setup.observe(s);
-    let outputs =
-        stepper::run(sys, &path, &setup.options(), &mut observe, progress).map_err(failure)?;
+    let outputs = stepper::run(sys, &path, &setup.options(), &mut observe, progress)
+        .map_err(|f| failure(f, all_outputs))?;
     Ok(Simulation {
         forces: outputs.iter().map(|o| o[0]).collect(),
         outputs,
@@ -152,11 +177,46 @@ pub(crate) fn simulate(
 }
 
 /// The per-thread evaluator of an FE model: the system is built on first use
-/// and kept (pattern, symbolic LU, scratch) for every later call.
+/// and kept (pattern, symbolic LU, scratch) for every later call. Every
+/// output [`Setup::observe`] returns is read at each sample;
+/// `predict_into` gives the first, `predict_outputs_into` all of them.
 pub(crate) struct FeEvaluator<'a> {
     pub setup: &'a dyn Setup,
     pub space: &'a ParamSpace,
+    /// The number of outputs the model declares
+    /// ([`palpate_core::ForwardModel::outputs`]), which `observe` returns.
+    pub outputs: usize,
     pub system: Option<System>,
+}
+
+impl FeEvaluator<'_> {
+    /// The simulation of `loading`, on the system built at first use.
+    fn run(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        all_outputs: bool,
+    ) -> Result<Simulation, ForwardError> {
+        if self.system.is_none() {
+            self.system = Some(self.setup.build().map_err(to_forward)?);
+        }
+        let sys = self
+            .system
+            .as_mut()
+            .ok_or_else(|| ForwardError::InvalidConfig {
+                field: "fe".into(),
+                reason: "system unavailable".into(),
+            })?;
+        simulate_with(
+            self.setup,
+            self.space,
+            sys,
+            theta,
+            loading,
+            None,
+            all_outputs,
+        )
+    }
 }
 
 impl Evaluator for FeEvaluator<'_> {
@@ -173,18 +233,183 @@ impl Evaluator for FeEvaluator<'_> {
                 loading.len()
             )));
         }
-        if self.system.is_none() {
-            self.system = Some(self.setup.build().map_err(to_forward)?);
-        }
-        let sys = self
-            .system
-            .as_mut()
-            .ok_or_else(|| ForwardError::InvalidConfig {
-                field: "fe".into(),
-                reason: "system unavailable".into(),
-            })?;
-        let sim = simulate(self.setup, self.space, sys, theta, loading, None)?;
+        let sim = self.run(theta, loading, false)?;
         out.copy_from_slice(&sim.forces);
         Ok(())
+    }
+
+    fn predict_outputs_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        let k = self.outputs;
+        check_output_slots(out.len(), loading.len(), k)?;
+        let sim = self.run(theta, loading, true)?;
+        for (row, values) in out.chunks_mut(k.max(1)).zip(&sim.outputs) {
+            if values.len() != k {
+                return Err(ForwardError::InvalidConfig {
+                    field: "outputs".into(),
+                    reason: format!(
+                        "the model declares {k} outputs but observes {}",
+                        values.len()
+                    ),
+                });
+            }
+            row.copy_from_slice(values);
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{C1Fe, Platens};
+    use palpate_core::{ForwardModel, Observable, Output};
+    use palpate_enrich::ZeroOffset;
+
+    /// Bonded C1 observing both platens: the reaction of the driven top
+    /// platen (C1's force) and the sum of the internal forces along y on the
+    /// bottom face, which equilibrium makes equal to it. `declared` is the
+    /// number of outputs it claims (2, or wrong on purpose).
+    struct BothPlatens {
+        c1: C1Fe,
+        declared: usize,
+    }
+
+    impl Setup for BothPlatens {
+        fn law(&self) -> &Law {
+            self.c1.law()
+        }
+        fn bulk(&self) -> Bulk {
+            self.c1.bulk()
+        }
+        fn options(&self) -> SolverOptions {
+            Setup::options(&self.c1)
+        }
+        fn build(&self) -> Result<System, FeError> {
+            self.c1.build()
+        }
+        fn prepare(
+            &self,
+            sys: &mut System,
+            material: RegionMaterial,
+            extra: &[f64],
+        ) -> Result<(), FeError> {
+            self.c1.prepare(sys, material, extra)
+        }
+        fn observe(&self, sys: &System) -> Vec<f64> {
+            let fint = sys.internal_forces();
+            let bottom = sys.mesh.node_set("bottom").expect("C1 has a bottom");
+            let d = sys.dofs.dim;
+            vec![
+                sys.channel_reaction(0),
+                bottom.iter().map(|&n| fint[n * d + 1]).sum(),
+            ]
+        }
+    }
+
+    impl ForwardModel for BothPlatens {
+        fn name(&self) -> String {
+            "C1 observing both platens".into()
+        }
+        fn space(&self) -> &ParamSpace {
+            self.c1.space()
+        }
+        fn observable(&self) -> Observable {
+            Observable::ForceN
+        }
+        fn outputs(&self) -> Vec<Output> {
+            let mut v = vec![
+                Output::new("force_N", Observable::ForceN),
+                Output::new("force_bottom_N", Observable::ForceN),
+            ];
+            v.resize(
+                self.declared,
+                Output::new("force_extra_N", Observable::ForceN),
+            );
+            v
+        }
+        fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+            Box::new(FeEvaluator {
+                setup: self,
+                space: self.c1.space(),
+                outputs: self.outputs().len(),
+                system: None,
+            })
+        }
+        fn expensive(&self) -> bool {
+            true
+        }
+    }
+
+    fn c1() -> C1Fe {
+        let mut c1 = C1Fe::new(Law::NeoHookean, Platens::Bonded);
+        c1.elements = (4, 2);
+        c1
+    }
+
+    const NH: [f64; 1] = [1101.295e-6];
+
+    /// The FE evaluator writes every observed output per sample, row-major;
+    /// the first column is the one-output prediction, bit for bit.
+    #[test]
+    fn fe_evaluator_writes_every_output_per_sample() {
+        let m = BothPlatens {
+            c1: c1(),
+            declared: 2,
+        };
+        let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.5, 1.0, 1.5]);
+        let columns = m.predict_outputs(&NH, &loading).unwrap();
+        assert_eq!(columns.len(), 2);
+        let one = c1().predict(&NH, &loading).unwrap();
+        assert!(one[2] > one[0] && one[0] > 0.0, "{one:?}");
+        assert_eq!(columns[0], one);
+        assert_eq!(m.predict(&NH, &loading).unwrap(), one);
+        // equilibrium: the bottom carries what the top platen pushes
+        for (top, bottom) in columns[0].iter().zip(&columns[1]) {
+            assert!(
+                (top - bottom).abs() <= 1e-7 * top,
+                "top {top} bottom {bottom}"
+            );
+        }
+        let mut ev = m.evaluator();
+        let mut rows = vec![0.0; 6];
+        ev.predict_outputs_into(&NH, &loading, &mut rows).unwrap();
+        for i in 0..3 {
+            assert_eq!(
+                [rows[2 * i], rows[2 * i + 1]],
+                [columns[0][i], columns[1][i]]
+            );
+        }
+        let err = ev
+            .predict_outputs_into(&NH, &loading, &mut [0.0; 3])
+            .unwrap_err();
+        assert!(err.to_string().contains("3 samples x 2 outputs"), "{err}");
+        drop(ev);
+
+        // a wrapper keeps both outputs
+        let offset = ZeroOffset::from_arc(Arc::new(m));
+        assert_eq!(offset.outputs()[1].name, "force_bottom_N");
+        let off = offset.predict_outputs(&[NH[0], 0.0], &loading).unwrap();
+        assert_eq!(off, columns);
+    }
+
+    /// A model whose `outputs` and `observe` disagree is told so.
+    #[test]
+    fn declared_and_observed_outputs_must_agree() {
+        let m = BothPlatens {
+            c1: c1(),
+            declared: 3,
+        };
+        let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.5]);
+        let err = m.predict_outputs(&NH, &loading).unwrap_err();
+        assert!(
+            err.to_string()
+                .contains("declares 3 outputs but observes 2"),
+            "{err}"
+        );
     }
 }

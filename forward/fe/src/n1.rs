@@ -373,6 +373,7 @@ impl ForwardModel for N1Needle {
         Box::new(FeEvaluator {
             setup: self,
             space: &self.space,
+            outputs: self.outputs().len(),
             system: None,
         })
     }

@@ -4,7 +4,7 @@
 
 use super::GapError;
 use palpate_core::{
-    Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+    Evaluator, ForwardError, ForwardModel, Loading, Observable, Output, ParamSpace, ParamSpec,
 };
 use palpate_inverse::{
     fit, DataSet, FdOptions, FitOptions, FitReport, LmOptions, Method, Objective, ResidualKind,
@@ -68,6 +68,10 @@ impl ForwardModel for Masked {
     }
     fn observable(&self) -> Observable {
         self.inner.observable()
+    }
+    /// The first of the inner model's outputs: the diagnosis fits that one.
+    fn outputs(&self) -> Vec<Output> {
+        self.inner.outputs().into_iter().take(1).collect()
     }
     fn expensive(&self) -> bool {
         self.inner.expensive()
