@@ -41,6 +41,9 @@ pub struct SolidBody {
     first: usize,
     outs: Vec<ElementOutput>,
     u_local: Vec<Vec<[f64; 3]>>,
+    /// Committed material history per cell (the trial history of the last
+    /// assembly is in `outs[k].history`).
+    history: Vec<Vec<f64>>,
 }
 
 impl SolidBody {
@@ -152,6 +155,7 @@ impl SolidBody {
             first: 0,
             outs: vec![ElementOutput::default(); n],
             u_local: vec![vec![[0.0; 3]; np]; n],
+            history: vec![Vec::new(); n],
         })
     }
 
@@ -181,6 +185,8 @@ impl SolidBody {
             });
         }
         self.materials[r] = Some(material);
+        // a new material starts from zero history
+        self.reset(&[]);
         Ok(())
     }
 
@@ -219,6 +225,8 @@ impl SolidBody {
                     material: &*m.material,
                     volumetric: m.volumetric,
                     scale: 0.0,
+                    history: &self.history[k],
+                    dt: 0.0,
                 };
                 self.kernel
                     .mean_cauchy_stress(&input, self.outs[k].pressure)
@@ -290,6 +298,7 @@ impl Contribution for SolidBody {
                 &self.size,
             );
             let (cells, first, npc) = (&self.cells, self.first, self.unknowns_per_cell);
+            let history = &self.history;
             // Cells in parallel into their own buffers; the reduction below
             // is serial in cell order, so results do not depend on the
             // thread count.
@@ -307,6 +316,8 @@ impl Contribution for SolidBody {
                         material: &*m.material,
                         volumetric: m.volumetric,
                         scale: m.material.shear_modulus() / size[k],
+                        history: &history[k],
+                        dt: ctx.dt,
                     };
                     kernel.evaluate(&input, tangent, o)
                 })?;
@@ -328,9 +339,27 @@ impl Contribution for SolidBody {
         Ok(())
     }
 
-    fn commit(&mut self, _ctx: &AssemblyContext) {}
+    /// The trial history of the last assembly (at the converged state)
+    /// becomes the committed history.
+    fn commit(&mut self, _ctx: &AssemblyContext) {
+        for (h, o) in self.history.iter_mut().zip(&self.outs) {
+            h.clone_from(&o.history);
+        }
+    }
 
+    /// Nothing to restore: every assembly recomputes the trial history
+    /// from the committed one.
     fn rollback(&mut self) {}
 
-    fn reset(&mut self, _x0: &[[f64; 3]]) {}
+    /// Zero history for the materials set now.
+    fn reset(&mut self, _x0: &[[f64; 3]]) {
+        let nq = self.kernel.quadrature_points();
+        for (k, h) in self.history.iter_mut().enumerate() {
+            let hl = self.materials[self.region_of[k]]
+                .as_ref()
+                .map_or(0, |m| m.material.history_len());
+            h.clear();
+            h.resize(nq * hl, 0.0);
+        }
+    }
 }

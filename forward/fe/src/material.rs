@@ -16,11 +16,36 @@ pub type StressTangent5 = ([f64; 5], [[f64; 5]; 5]);
 /// First Piola stress and tangent `A = dP/dF` (9 x 9, index `3 i + j` for `F_ij`).
 pub type StressTangent9 = (Matrix3<f64>, SMatrix<f64, 9, 9>);
 
-/// A hyperelastic material at a quadrature point: the isochoric part
-/// `W(J^{-1/3} F)` only.
+/// A material at a quadrature point: the isochoric part `W(J^{-1/3} F)`
+/// only, optionally with history variables.
+///
+/// History follows the FE layer's trial/commit protocol without the
+/// material holding any state: the stress and the new history are pure
+/// functions of the deformation gradient, the committed history `old` and
+/// the time step `dt` ([`PointMaterial::stress_tangent_with_history`],
+/// [`PointMaterial::update_history`]); the body keeps the committed values
+/// and the trial values of the last assembly, so a cut increment simply
+/// recomputes from the committed ones.
 pub trait PointMaterial: Send + Sync {
     /// `P_iso = dW/dF` and `A_iso = dP_iso/dF` at `f`.
     fn iso_stress_tangent(&self, f: &Matrix3<f64>) -> StressTangent9;
+    /// History variables per quadrature point (0: elastic, the default).
+    fn history_len(&self) -> usize {
+        0
+    }
+    /// Stress and tangent (`dP/dF` at fixed `old` and `dt`) at `f` after a
+    /// step `dt` (s) from the committed history `old`. Default: elastic.
+    fn stress_tangent_with_history(
+        &self,
+        f: &Matrix3<f64>,
+        _dt: f64,
+        _old: &[f64],
+    ) -> StressTangent9 {
+        self.iso_stress_tangent(f)
+    }
+    /// The history after a step `dt` to `f` from `old`, into `new`
+    /// (`history_len` values each). Default: nothing to update.
+    fn update_history(&self, _f: &Matrix3<f64>, _dt: f64, _old: &[f64], _new: &mut [f64]) {}
     /// Initial shear modulus (MPa), used to scale penalties and tolerances.
     fn shear_modulus(&self) -> f64;
     /// The five components of `P_iso` and (when `tangent`, else zeros)
@@ -28,6 +53,38 @@ pub trait PointMaterial: Send + Sync {
     /// `[[F00, F01, 0], [F10, F11, 0], [0, 0, F22]]`. The default restricts
     /// [`PointMaterial::iso_stress_tangent`].
     fn iso_stress_tangent_2d(&self, f: &Matrix3<f64>, tangent: bool) -> StressTangent5 {
+        let (p, a) = self.iso_stress_tangent(f);
+        let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
+        let a5 = if tangent {
+            std::array::from_fn(|k| std::array::from_fn(|l| a[(F_COMPONENTS[k], F_COMPONENTS[l])]))
+        } else {
+            [[0.0; 5]; 5]
+        };
+        (p5, a5)
+    }
+}
+
+/// A material seen at one quadrature point with its committed history and
+/// time step: an elastic [`PointMaterial`] for the kinematics, whatever the
+/// material's history (elastic materials keep their fast 2D path).
+pub struct AtPoint<'a> {
+    pub material: &'a dyn PointMaterial,
+    pub old: &'a [f64],
+    pub dt: f64,
+}
+
+impl PointMaterial for AtPoint<'_> {
+    fn iso_stress_tangent(&self, f: &Matrix3<f64>) -> StressTangent9 {
+        self.material
+            .stress_tangent_with_history(f, self.dt, self.old)
+    }
+    fn shear_modulus(&self) -> f64 {
+        self.material.shear_modulus()
+    }
+    fn iso_stress_tangent_2d(&self, f: &Matrix3<f64>, tangent: bool) -> StressTangent5 {
+        if self.material.history_len() == 0 {
+            return self.material.iso_stress_tangent_2d(f, tangent);
+        }
         let (p, a) = self.iso_stress_tangent(f);
         let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
         let a5 = if tangent {

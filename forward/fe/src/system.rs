@@ -101,7 +101,8 @@ pub struct System {
     /// Smallest force scale of the residual test (N), e.g. `1e-6 mu h^2`.
     pub force_floor: f64,
     pub stats: RunStats,
-    /// A test hook: the assembly fails once this many assemblies from now.
+    /// A test hook: every assembly fails once this many have passed, until
+    /// it is cleared.
     #[doc(hidden)]
     pub fail_after: Option<usize>,
 }
@@ -289,7 +290,6 @@ impl System {
     fn assemble_inner(&mut self, target: &Target, tangent: bool) -> Result<Assembled, FeError> {
         if let Some(n) = self.fail_after.as_mut() {
             if *n == 0 {
-                self.fail_after = None;
                 return Err(FeError::NonFiniteStress {
                     element: usize::MAX,
                 });

@@ -43,6 +43,11 @@ pub struct ElementInput<'a> {
     /// Multiplier scale `s` (MPa per unit multiplier, typically `mu / h_e`)
     /// so that the constraint rows have the magnitude of the force rows.
     pub scale: f64,
+    /// Committed material history, `material.history_len()` values per
+    /// quadrature point in rule order (empty for elastic materials).
+    pub history: &'a [f64],
+    /// Time step of the increment (s; 0 for rate-independent histories).
+    pub dt: f64,
 }
 
 /// Residual and tangent of one cell, local dof order.
@@ -57,6 +62,9 @@ pub struct ElementOutput {
     pub ref_volume: f64,
     /// Pressure (mean stress, MPa, tension positive) at the cell centre.
     pub pressure: f64,
+    /// Trial material history at the quadrature points (same layout as
+    /// [`ElementInput::history`]).
+    pub history: Vec<f64>,
     /// Work space of the kernel, kept between calls.
     pub(crate) scratch: Scratch,
 }
@@ -119,6 +127,8 @@ pub trait ElementKernel: Send + Sync {
         tangent: bool,
         out: &mut ElementOutput,
     ) -> Result<(), FeError>;
+    /// Number of quadrature points of a cell.
+    fn quadrature_points(&self) -> usize;
     /// Reference volume of a cell (mm^3; per radian x 2 pi in axisymmetry).
     fn reference_volume(&self, x: &[[f64; 3]]) -> Result<f64, FeError>;
     /// Volume-average Cauchy stress of a cell (MPa, components xx, yy, zz,

@@ -23,6 +23,7 @@ use palpate_material::Volumetric;
 
 use super::{ElementInput, ElementKernel, ElementOutput, PressureSpace, Scratch};
 use crate::kinematics::{jacobian_derivs_3d, Kinematics};
+use crate::material::{AtPoint, PointMaterial};
 use crate::mesh::CellType;
 use crate::quadrature::QuadratureRule;
 use crate::shape::ShapeEval;
@@ -157,6 +158,19 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
         // volume gradients G_m (per local dof) and the psi-weighted
         // B^T (d2J/dF2) B of each pressure mode
         scratch.reset(nu, if tangent { np } else { 0 });
+        let hl = input.material.history_len();
+        if input.history.len() != hl * self.weights.len() {
+            return Err(FeError::InvalidConfig {
+                field: format!("element {e}"),
+                reason: format!(
+                    "{} history values for {} points x {hl} per point",
+                    input.history.len(),
+                    self.weights.len()
+                ),
+            });
+        }
+        out.history.clear();
+        out.history.resize(hl * self.weights.len(), 0.0);
         let Scratch { gv, d2v, points } = scratch;
         let (mut v, mut vref) = ([0.0; 4], [0.0; 4]);
         let mut mass = SMatrix::<f64, 4, 4>::identity();
@@ -164,7 +178,7 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
             mass[(m, m)] = 0.0;
         }
         let (mut vol, mut vol_ref) = (0.0, 0.0);
-        for (s, &w) in self.shape.iter().zip(&self.weights) {
+        for (qp, (s, &w)) in self.shape.iter().zip(&self.weights).enumerate() {
             let p = self
                 .geometry(input.x, s, w)
                 .map_err(|det| FeError::InvalidMesh {
@@ -181,12 +195,26 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
                     det_f: det2,
                 });
             }
+            let old = &input.history[qp * hl..(qp + 1) * hl];
+            let point_material = AtPoint {
+                material: input.material,
+                old,
+                dt: input.dt,
+            };
             let Some((ps, amat)) =
                 self.kin
-                    .stress_tangent(input.material, input.volumetric, &mut f, tangent)
+                    .stress_tangent(&point_material, input.volumetric, &mut f, tangent)
             else {
                 return Err(FeError::NonFiniteStress { element: e });
             };
+            if hl > 0 {
+                input.material.update_history(
+                    &f,
+                    input.dt,
+                    old,
+                    &mut out.history[qp * hl..(qp + 1) * hl],
+                );
+            }
             let (j, cof, hj) = jacobian_derivs_3d(&f);
             if !(j > 0.0) {
                 return Err(FeError::InvertedElement {
@@ -484,6 +512,10 @@ impl<const N: usize, const D: usize> ElementKernel for SolidKernel<N, D> {
         }
     }
 
+    fn quadrature_points(&self) -> usize {
+        self.weights.len()
+    }
+
     fn reference_volume(&self, x: &[[f64; 3]]) -> Result<f64, FeError> {
         let mut v = 0.0;
         for (s, &w) in self.shape.iter().zip(&self.weights) {
@@ -515,25 +547,28 @@ impl<const N: usize, const D: usize> ElementKernel for SolidKernel<N, D> {
     fn mean_cauchy_stress(&self, input: &ElementInput, pressure: f64) -> [f64; 6] {
         let mut s = [0.0; 6];
         let mut vsum = 0.0;
-        for (sh, &w) in self.shape.iter().zip(&self.weights) {
+        let hl = input.material.history_len();
+        for (qp, (sh, &w)) in self.shape.iter().zip(&self.weights).enumerate() {
             let Ok(p) = self.geometry(input.x, sh, w) else {
                 continue;
             };
+            let material = AtPoint {
+                material: input.material,
+                old: input.history.get(qp * hl..(qp + 1) * hl).unwrap_or(&[]),
+                dt: input.dt,
+            };
             let (mut f, _) = self.gradient(&p, input.u);
-            let Some((_, _)) =
-                self.kin
-                    .stress_tangent(input.material, input.volumetric, &mut f, false)
+            let Some((_, _)) = self
+                .kin
+                .stress_tangent(&material, input.volumetric, &mut f, false)
             else {
                 continue;
             };
             let j = f.determinant();
             let sig = match self.kin {
                 Kinematics::PlaneStress { .. } => {
-                    let (pt, _) = crate::kinematics::total_stress_tangent(
-                        input.material,
-                        input.volumetric,
-                        &f,
-                    );
+                    let (pt, _) =
+                        crate::kinematics::total_stress_tangent(&material, input.volumetric, &f);
                     let pm = Matrix3::from_fn(|i, k| pt[3 * i + k]);
                     let sig = pm * f.transpose() / j;
                     // incompressible: the pressure that makes sigma_33 = 0
@@ -544,7 +579,7 @@ impl<const N: usize, const D: usize> ElementKernel for SolidKernel<N, D> {
                     }
                 }
                 _ => {
-                    let (p_iso, _) = input.material.iso_stress_tangent(&f);
+                    let (p_iso, _) = material.iso_stress_tangent(&f);
                     p_iso * f.transpose() / j + Matrix3::identity() * pressure
                 }
             };
@@ -650,6 +685,8 @@ mod tests {
                 material: mat,
                 volumetric: vol,
                 scale: 0.7,
+                history: &[],
+                dt: 0.0,
             };
             k.evaluate(&inp, t, out).unwrap();
         };
