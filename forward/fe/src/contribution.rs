@@ -142,8 +142,11 @@ pub trait Contribution: Send + std::any::Any {
     fn rollback(&mut self);
     /// Forgets all history (a new loading history starts at the reference state).
     fn reset(&mut self, x0: &[[f64; 3]]);
-    /// Force exerted by the body on this contribution's tool along `axis`
-    /// at the last assembly (N); `None` for contributions without a tool.
+    /// Force the tool exerts on the body along `axis` at the last assembly
+    /// (N; minus the body's reaction on the tool): a tool pressed down
+    /// reports its compression force on `axis = -y`, and a tool dragging the
+    /// surface along `+x` a positive force on `+x`. `None` for
+    /// contributions without a tool.
     fn tool_force(&self, _axis: [f64; 3]) -> Option<f64> {
         None
     }

@@ -165,9 +165,15 @@ fn simulate_with(
     setup
         .prepare(sys, material, &theta[n_law..])
         .map_err(to_forward)?;
-    let path = LoadPath::from_drive(&loading.drive);
+    let opts = setup.options();
+    let path = LoadPath::from_loading(
+        &loading.drive,
+        loading.time.as_deref(),
+        opts.max_step,
+        opts.max_time_step,
+    );
     let mut observe = |s: &System| setup.observe(s);
-    let outputs = stepper::run(sys, &path, &setup.options(), &mut observe, progress)
+    let outputs = stepper::run(sys, &path, &opts, &mut observe, progress)
         .map_err(|f| failure(f, all_outputs))?;
     Ok(Simulation {
         forces: outputs.iter().map(|o| o[0]).collect(),

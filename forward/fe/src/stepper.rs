@@ -42,6 +42,33 @@ impl LoadPath {
         }
     }
 
+    /// The path of a [`palpate_core::Loading`] with one drive channel: by
+    /// drive change alone when it has no time or `max_time_step` is `None`
+    /// (the stations keep their times, so `dt` reaches the materials), and
+    /// with time as a second measure of progress otherwise
+    /// ([`LoadPath::timed`] with `max_step` of path per `max_time_step`
+    /// seconds).
+    pub fn from_loading(
+        drive: &[f64],
+        time: Option<&[f64]>,
+        max_step: f64,
+        max_time_step: Option<f64>,
+    ) -> LoadPath {
+        match (time, max_time_step) {
+            (Some(t), Some(dt)) => LoadPath::timed(
+                t,
+                drive.iter().map(|&d| vec![d]).collect(),
+                &[1.0],
+                dt / max_step,
+            ),
+            (Some(t), None) => LoadPath {
+                time: t.to_vec(),
+                ..LoadPath::from_drive(drive)
+            },
+            (None, _) => LoadPath::from_drive(drive),
+        }
+    }
+
     /// Channels given at times `time` (s): `tau` accumulates
     /// `max(|change of channel c| / unit[c], dt / time_unit)` over each
     /// segment, so that an increment of 1 in `tau` moves no channel by more

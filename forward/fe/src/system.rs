@@ -33,6 +33,12 @@ pub struct SolverOptions {
     /// try the next step with the same factorisation and keep it when it
     /// cuts the residual fourfold (otherwise refactorise).
     pub reuse_factorisation: bool,
+    /// For timed histories: the largest time increment (s). `None`: time
+    /// does not limit increments (rate-independent materials: a hold at
+    /// constant drive costs no increment, and `dt` still reaches the
+    /// materials); `Some(dt)`: holds advance in increments of at most `dt`
+    /// (rate-dependent materials).
+    pub max_time_step: Option<f64>,
 }
 
 impl Default for SolverOptions {
@@ -46,6 +52,7 @@ impl Default for SolverOptions {
             max_augmentations: 20,
             stagnation_tolerance: 1e-4,
             reuse_factorisation: true,
+            max_time_step: None,
         }
     }
 }

@@ -372,6 +372,11 @@ impl crate::material::PointMaterial for Hardening {
 /// A 2 x 2 plane-strain block of the hardening material, bottom and left
 /// side held normally, the top pressed by channel 0.
 fn hardening_block(beta: f64) -> System {
+    block(Arc::new(Hardening { c10: 0.5, beta }), Volumetric::D1(0.1))
+}
+
+/// The 2 x 2 plane-strain block of `hardening_block` with any material.
+fn block(material: Arc<dyn crate::material::PointMaterial>, volumetric: Volumetric) -> System {
     let mesh = Mesh::graded_rectangle(2.0, 2.0, Grading::uniform(2.0, 2), Grading::uniform(2.0, 2))
         .unwrap();
     let kin = Kinematics::PlaneStrain { thickness: 1.0 };
@@ -380,14 +385,14 @@ fn hardening_block(beta: f64) -> System {
         &mesh,
         &["body"],
         kernel_for(CellType::Quad4, kin, PressureSpace::P0).unwrap(),
-        false,
+        volumetric == Volumetric::Incompressible,
     )
     .unwrap();
     body.set_material(
         "body",
         RegionMaterial {
-            material: Arc::new(Hardening { c10: 0.5, beta }),
-            volumetric: Volumetric::D1(0.1),
+            material,
+            volumetric,
         },
     )
     .unwrap();
@@ -479,5 +484,194 @@ fn rollback_restores_material_history_exactly() {
     assert_eq!(
         a.channel_reaction(0).to_bits(),
         b.channel_reaction(0).to_bits()
+    );
+}
+
+/// A plane-strain block under a wheel pressed by channel 0 and moved along
+/// +x by channel 1, rolling without slip (`rolling`) or sliding; returns
+/// the (horizontal, vertical) force on the wheel at the end.
+fn wheel_forces(rolling: bool, friction: f64) -> (f64, f64) {
+    let mesh = Mesh::graded_rectangle(
+        8.0,
+        2.0,
+        Grading::uniform(8.0, 16),
+        Grading::uniform(2.0, 4),
+    )
+    .unwrap();
+    let kin = Kinematics::PlaneStrain { thickness: 1.0 };
+    let mut body = SolidBody::new(
+        "body",
+        &mesh,
+        &["body"],
+        kernel_for(CellType::Quad4, kin, PressureSpace::P0).unwrap(),
+        true,
+    )
+    .unwrap();
+    body.set_material(
+        "body",
+        RegionMaterial {
+            material: Arc::new(NeoHookeanIso { c10: 0.5 }),
+            volumetric: Volumetric::Incompressible,
+        },
+    )
+    .unwrap();
+    let (origin, press, travel) = ([2.0, 2.0, 0.0], (0, [0.0, -1.0, 0.0]), (1, [1.0, 0.0, 0.0]));
+    let motion = if rolling {
+        ToolMotion::rolling(origin, press, travel, 1.5, 2)
+    } else {
+        ToolMotion::translating(origin, vec![press, travel])
+    };
+    let contact = RigidContact::new(
+        "wheel",
+        Box::new(Wheel2d { radius: 1.5 }),
+        motion,
+        &mesh,
+        "top",
+        kin,
+        ContactOptions {
+            friction,
+            penalty_normal: 50.0,
+            penalty_tangent: 50.0,
+            penetration_tol: 1e-6,
+            points: ContactPoints::EdgeGauss,
+        },
+        2,
+    )
+    .unwrap();
+    let bcs = [Dirichlet::fixed("bottom", 0), Dirichlet::fixed("bottom", 1)];
+    let mut sys = System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 2).unwrap();
+    sys.force_floor = 1e-6;
+    let path = LoadPath {
+        tau: vec![0.15, 2.15],
+        values: vec![vec![0.15, 0.0], vec![0.15, 2.0]],
+        time: vec![0.0; 2],
+    };
+    let opts = SolverOptions {
+        max_step: 0.05,
+        first_step: 0.05,
+        ..SolverOptions::default()
+    };
+    let mut observe = |s: &System| {
+        let c = &s.contributions[1];
+        vec![
+            c.tool_force([1.0, 0.0, 0.0]).unwrap_or(0.0),
+            c.tool_force([0.0, -1.0, 0.0]).unwrap_or(0.0),
+        ]
+    };
+    let out = stepper::run(&mut sys, &path, &opts, &mut observe, None).unwrap();
+    let last = out.last().unwrap();
+    (last[0], last[1])
+}
+
+/// The wheel's stick points are carried in its own (rotating) frame: a
+/// wheel that rolls without slip drags the surface much less than the same
+/// wheel sliding, which reaches the Coulomb limit `|F_x| = mu F_y`; both
+/// are reported on any axis while the wheel travels horizontally.
+#[test]
+fn rolling_wheel_carries_its_stick_points_and_reports_both_forces() {
+    let mu = 0.4;
+    let (fx_slide, fy_slide) = wheel_forces(false, mu);
+    let (fx_roll, fy_roll) = wheel_forces(true, mu);
+    assert!(fy_slide > 0.0 && fy_roll > 0.0);
+    // sliding: the wheel drags the surface along +x at the Coulomb limit
+    assert!(
+        (fx_slide / fy_slide - mu).abs() < 0.05 * mu,
+        "sliding: F_x / F_y = {}",
+        fx_slide / fy_slide
+    );
+    // rolling: the stick points move with the wheel, the contact sticks
+    // (partly) and the traction stays well inside the Coulomb limit; what
+    // remains is the creep of a wheel turned at v / R over a surface that
+    // the dent compresses
+    assert!(
+        fx_roll.abs() < 0.6 * mu * fy_roll,
+        "rolling slides like sliding: F_x / F_y = {}",
+        fx_roll / fy_roll
+    );
+    // frictionless: no horizontal force beyond the asymmetry of the dent
+    let (fx0, fy0) = wheel_forces(false, 0.0);
+    assert!(
+        fx0.abs() < 0.1 * mu * fy0 && fy0 > 0.0,
+        "frictionless F_x / F_y = {}",
+        fx0 / fy0
+    );
+}
+
+/// A material whose stress grows with the time it has spent loaded
+/// (`P = (1 + beta t_loaded) P_NH`, history: the accumulated time): holds
+/// must advance in time and hand `dt` to the material.
+struct Aging {
+    c10: f64,
+    beta: f64,
+}
+
+impl crate::material::PointMaterial for Aging {
+    fn iso_stress_tangent(&self, f: &nalgebra::Matrix3<f64>) -> crate::material::StressTangent9 {
+        NeoHookeanIso { c10: self.c10 }.iso_stress_tangent(f)
+    }
+    fn shear_modulus(&self) -> f64 {
+        2.0 * self.c10
+    }
+    fn history_len(&self) -> usize {
+        1
+    }
+    fn stress_tangent_with_history(
+        &self,
+        f: &nalgebra::Matrix3<f64>,
+        dt: f64,
+        old: &[f64],
+    ) -> crate::material::StressTangent9 {
+        let (p, a) = self.iso_stress_tangent(f);
+        let s = 1.0 + self.beta * (old[0] + dt);
+        (p * s, a * s)
+    }
+    fn update_history(&self, _f: &nalgebra::Matrix3<f64>, dt: f64, old: &[f64], new: &mut [f64]) {
+        new[0] = old[0] + dt;
+    }
+}
+
+fn aging_force(max_time_step: Option<f64>) -> (Vec<f64>, usize) {
+    // exactly incompressible: the pressure scales with the deviatoric
+    // stress, so the displacement field does not change over the hold and
+    // the force follows the aging factor exactly
+    let mut sys = block(
+        Arc::new(Aging {
+            c10: 0.5,
+            beta: 0.5,
+        }),
+        Volumetric::Incompressible,
+    );
+    // ramp to 0.2 mm in 1 s, hold 1 s
+    let time = [0.5, 1.0, 1.5, 2.0];
+    let drive = [0.1, 0.2, 0.2, 0.2];
+    let opts = SolverOptions {
+        max_time_step,
+        ..SolverOptions::default()
+    };
+    let path = LoadPath::from_loading(&drive, Some(&time), opts.max_step, max_time_step);
+    let mut observe = |s: &System| vec![s.channel_reaction(0)];
+    let out = stepper::run(&mut sys, &path, &opts, &mut observe, None).unwrap();
+    (out.iter().map(|o| o[0]).collect(), sys.stats.increments)
+}
+
+/// A hold at constant drive advances time in increments of at most
+/// `max_time_step` and the material sees `dt`: the aging block's force
+/// grows by the factor (1 + beta t) over the hold. Without a time step,
+/// the hold costs no increment (rate-independent use).
+#[test]
+fn holds_advance_time_and_hand_dt_to_the_material() {
+    let (f, increments) = aging_force(Some(0.1));
+    assert!(
+        increments >= 20,
+        "{increments} increments for 2 s in steps of 0.1 s"
+    );
+    // force at the end of the hold / at its start = (1 + 0.5 * 2) / (1 + 0.5 * 1)
+    let ratio = f[3] / f[1];
+    assert!((ratio - 2.0 / 1.5).abs() < 1e-6, "ratio {ratio}");
+    let (g, _) = aging_force(None);
+    assert_eq!(
+        g[3].to_bits(),
+        g[1].to_bits(),
+        "a hold without a time step is free"
     );
 }
