@@ -53,15 +53,20 @@ pub trait PointMaterial: Send + Sync {
     /// `[[F00, F01, 0], [F10, F11, 0], [0, 0, F22]]`. The default restricts
     /// [`PointMaterial::iso_stress_tangent`].
     fn iso_stress_tangent_2d(&self, f: &Matrix3<f64>, tangent: bool) -> StressTangent5 {
-        let (p, a) = self.iso_stress_tangent(f);
-        let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
-        let a5 = if tangent {
-            std::array::from_fn(|k| std::array::from_fn(|l| a[(F_COMPONENTS[k], F_COMPONENTS[l])]))
-        } else {
-            [[0.0; 5]; 5]
-        };
-        (p5, a5)
+        restrict_2d(self.iso_stress_tangent(f), tangent)
     }
+}
+
+/// The five components ([`F_COMPONENTS`]) of a 9-component stress and
+/// (when `tangent`, else zeros) tangent.
+fn restrict_2d((p, a): StressTangent9, tangent: bool) -> StressTangent5 {
+    let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
+    let a5 = if tangent {
+        std::array::from_fn(|k| std::array::from_fn(|l| a[(F_COMPONENTS[k], F_COMPONENTS[l])]))
+    } else {
+        [[0.0; 5]; 5]
+    };
+    (p5, a5)
 }
 
 /// A material seen at one quadrature point with its committed history and
@@ -85,14 +90,7 @@ impl PointMaterial for AtPoint<'_> {
         if self.material.history_len() == 0 {
             return self.material.iso_stress_tangent_2d(f, tangent);
         }
-        let (p, a) = self.iso_stress_tangent(f);
-        let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
-        let a5 = if tangent {
-            std::array::from_fn(|k| std::array::from_fn(|l| a[(F_COMPONENTS[k], F_COMPONENTS[l])]))
-        } else {
-            [[0.0; 5]; 5]
-        };
-        (p5, a5)
+        restrict_2d(self.iso_stress_tangent(f), tangent)
     }
 }
 
@@ -135,16 +133,7 @@ impl PointMaterial for LawMaterial {
         };
         let (i1b, i2b) = kin.modified();
         let Some(d) = self.law.invariant_derivs(&self.params, i1b, i2b) else {
-            let (p, a) = self.iso_stress_tangent(f);
-            let p5 = std::array::from_fn(|k| p[(F_COMPONENTS[k] / 3, F_COMPONENTS[k] % 3)]);
-            let a5 = if tangent {
-                std::array::from_fn(|k| {
-                    std::array::from_fn(|l| a[(F_COMPONENTS[k], F_COMPONENTS[l])])
-                })
-            } else {
-                [[0.0; 5]; 5]
-            };
-            return (p5, a5);
+            return restrict_2d(self.iso_stress_tangent(f), tangent);
         };
         let idx = F_COMPONENTS.map(|r| (r / 3, r % 3));
         let p = kin.iso_stress(&d);

@@ -15,21 +15,8 @@
 //! counter-clockwise seen from the top face.
 
 use super::CellType;
-
-/// Reference coordinates of the corners of a quadrilateral.
-const QUAD_CORNERS: [[f64; 2]; 4] = [[-1.0, -1.0], [1.0, -1.0], [1.0, 1.0], [-1.0, 1.0]];
-
-/// Reference coordinates of the corners of a hexahedron.
-const HEX_CORNERS: [[f64; 3]; 8] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-];
+// the reference corners are those of the shape functions
+use crate::shape::{HEX8_NODES as HEX_CORNERS, QUAD4_NODES as QUAD_CORNERS};
 
 /// The mid-node of the edge between two corners of a 9-node quadrilateral.
 fn quad9_mid(a: usize, b: usize) -> usize {
