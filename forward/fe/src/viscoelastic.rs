@@ -45,7 +45,8 @@
 //! nominal stress `lambda S_zz - lambda^-2 S_rr` (pressure eliminated by the
 //! free lateral surface) is not the hereditary integral of the elastic
 //! nominal stress at finite strain, because the pressure multiplies the
-//! current `C^-1`; the two agree to first order in the strain (see
+//! current `C^-1`; the difference, relative to the viscous part, is of
+//! second order in the strain (1.4e-2 at 20 % compression; see
 //! `tests/c1_viscoelastic.rs`).
 
 use nalgebra::Matrix3;
