@@ -19,6 +19,7 @@
 //! law = "neo-hookean"
 //! platens = "frictionless"    # frictionless | bonded
 //! mesh = "medium"             # level N: 19N x 9N elements
+//! prony = "g1=0.3,tau1=0.5"   # viscoelastic (Prony series on the isochoric stress; needs timed data)
 //!
 //! [models.press-analytic.c1]  # C1 compression (analytic, lubricated)
 //! law = "neo-hookean"
@@ -41,7 +42,7 @@
 use crate::calibration::TestKind;
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Effect, ForwardModel};
-use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, ToolShape};
+use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, Prony, ToolShape};
 use palpate_material::Law;
 use serde::Deserialize;
 use std::fmt;
@@ -98,6 +99,10 @@ pub struct C1FeSpec {
     /// `exact` (default) or a bulk-to-shear ratio K/mu.
     #[serde(default, deserialize_with = "text_or_number")]
     pub bulk: Option<String>,
+    /// A Prony series `g1=..,tau1=..,g2=..,tau2=..` on the law's isochoric
+    /// stress (`palpate_fe::Viscoelastic`); none: elastic.
+    #[serde(default)]
+    pub prony: Option<String>,
 }
 
 /// `[... .n1_needle]`
@@ -271,6 +276,12 @@ impl ModelSpec {
                 let level = parse_mesh(K, s.mesh.as_deref())?;
                 m.elements = (19 * level, 9 * level);
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+                if let Some(p) = &s.prony {
+                    let prony = p
+                        .parse::<Prony>()
+                        .map_err(|e| ModelError::new(K, "prony", p, e.to_string()))?;
+                    m.prony = Some(prony);
+                }
                 Model::C1Fe(m)
             }
             ModelSpec::N1Needle(s) => {
@@ -480,6 +491,19 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("mesh"), "{e}");
+    }
+
+    #[test]
+    fn c1_fe_takes_a_prony_series() {
+        let s: ModelSpec =
+            toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nprony = \"g1=0.3,tau1=0.5\"\n").unwrap();
+        assert!(matches!(s.validate(),
+            Ok(Model::C1Fe(m)) if m.prony.as_ref().map(|p| p.terms().to_vec()) == Some(vec![(0.3, 0.5)])));
+        let s: ModelSpec =
+            toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nprony = \"g1=0.7,tau1=1,g2=0.3,tau2=2\"\n")
+                .unwrap();
+        let e = s.validate().unwrap_err().to_string();
+        assert!(e.contains("prony") && e.contains("sum to 1"), "{e}");
     }
 
     #[test]

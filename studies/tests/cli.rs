@@ -271,3 +271,72 @@ fn simulate_states_its_discretisation_error() {
     bad.extend(["--order", "0"]);
     assert_clean_failure(&palpate(&bad), &["--order"]);
 }
+
+/// `simulate --prony` on C1: a timed ramp and hold written with `time_s`,
+/// relaxing over the hold towards `g_inf` times the elastic force; bad
+/// Prony series and misplaced timing options are clear errors.
+#[test]
+fn simulate_c1_viscoelastic_ramp_and_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("c1v.csv");
+    let o = palpate(&[
+        "simulate",
+        "--benchmark",
+        "C1",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.001101295",
+        "--mesh",
+        "coarse",
+        "--depth",
+        "1.8",
+        "--prony",
+        "g1=0.3,tau1=0.2,g2=0.25,tau2=2",
+        "--ramp",
+        "1",
+        "--hold",
+        "20",
+        "--error-estimate",
+        "off",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let t = palpate_core::Table::read(&csv).unwrap();
+    let time = t.column("time_s").unwrap();
+    let f = t.column("force_N").unwrap();
+    assert_eq!(time.len(), 19 + 200);
+    assert!((time[18] - 1.0).abs() < 1e-9 && (time[218] - 21.0).abs() < 1e-9);
+    // neo-Hookean elastic force at 1.8 mm: 2 C10 (1/l^2 - l) A, l = 0.8
+    let elastic = 2.0 * 0.001101295 * (1.0 / 0.64 - 0.8) * std::f64::consts::PI * 19.0 * 19.0;
+    assert!(f[18] < elastic && f[18] > f[218], "{} {}", f[18], f[218]);
+    let relaxed = 0.45 * elastic;
+    assert!(
+        (f[218] - relaxed).abs() < 0.01 * relaxed,
+        "{} vs {relaxed}",
+        f[218]
+    );
+
+    let base = [
+        "simulate",
+        "--benchmark",
+        "C1",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.001101295",
+    ];
+    for (extra, says) in [
+        (
+            &["--prony", "g1=0.6,tau1=1,g2=0.4,tau2=2"][..],
+            &["--prony", "sum to 1"][..],
+        ),
+        (&["--prony", "g1=0.3,tau1=0"], &["tau1", "positive"]),
+        (&["--hold", "5"], &["need --prony"]),
+    ] {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        assert_clean_failure(&palpate(&args), says);
+    }
+}

@@ -19,6 +19,7 @@ use crate::mesh::{CellType, Grading, Mesh};
 use crate::model::{law_space, simulate, Bulk, FeEvaluator, Setup, Simulation};
 use crate::stepper::Progress;
 use crate::system::{SolverOptions, System};
+use crate::viscoelastic::Prony;
 use crate::FeError;
 
 /// Platen contact condition.
@@ -41,6 +42,12 @@ pub struct C1Fe {
     /// Elements along the radius and the height.
     pub elements: (usize, usize),
     pub options: SolverOptions,
+    /// A Prony series on the law's isochoric stress
+    /// ([`crate::viscoelastic::Viscoelastic`]); `None`: elastic. A
+    /// viscoelastic run needs the loading's time and steps it by at most
+    /// `options.max_time_step` (a tenth of the shortest relaxation time
+    /// when unset).
+    pub prony: Option<Prony>,
     space: ParamSpace,
 }
 
@@ -60,6 +67,7 @@ impl C1Fe {
                 first_step: 0.1,
                 ..SolverOptions::default()
             },
+            prony: None,
         }
     }
 
@@ -130,6 +138,9 @@ impl Setup for C1Fe {
     fn options(&self) -> SolverOptions {
         self.options
     }
+    fn prony(&self) -> Option<&Prony> {
+        self.prony.as_ref()
+    }
     fn build(&self) -> Result<System, FeError> {
         let r = 0.5 * self.diameter;
         let (nr, nz) = self.elements;
@@ -179,11 +190,15 @@ impl Setup for C1Fe {
 
 impl ForwardModel for C1Fe {
     fn name(&self) -> String {
-        format!(
+        let mut name = format!(
             "C1 FE compression ({:?} platens), {}",
             self.platens, self.law
         )
-        .to_lowercase()
+        .to_lowercase();
+        if let Some(p) = &self.prony {
+            name += &format!(", Prony {p}");
+        }
+        name
     }
     fn space(&self) -> &ParamSpace {
         &self.space

@@ -53,6 +53,7 @@ pub mod stepper;
 pub mod surface;
 pub mod system;
 pub mod tool;
+pub mod viscoelastic;
 pub mod vtu;
 
 pub use c1::{C1Fe, Platens};
@@ -66,3 +67,4 @@ pub use stepper::{LoadPath, Progress};
 pub use surface::{Cylinder3d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};
 pub use system::{RunStats, SolverOptions, System};
 pub use tool::ToolShape;
+pub use viscoelastic::{Prony, Viscoelastic};

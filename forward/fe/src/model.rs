@@ -12,8 +12,10 @@ use std::sync::Arc;
 
 use crate::body::RegionMaterial;
 use crate::material::LawMaterial;
+use crate::material::PointMaterial;
 use crate::stepper::{self, LoadPath, Progress, RunFailure};
 use crate::system::{RunStats, SolverOptions, System};
+use crate::viscoelastic::{Prony, Viscoelastic};
 use crate::FeError;
 
 /// How an "incompressible" law is treated in the FE model.
@@ -66,6 +68,11 @@ pub(crate) trait Setup: Send + Sync {
     fn law(&self) -> &Law;
     fn bulk(&self) -> Bulk;
     fn options(&self) -> SolverOptions;
+    /// A Prony series on the material's isochoric stress (viscoelastic
+    /// runs); `None` (the default): elastic.
+    fn prony(&self) -> Option<&Prony> {
+        None
+    }
     fn build(&self) -> Result<System, FeError>;
     /// Sets what depends on the parameters before a run: the materials,
     /// contact penalties (scaled by the shear modulus `mu`) and the
@@ -158,14 +165,28 @@ fn simulate_with(
     let n_law = law.params().len();
     let mat = LawMaterial::new(*law, theta[..n_law].to_vec()).map_err(to_forward)?;
     let mu = law.shear_modulus(&theta[..n_law]);
+    let mut opts = setup.options();
+    let point: Arc<dyn PointMaterial> = match setup.prony() {
+        None => Arc::new(mat),
+        Some(prony) => {
+            if loading.time.is_none() {
+                return Err(ForwardError::InvalidLoading(
+                    "a viscoelastic material needs the time of each sample".into(),
+                ));
+            }
+            if opts.max_time_step.is_none() {
+                opts.max_time_step = Some(0.1 * prony.shortest_time());
+            }
+            Arc::new(Viscoelastic::new(mat, prony.clone()))
+        }
+    };
     let material = RegionMaterial {
-        material: Arc::new(mat),
+        material: point,
         volumetric: setup.bulk().volumetric(mu),
     };
     setup
         .prepare(sys, material, &theta[n_law..])
         .map_err(to_forward)?;
-    let opts = setup.options();
     let path = LoadPath::from_loading(
         &loading.drive,
         loading.time.as_deref(),

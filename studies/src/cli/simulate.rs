@@ -65,7 +65,16 @@ pub struct Args {
     /// Order of convergence P for the error estimate instead of the model's documented one (N1 1.22, C1 bonded 0.58); a smaller P gives a larger estimate.
     #[arg(long, value_name = "P")]
     pub order: Option<f64>,
-    /// Write the force curve as CSV (columns displacement_mm,force_N[,error_estimate_N]; `#` lines state the model, the volumetric treatment and the error estimate).
+    /// C1: viscoelastic material, a Prony series g1=..,tau1=..,g2=..,tau2=.. on the law's isochoric stress (G(t) = 1 - sum g_i (1 - exp(-t/tau_i)), tau in s); the history becomes timed: ramp to --depth in --ramp seconds, then hold --hold seconds.
+    #[arg(long, value_name = "g1=..,tau1=..")]
+    pub prony: Option<String>,
+    /// With --prony: duration of the ramp to --depth in s [default: 1].
+    #[arg(long, value_name = "SECONDS")]
+    pub ramp: Option<f64>,
+    /// With --prony: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0].
+    #[arg(long, value_name = "SECONDS")]
+    pub hold: Option<f64>,
+    /// Write the force curve as CSV (columns [time_s,]displacement_mm,force_N[,error_estimate_N], time_s with --prony; `#` lines state the model, the volumetric treatment and the error estimate).
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
     /// Write the final deformed state as a VTK .vtu file for ParaView.
@@ -133,6 +142,7 @@ pub fn model_spec(args: &Args) -> ModelSpec {
             platens: args.bonded.then(|| "bonded".into()),
             mesh: args.mesh.clone(),
             bulk: args.bulk.clone(),
+            prony: args.prony.clone(),
         })
     }
 }
@@ -159,8 +169,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     let n = (depth / step).ceil() as usize;
-    let drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
-    let loading = Loading::quasi_static(Drive::DisplacementMm, drive.clone());
+    let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
+    let time = timed_history(&args, depth, &mut drive)?;
+    let loading = match &time {
+        Some(t) => Loading::timed(Drive::DisplacementMm, t.clone(), drive.clone()),
+        None => Loading::quasi_static(Drive::DisplacementMm, drive.clone()),
+    };
 
     let (bar, mut cb) = progress_bar(drive.len(), "");
     let (title, bulk, result) = match &model {
@@ -195,7 +209,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 comments.push(format!(
                     "did not converge at sample {sample} (drive {d} mm): partial curve, no error estimate"
                 ));
-                write_curve(path, &comments, &drive[..completed.len()], &completed, None)?;
+                write_curve(
+                    path,
+                    &comments,
+                    time.as_ref().map(|t| &t[..completed.len()]),
+                    &drive[..completed.len()],
+                    &completed,
+                    None,
+                )?;
                 eprintln!(
                     "wrote the {} converged samples to {}",
                     completed.len(),
@@ -237,25 +258,43 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         None
     };
     if let Some(path) = &args.csv {
-        write_curve(path, &comments, &drive, &sim.forces, errors.as_deref())?;
+        write_curve(
+            path,
+            &comments,
+            time.as_deref(),
+            &drive,
+            &sim.forces,
+            errors.as_deref(),
+        )?;
     }
     if let Some(path) = &args.vtu {
         let vtu = palpate_fe::vtu::to_vtu(&solver).map_err(|e| anyhow!("{e}"))?;
         write_atomic(path, vtu.as_bytes())?;
     }
     if let Some(path) = &args.plot {
-        let plot = Plot::new(&title, "displacement (mm)", "force (N)").with(Series::line(
-            "FE",
-            &drive,
-            &sim.forces,
-        ));
+        let plot = match &time {
+            Some(t) => {
+                Plot::new(&title, "time (s)", "force (N)").with(Series::line("FE", t, &sim.forces))
+            }
+            None => Plot::new(&title, "displacement (mm)", "force (N)").with(Series::line(
+                "FE",
+                &drive,
+                &sim.forces,
+            )),
+        };
         write_atomic(path, plot.to_svg().as_bytes())
             .with_context(|| format!("plot {}", path.display()))?;
     }
     if args.csv.is_none() {
         print!(
             "{}",
-            curve_text(&comments, &drive, &sim.forces, errors.as_deref())
+            curve_text(
+                &comments,
+                time.as_deref(),
+                &drive,
+                &sim.forces,
+                errors.as_deref()
+            )
         );
     }
     Ok(())
@@ -375,10 +414,55 @@ fn estimate(
     Ok(Estimate { line, errors })
 }
 
-fn curve_text(comments: &[String], d: &[f64], f: &[f64], errors: Option<&[f64]>) -> String {
+/// The sample times of a viscoelastic (`--prony`) run: the drive samples
+/// spread over `--ramp` seconds, then `--hold` seconds at `depth` in 200
+/// samples appended to `drive`; `None` for an elastic run.
+fn timed_history(
+    args: &Args,
+    depth: f64,
+    drive: &mut Vec<f64>,
+) -> anyhow::Result<Option<Vec<f64>>> {
+    if args.prony.is_none() {
+        if args.ramp.is_some() || args.hold.is_some() {
+            bail!("--ramp and --hold time a viscoelastic run: they need --prony");
+        }
+        return Ok(None);
+    }
+    if args.benchmark.eq_ignore_ascii_case("n1") {
+        bail!("--prony: only C1 has the viscoelastic material so far");
+    }
+    let ramp = args.ramp.unwrap_or(1.0);
+    let hold = args.hold.unwrap_or(0.0);
+    if !(ramp > 0.0 && ramp.is_finite()) {
+        bail!("--ramp {ramp}: must be a positive duration in s");
+    }
+    if !(hold >= 0.0 && hold.is_finite()) {
+        bail!("--hold {hold}: must be a duration in s, zero or more");
+    }
+    let mut time: Vec<f64> = drive.iter().map(|d| ramp * d / depth).collect();
+    if hold > 0.0 {
+        const HOLD_SAMPLES: usize = 200;
+        for k in 1..=HOLD_SAMPLES {
+            time.push(ramp + hold * k as f64 / HOLD_SAMPLES as f64);
+            drive.push(depth);
+        }
+    }
+    Ok(Some(time))
+}
+
+fn curve_text(
+    comments: &[String],
+    time: Option<&[f64]>,
+    d: &[f64],
+    f: &[f64],
+    errors: Option<&[f64]>,
+) -> String {
     let mut s = String::new();
     for c in comments {
         s.push_str(&format!("# {c}\n"));
+    }
+    if time.is_some() {
+        s.push_str("time_s,");
     }
     s.push_str("displacement_mm,force_N");
     s.push_str(if errors.is_some() {
@@ -387,6 +471,9 @@ fn curve_text(comments: &[String], d: &[f64], f: &[f64], errors: Option<&[f64]>)
         "\n"
     });
     for (k, (d, f)) in d.iter().zip(f).enumerate() {
+        if let Some(t) = time {
+            s.push_str(&format!("{:.6},", t[k]));
+        }
         s.push_str(&format!("{d:.6},{f:.9e}"));
         if let Some(e) = errors {
             s.push_str(&format!(",{:.9e}", e[k]));
@@ -399,9 +486,10 @@ fn curve_text(comments: &[String], d: &[f64], f: &[f64], errors: Option<&[f64]>)
 fn write_curve(
     path: &std::path::Path,
     comments: &[String],
+    time: Option<&[f64]>,
     d: &[f64],
     f: &[f64],
     errors: Option<&[f64]>,
 ) -> anyhow::Result<()> {
-    write_atomic(path, curve_text(comments, d, f, errors).as_bytes())
+    write_atomic(path, curve_text(comments, time, d, f, errors).as_bytes())
 }
