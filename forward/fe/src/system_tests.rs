@@ -237,6 +237,30 @@ fn global_tangent_equals_finite_differences_of_the_global_residual() {
             exact: false,
             friction: 0.0,
         },
+        Case {
+            kin: Kinematics::ThreeD,
+            cell: CellType::Hex8,
+            exact: true,
+            friction: 0.2,
+        },
+        Case {
+            kin: Kinematics::ThreeD,
+            cell: CellType::Hex8,
+            exact: false,
+            friction: 50.0,
+        },
+        Case {
+            kin: Kinematics::ThreeD,
+            cell: CellType::Hex8,
+            exact: false,
+            friction: 0.5,
+        },
+        Case {
+            kin: Kinematics::ThreeD,
+            cell: CellType::Hex8,
+            exact: true,
+            friction: 50.0,
+        },
     ];
     for c in &cases {
         let mut sys = system(c);
@@ -252,6 +276,20 @@ fn global_tangent_equals_finite_differences_of_the_global_residual() {
             }
         }
         sys.assemble(&target, true).unwrap();
+        if c.kin == Kinematics::ThreeD && c.friction > 0.0 {
+            // both regimes of the 3D return map: mu = 50 sticks everywhere,
+            // mu = 0.2 slides, mu = 0.5 has points in both
+            let tool = sys.part::<RigidContact>(1).unwrap();
+            let (a, s) = (tool.active(), tool.slipping());
+            let mixed = if c.friction > 1.0 {
+                s == 0
+            } else if c.friction < 0.3 {
+                s > 0
+            } else {
+                s > 0 && s < a
+            };
+            assert!(mixed, "friction {}: {s} of {a} sliding", c.friction);
+        }
         let k = dense(&sys);
         let scale = k.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
         let h = 1e-7;
