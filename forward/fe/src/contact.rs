@@ -18,15 +18,49 @@
 //! the arc length of the closest point in the tool's own frame, so a
 //! rotating wheel carries its stick points with it. `A` is the point's
 //! area (360 degrees in axisymmetry), and the tangent `d f / d x` is exact
-//! and unsymmetric in slip. (3D friction, with a two-component slip, comes
-//! with the 3D needle; 3D contact is frictionless for now.)
+//! and unsymmetric in slip.
+//!
+//! Tangential (3D): the same return map with a two-component slip
+//! (Wriggers 2006, 5.2; Laursen, *Computational Contact and
+//! Impact Mechanics*, 2002, ch. 5, with the rigid master's material point
+//! as the stick point). The stick point `X_s` is stored in the tool frame
+//! (the tool's material point the body point is stuck to, carried by a
+//! rotating tool); with the pose `x = p + R X`, the current closest point
+//! `x_c = x - g n` ([`SurfacePoint::closest`]) and `P = I - n (x) n`:
+//!
+//! ```text
+//! x_s = p + R X_s,   d = x_c - x_s,   s = P d                 (slip, tangential)
+//! trial  t_T = -eps_T A s
+//! stick  |t_T| <= mu t_N:  t_T as is,                 X_s kept
+//! slip   otherwise:        t_T = -mu t_N m, m = s/|s|, x_s <- x_c + t_T / (eps_T A)
+//! f = t_N n + t_T   (the force on the body)
+//! ```
+//!
+//! The moved stick point lies in the tangent plane at `x_c`, at the
+//! distance for which a re-evaluation at the same `x` is exactly at the
+//! Coulomb limit. At first contact `X_s` is the closest point of the
+//! position at the last commit (committed pose). The tangent, with
+//! `C = d x_c / d x = I - n (x) n - g dn/dx` ([`SurfacePoint::dclosest`]),
+//! `d t_N / d x = -eps_N A n` and `dn/dx` symmetric (the surface module):
+//!
+//! ```text
+//! S = ds/dx = C - (n . d) dn/dx - n (x) (dn/dx^T d + C^T n)
+//! stick  d t_T / d x = -eps_T A S
+//! slip   d t_T / d x = -(mu t_N / |s|) (I - m (x) m) S - mu m (x) d t_N / d x
+//! d f / d x = n (x) d t_N / d x + t_N dn/dx + d t_T / d x
+//! ```
+//!
+//! (`C^T n = -g dn/dx n = 0` on a smooth piece; it is kept for generality.)
+//! `x_s` does not depend on `x` within an evaluation: the stick point is
+//! history. Like the 2D one, the 3D stick point is trial state written by
+//! every assembly, accepted by a commit and restored by a rollback.
 
 use crate::contribution::{Assembly, AssemblyContext, Contribution};
 use crate::kinematics::Kinematics;
 use crate::mesh::{CellType, Mesh};
-use crate::motion::ToolMotion;
+use crate::motion::{Pose, ToolMotion};
 use crate::quadrature::QuadratureRule;
-use crate::surface::RigidSurface;
+use crate::surface::{RigidSurface, SurfacePoint};
 use crate::FeError;
 
 /// Contact options.
@@ -83,14 +117,19 @@ impl ContactPoint {
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 struct PointHistory {
-    /// Stick point (tool-frame arc length), when in contact.
+    /// 2D stick point (tool-frame arc length), when in contact.
     stick: Option<f64>,
+    /// 3D stick point (tool-frame coordinates of the tool's material point
+    /// the body point is stuck to), when in contact.
+    stick_point: Option<[f64; 3]>,
     /// Normal multiplier (N).
     lambda: f64,
     /// Position at the last commit.
     pos: [f64; 3],
     /// Normal force (N) and gap (mm) of the last evaluation.
     normal_force: f64,
+    /// Sliding (at the Coulomb limit) at the last evaluation.
+    slipping: bool,
     gap: f64,
 }
 
@@ -121,8 +160,7 @@ pub struct RigidContact {
 impl RigidContact {
     /// Contact between `surface` moving by `motion` and facet set `facets`
     /// of `mesh`. Errors: unknown set, bad tool dimensions, a surface,
-    /// motion or kinematics of another dimension than the mesh, friction in
-    /// 3D, a tool that starts inside the body (naming tool, node and position).
+    /// motion or kinematics of another dimension than the mesh, a tool that starts inside the body (naming tool, node and position).
     // (the tool, its motion, the body's surface and the options are all
     // independent inputs; a builder would only rename them)
     #[allow(clippy::too_many_arguments)]
@@ -147,9 +185,6 @@ impl RigidContact {
                 "a {}D surface in {kinematics:?} kinematics",
                 surface.dim()
             )));
-        }
-        if kinematics.dim() == 3 && options.friction != 0.0 {
-            return Err(bad("3D contact is frictionless for now".into()));
         }
         if mesh.dim != kinematics.dim() {
             return Err(bad(format!(
@@ -194,6 +229,12 @@ impl RigidContact {
     /// Number of contact points in contact at the last assembly.
     pub fn active(&self) -> usize {
         self.trial.iter().filter(|h| h.normal_force > 0.0).count()
+    }
+
+    /// Number of contact points sliding (at the Coulomb limit) at the last
+    /// assembly.
+    pub fn slipping(&self) -> usize {
+        self.trial.iter().filter(|h| h.slipping).count()
     }
 
     /// Largest penetration (mm) of the last assembly.
@@ -331,6 +372,165 @@ fn facet_shape(ct: CellType, xi: &[f64; 3], x: &[[f64; 3]]) -> ([f64; MAX_NODES]
     }
 }
 
+/// What the evaluation of a contact point needs of its tool.
+struct Tool<'a> {
+    surface: &'a dyn RigidSurface,
+    /// The pose of the current evaluation and of the last commit.
+    pose: &'a Pose,
+    pose_committed: &'a Pose,
+    options: &'a ContactOptions,
+    dim: usize,
+}
+
+impl Tool<'_> {
+    /// The trial history and the force (on the body) of a contact point of
+    /// reference area `area` at position `x`, with normal multiplier
+    /// `lambda` and committed history `c`.
+    fn point(
+        &self,
+        area: f64,
+        lambda: f64,
+        c: &PointHistory,
+        x: [f64; 3],
+    ) -> (PointHistory, PointForce) {
+        let (o, dim, surface) = (self.options, self.dim, self.surface);
+        let pr = self.pose.project(surface, x);
+        let (eps_n, eps_t) = (o.penalty_normal * area, o.penalty_tangent * area);
+        let tn = lambda - eps_n * pr.gap;
+        let mut t = PointHistory {
+            pos: c.pos,
+            lambda,
+            gap: pr.gap,
+            ..Default::default()
+        };
+        if tn <= 0.0 {
+            return (t, PointForce::default());
+        }
+        t.normal_force = tn;
+        let nv = pr.normal;
+        let dtn: [f64; 3] = std::array::from_fn(|j| -eps_n * nv[j]);
+        let mut f: [f64; 3] = std::array::from_fn(|i| tn * nv[i]);
+        let mut kmat = [[0.0; 3]; 3];
+        for i in 0..dim {
+            for j in 0..dim {
+                kmat[i][j] = nv[i] * dtn[j] + tn * pr.dnormal[i][j];
+            }
+        }
+        if o.friction > 0.0 && dim == 3 {
+            let (stick, slipping, tt, dtt) = self.friction_3d(&pr, eps_t, tn, &dtn, c, x);
+            t.stick_point = Some(stick);
+            t.slipping = slipping;
+            for i in 0..3 {
+                f[i] += tt[i];
+                for j in 0..3 {
+                    kmat[i][j] += dtt[i][j];
+                }
+            }
+        } else if o.friction > 0.0 {
+            let tv = pr.tangent;
+            let stick = c.stick.unwrap_or_else(|| {
+                // first contact: stick where the point was at the last commit
+                self.pose_committed.project(surface, c.pos).xi
+            });
+            let slip = pr.xi - stick;
+            let tt_trial = -eps_t * slip;
+            let limit = o.friction * tn;
+            let (tt, dtt) = if tt_trial.abs() <= limit {
+                t.stick = Some(stick);
+                (
+                    tt_trial,
+                    std::array::from_fn::<f64, 3, _>(|j| -eps_t * pr.dxi[j]),
+                )
+            } else {
+                let s = slip.signum();
+                let tt = -s * limit;
+                t.slipping = true;
+                t.stick = Some(pr.xi + tt / eps_t);
+                (tt, std::array::from_fn(|j| -s * o.friction * dtn[j]))
+            };
+            for i in 0..dim {
+                f[i] += tt * tv[i];
+            }
+            for i in 0..dim {
+                for j in 0..dim {
+                    kmat[i][j] += tv[i] * dtt[j] + tt * pr.dtangent[i][j];
+                }
+            }
+        }
+        (
+            t,
+            PointForce {
+                force: f,
+                stiffness: kmat,
+            },
+        )
+    }
+
+    /// 3D Coulomb friction at a point in contact (see the module
+    /// documentation for the equations): the stick point in the tool frame,
+    /// the tangential traction `t_T` on the body and `d t_T / d x`, given
+    /// whether it slips, given the projection `pr` of `x`, `eps_T = eps_t`, `t_N = tn` and
+    /// `d t_N / d x = dtn`.
+    fn friction_3d(
+        &self,
+        pr: &SurfacePoint,
+        eps_t: f64,
+        tn: f64,
+        dtn: &[f64; 3],
+        c: &PointHistory,
+        x: [f64; 3],
+    ) -> ([f64; 3], bool, [f64; 3], [[f64; 3]; 3]) {
+        let stick = c.stick_point.unwrap_or_else(|| {
+            // first contact: stick to the tool's material point closest to
+            // where the point was at the last commit
+            let local = self.pose_committed.to_local(c.pos);
+            self.surface.project(local).closest(local)
+        });
+        let (n, dn) = (pr.normal, pr.dnormal);
+        let xc = pr.closest(x);
+        let xs = self.pose.to_global_point(stick);
+        let d: [f64; 3] = std::array::from_fn(|i| xc[i] - xs[i]);
+        let nd = dot(n, d);
+        let s: [f64; 3] = std::array::from_fn(|i| d[i] - nd * n[i]);
+        // ds/dx = C - (n . d) dn/dx - n (x) (dn/dx^T d + C^T n)
+        let cm = pr.dclosest();
+        let w: [f64; 3] = std::array::from_fn(|j| {
+            (0..3)
+                .map(|k| d[k] * dn[k][j] + n[k] * cm[k][j])
+                .sum::<f64>()
+        });
+        let ds: [[f64; 3]; 3] = std::array::from_fn(|i| {
+            std::array::from_fn(|j| cm[i][j] - nd * dn[i][j] - n[i] * w[j])
+        });
+        let limit = self.options.friction * tn;
+        let norm_s = dot(s, s).sqrt();
+        if eps_t * norm_s <= limit {
+            // stick: t_T = -eps_T s
+            let tt = s.map(|v| -eps_t * v);
+            let dtt = ds.map(|row| row.map(|v| -eps_t * v));
+            return (stick, false, tt, dtt);
+        }
+        // slip: t_T = -mu t_N m, m = s / |s|, and the stick point moves to
+        // x_c + t_T / eps_T (then |t_T| is the trial traction of the next
+        // evaluation at the same x)
+        let m = s.map(|v| v / norm_s);
+        let tt = m.map(|v| -limit * v);
+        let moved: [f64; 3] = std::array::from_fn(|i| xc[i] + tt[i] / eps_t);
+        // dm/dx = (I - m (x) m) ds/dx / |s|
+        let mds: [f64; 3] = std::array::from_fn(|j| (0..3).map(|k| m[k] * ds[k][j]).sum::<f64>());
+        let dtt = std::array::from_fn(|i| {
+            std::array::from_fn(|j| {
+                -limit * (ds[i][j] - m[i] * mds[j]) / norm_s - self.options.friction * m[i] * dtn[j]
+            })
+        });
+        (self.pose.to_local(moved), true, tt, dtt)
+    }
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
 impl Contribution for RigidContact {
     fn name(&self) -> String {
         format!("tool `{}`", self.name)
@@ -364,69 +564,18 @@ impl Contribution for RigidContact {
         let dim = ctx.dofs.dim;
         let pose = self.motion.pose(ctx.channels);
         let pose_c = self.motion.pose(ctx.channels_committed);
-        let surface = &*self.surface;
+        let tool = Tool {
+            surface: &*self.surface,
+            pose: &pose,
+            pose_committed: &pose_c,
+            options: &o,
+            dim,
+        };
         for (k, p) in self.points.iter().enumerate() {
-            let a = p.area;
-            let c = self.committed[k];
-            let pr = pose.project(surface, p.position(|n| ctx.position(n)));
-            let (eps_n, eps_t) = (o.penalty_normal * a, o.penalty_tangent * a);
-            let tn = self.lambda[k] - eps_n * pr.gap;
-            let mut t = PointHistory {
-                pos: c.pos,
-                lambda: self.lambda[k],
-                gap: pr.gap,
-                ..Default::default()
-            };
-            if tn <= 0.0 {
-                self.trial[k] = t;
-                self.forces[k] = PointForce::default();
-                continue;
-            }
-            t.normal_force = tn;
-            let nv = pr.normal;
-            let dtn: [f64; 3] = std::array::from_fn(|j| -eps_n * nv[j]);
-            let mut f: [f64; 3] = std::array::from_fn(|i| tn * nv[i]);
-            let mut kmat = [[0.0; 3]; 3];
-            for i in 0..dim {
-                for j in 0..dim {
-                    kmat[i][j] = nv[i] * dtn[j] + tn * pr.dnormal[i][j];
-                }
-            }
-            if o.friction > 0.0 {
-                let tv = pr.tangent;
-                let stick = c.stick.unwrap_or_else(|| {
-                    // first contact: stick where the point was at the last commit
-                    pose_c.project(surface, c.pos).xi
-                });
-                let slip = pr.xi - stick;
-                let tt_trial = -eps_t * slip;
-                let limit = o.friction * tn;
-                let (tt, dtt) = if tt_trial.abs() <= limit {
-                    t.stick = Some(stick);
-                    (
-                        tt_trial,
-                        std::array::from_fn::<f64, 3, _>(|j| -eps_t * pr.dxi[j]),
-                    )
-                } else {
-                    let s = slip.signum();
-                    let tt = -s * limit;
-                    t.stick = Some(pr.xi + tt / eps_t);
-                    (tt, std::array::from_fn(|j| -s * o.friction * dtn[j]))
-                };
-                for i in 0..dim {
-                    f[i] += tt * tv[i];
-                }
-                for i in 0..dim {
-                    for j in 0..dim {
-                        kmat[i][j] += tv[i] * dtt[j] + tt * pr.dtangent[i][j];
-                    }
-                }
-            }
+            let x = p.position(|n| ctx.position(n));
+            let (t, f) = tool.point(p.area, self.lambda[k], &self.committed[k], x);
             self.trial[k] = t;
-            self.forces[k] = PointForce {
-                force: f,
-                stiffness: kmat,
-            };
+            self.forces[k] = f;
         }
         for (p, pf) in self.points.iter().zip(&self.forces) {
             if pf.force == [0.0; 3] && pf.stiffness == [[0.0; 3]; 3] {
@@ -511,5 +660,186 @@ impl Contribution for RigidContact {
                 .map(|f| f.force[0] * axis[0] + f.force[1] * axis[1] + f.force[2] * axis[2])
                 .sum(),
         )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::motion::Rotation;
+    use crate::surface::{Revolution3d, Wheel2d};
+    use crate::tool::ToolShape;
+
+    fn options(friction: f64) -> ContactOptions {
+        ContactOptions {
+            friction,
+            penalty_normal: 20.0,
+            penalty_tangent: 30.0,
+            penetration_tol: 1e-6,
+            points: ContactPoints::Nodes,
+        }
+    }
+
+    /// A translated and rotated pose (3D: about a skew axis; 2D: about z).
+    fn pose(dim: usize) -> Pose {
+        let axis = if dim == 3 {
+            let a = [0.3, -0.5, 0.8];
+            let l = dot(a, a).sqrt();
+            a.map(|v| v / l)
+        } else {
+            [0.0, 0.0, 1.0]
+        };
+        ToolMotion {
+            origin: [0.2, -0.1, 0.3],
+            translation: vec![(0, [0.1, 0.2, if dim == 3 { -0.3 } else { 0.0 }])],
+            rotation: Some(Rotation::About {
+                channel: 0,
+                axis,
+                rate: 0.4,
+            }),
+        }
+        .pose(&[0.7])
+    }
+
+    /// Largest difference between the point stiffness and central finite
+    /// differences of the point force, relative to the largest entry.
+    fn stiffness_error(tool: &Tool, c: &PointHistory, x: [f64; 3]) -> f64 {
+        let (_, pf) = tool.point(1.3, 0.0, c, x);
+        let scale = pf
+            .stiffness
+            .iter()
+            .flatten()
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        let h = 1e-6;
+        let mut worst = 0.0f64;
+        for j in 0..tool.dim {
+            let (mut xp, mut xm) = (x, x);
+            xp[j] += h;
+            xm[j] -= h;
+            let fp = tool.point(1.3, 0.0, c, xp).1.force;
+            let fm = tool.point(1.3, 0.0, c, xm).1.force;
+            for i in 0..tool.dim {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                worst = worst.max((fd - pf.stiffness[i][j]).abs() / scale);
+            }
+        }
+        worst
+    }
+
+    /// The 3D frictional point stiffness equals central finite differences
+    /// of the point force in stick (mu = 50) and in slip (mu = 0.2), for a
+    /// stored stick point and at first contact, on a sphere and on the
+    /// needle's cone (hoop curvature), under a rotated tool; and a slipped
+    /// point re-evaluated with its moved stick point is at the Coulomb limit
+    /// with the same force.
+    #[test]
+    fn frictional_point_stiffness_3d_equals_finite_differences() {
+        let pose = pose(3);
+        let surfaces: [(Box<dyn RigidSurface>, [f64; 3]); 2] = [
+            (
+                Box::new(Revolution3d(ToolShape::Sphere { radius: 1.5 })),
+                [0.4, 0.3, 0.05],
+            ),
+            (
+                Box::new(Revolution3d(ToolShape::n1_needle())),
+                [2.6, 1.0, 2.6],
+            ),
+        ];
+        for (surface, local) in &surfaces {
+            // a point 0.05 mm inside the tool, and a tangent offset
+            let sp = surface.project(*local);
+            let xl: [f64; 3] = std::array::from_fn(|i| local[i] - (sp.gap + 0.05) * sp.normal[i]);
+            let sp = surface.project(xl);
+            assert!((sp.gap + 0.05).abs() < 1e-9, "{}", sp.gap);
+            let x = pose.to_global_point(xl);
+            let xc = sp.closest(xl);
+            // a unit tangent
+            let a = [0.3, -1.0, 0.5];
+            let an = dot(a, sp.normal);
+            let e: [f64; 3] = std::array::from_fn(|i| a[i] - an * sp.normal[i]);
+            let e = e.map(|v| v / dot(e, e).sqrt());
+            for (friction, slips) in [(50.0, false), (0.2, true)] {
+                let o = options(friction);
+                let tool = Tool {
+                    surface: &**surface,
+                    pose: &pose,
+                    pose_committed: &pose,
+                    options: &o,
+                    dim: 3,
+                };
+                let stuck = PointHistory {
+                    stick_point: Some(std::array::from_fn(|i| xc[i] + 0.05 * e[i])),
+                    ..Default::default()
+                };
+                let first = PointHistory {
+                    pos: pose.to_global_point(std::array::from_fn(|i| xl[i] - 0.04 * e[i])),
+                    ..Default::default()
+                };
+                for c in [stuck, first] {
+                    let (t, pf) = tool.point(1.3, 0.0, &c, x);
+                    assert!(t.normal_force > 0.0);
+                    let n = pose.to_global_vector(sp.normal);
+                    let fnormal = dot(pf.force, n);
+                    assert!((fnormal - t.normal_force).abs() < 1e-12 * fnormal);
+                    let tt: [f64; 3] = std::array::from_fn(|i| pf.force[i] - fnormal * n[i]);
+                    let ratio = dot(tt, tt).sqrt() / (friction * t.normal_force);
+                    assert_eq!(
+                        ratio > 1.0 - 1e-12,
+                        slips,
+                        "{} mu {friction}: ratio {ratio}",
+                        surface.name()
+                    );
+                    let err = stiffness_error(&tool, &c, x);
+                    assert!(
+                        err < 1e-7,
+                        "{} mu {friction} first {}: {err:.2e}",
+                        surface.name(),
+                        c.stick_point.is_none()
+                    );
+                    if slips {
+                        let (t2, pf2) = tool.point(1.3, 0.0, &t, x);
+                        for i in 0..3 {
+                            assert!(
+                                (pf2.force[i] - pf.force[i]).abs() < 1e-12,
+                                "{:?} vs {:?}",
+                                pf2.force,
+                                pf.force
+                            );
+                        }
+                        assert!(t2.stick_point.is_some());
+                    }
+                }
+            }
+        }
+    }
+
+    /// The 2D frictional point stiffness (arc-length stick point) equals
+    /// central finite differences in stick and in slip.
+    #[test]
+    fn frictional_point_stiffness_2d_equals_finite_differences() {
+        let pose = pose(2);
+        let surface = Wheel2d { radius: 1.5 };
+        let xl = [0.5, 0.2, 0.0];
+        let sp = surface.project(xl);
+        assert!(sp.gap < 0.0);
+        let x = pose.to_global_point(xl);
+        for (friction, stick) in [(50.0, sp.xi + 0.02), (0.2, sp.xi - 0.1)] {
+            let o = options(friction);
+            let tool = Tool {
+                surface: &surface,
+                pose: &pose,
+                pose_committed: &pose,
+                options: &o,
+                dim: 2,
+            };
+            let c = PointHistory {
+                stick: Some(stick),
+                ..Default::default()
+            };
+            let (t, _) = tool.point(1.3, 0.0, &c, x);
+            assert_eq!(t.stick == Some(stick), friction > 1.0);
+            let err = stiffness_error(&tool, &c, x);
+            assert!(err < 1e-7, "mu {friction}: {err:.2e}");
+        }
     }
 }
