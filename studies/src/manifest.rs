@@ -88,9 +88,17 @@ pub enum ModelForm {
 
 impl<'de> Deserialize<'de> for ModelEntry {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use crate::models::{C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec};
+        use crate::models::{C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec, Q1Spec};
         use serde::de::{Error, MapAccess, Visitor};
-        const FIELDS: &[&str] = &["law", "fixed", "homogeneous", "c1", "c1_fe", "n1_needle"];
+        const FIELDS: &[&str] = &[
+            "law",
+            "fixed",
+            "homogeneous",
+            "c1",
+            "c1_fe",
+            "n1_needle",
+            "q1",
+        ];
         struct V;
         impl<'de> Visitor<'de> for V {
             type Value = ModelEntry;
@@ -119,6 +127,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         "c1" => Some(ModelSpec::C1(map.next_value::<C1Spec>()?)),
                         "c1_fe" => Some(ModelSpec::C1Fe(map.next_value::<C1FeSpec>()?)),
                         "n1_needle" => Some(ModelSpec::N1Needle(map.next_value::<N1NeedleSpec>()?)),
+                        "q1" => Some(ModelSpec::Q1(map.next_value::<Q1Spec>()?)),
                         other => return Err(A::Error::unknown_field(other, FIELDS)),
                     };
                     if let Some(n) = next {

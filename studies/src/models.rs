@@ -21,6 +21,12 @@
 //! mesh = "medium"             # level N: 19N x 9N elements
 //! prony = "g1=0.3,tau1=0.5"   # viscoelastic (Prony series on the isochoric stress; needs timed data)
 //!
+//! [models.punch.q1]         # Q1 flat-punch ramp-and-hold (finite elements)
+//! law = "neo-hookean"
+//! mesh = "medium"             # level N: elements of 0.2/N mm under the punch
+//! element = "quad4"           # quad4 (Q1/P0) | quad9 (Q2/P1)
+//! prony = "g1=0.3,tau1=0.5,g2=0.2,tau2=10"
+//!
 //! [models.press-analytic.c1]  # C1 compression (analytic, lubricated)
 //! law = "neo-hookean"
 //!
@@ -42,7 +48,9 @@
 use crate::calibration::TestKind;
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Effect, ForwardModel};
-use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, Prony, ToolShape};
+use palpate_fe::{
+    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, Prony, Q1Punch, ToolShape,
+};
 use palpate_material::Law;
 use serde::Deserialize;
 use std::fmt;
@@ -67,6 +75,8 @@ pub enum ModelSpec {
     C1Fe(C1FeSpec),
     /// Benchmark N1, needle indentation by finite elements.
     N1Needle(N1NeedleSpec),
+    /// Benchmark Q1, flat-punch ramp-and-hold by finite elements.
+    Q1(Q1Spec),
 }
 
 /// `[... .homogeneous]`
@@ -131,6 +141,25 @@ pub struct N1NeedleSpec {
     pub element: Option<String>,
 }
 
+/// `[... .q1]`
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Q1Spec {
+    pub law: String,
+    /// `coarse`, `medium` (default), `fine` or a level 1..12: elements of 0.2/N mm under the punch.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub mesh: Option<String>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub bulk: Option<String>,
+    /// `quad4` (default, Q1/P0) or `quad9` (Q2/P1).
+    #[serde(default)]
+    pub element: Option<String>,
+    /// A Prony series `g1=..,tau1=..,g2=..,tau2=..`; none: elastic.
+    #[serde(default)]
+    pub prony: Option<String>,
+}
+
 /// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
 pub fn text_or_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     #[derive(Deserialize)]
@@ -191,6 +220,7 @@ pub enum Model {
     C1(C1Compression),
     C1Fe(C1Fe),
     N1Needle(N1Needle),
+    Q1(Q1Punch),
 }
 
 impl Model {
@@ -201,6 +231,7 @@ impl Model {
             Model::C1(m) => Box::new(m),
             Model::C1Fe(m) => Box::new(m),
             Model::N1Needle(m) => Box::new(m),
+            Model::Q1(m) => Box::new(m),
         }
     }
 }
@@ -212,7 +243,7 @@ pub fn build(spec: &ModelSpec) -> Result<Box<dyn ForwardModel>, ModelError> {
 
 impl ModelSpec {
     /// The kinds, as spelled in manifests.
-    pub const KINDS: [&'static str; 4] = ["homogeneous", "c1", "c1_fe", "n1_needle"];
+    pub const KINDS: [&'static str; 5] = ["homogeneous", "c1", "c1_fe", "n1_needle", "q1"];
 
     /// The kind, as spelled in manifests.
     pub fn kind(&self) -> &'static str {
@@ -221,6 +252,7 @@ impl ModelSpec {
             ModelSpec::C1(_) => "c1",
             ModelSpec::C1Fe(_) => "c1_fe",
             ModelSpec::N1Needle(_) => "n1_needle",
+            ModelSpec::Q1(_) => "q1",
         }
     }
 
@@ -231,6 +263,7 @@ impl ModelSpec {
             ModelSpec::C1(s) => &s.law,
             ModelSpec::C1Fe(s) => &s.law,
             ModelSpec::N1Needle(s) => &s.law,
+            ModelSpec::Q1(s) => &s.law,
         }
     }
 
@@ -247,6 +280,14 @@ impl ModelSpec {
             ModelSpec::Homogeneous(s) => TestKind::Homogeneous(parse_mode(&s.mode)?),
             ModelSpec::C1(_) | ModelSpec::C1Fe(_) => TestKind::C1,
             ModelSpec::N1Needle(_) => TestKind::N1,
+            ModelSpec::Q1(_) => {
+                return Err(ModelError::new(
+                    "q1",
+                    "test",
+                    "Q1",
+                    "Q1 records are not a test kind of calibrate/sample yet",
+                ))
+            }
         })
     }
 
@@ -284,6 +325,20 @@ impl ModelSpec {
                 }
                 Model::C1Fe(m)
             }
+            ModelSpec::Q1(s) => {
+                const K: &str = "q1";
+                let mut m = Q1Punch::new(law);
+                m.level = parse_mesh(K, s.mesh.as_deref())?;
+                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+                m.element = parse_element(K, s.element.as_deref())?;
+                if let Some(p) = &s.prony {
+                    let prony = p
+                        .parse::<Prony>()
+                        .map_err(|e| ModelError::new(K, "prony", p, e.to_string()))?;
+                    m.prony = Some(prony);
+                }
+                Model::Q1(m)
+            }
             ModelSpec::N1Needle(s) => {
                 const K: &str = "n1_needle";
                 let mut m = N1Needle::new(law);
@@ -314,18 +369,7 @@ impl ModelSpec {
                     }
                 };
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
-                m.element = match s.element.as_deref().unwrap_or("quad4") {
-                    "quad4" => N1Element::Quad4,
-                    "quad9" => N1Element::Quad9,
-                    other => {
-                        return Err(ModelError::new(
-                            K,
-                            "element",
-                            other,
-                            "expected quad4 or quad9",
-                        ))
-                    }
-                };
+                m.element = parse_element(K, s.element.as_deref())?;
                 Model::N1Needle(m)
             }
         })
@@ -360,6 +404,19 @@ pub fn parse_mesh(kind: &'static str, s: Option<&str>) -> Result<usize, ModelErr
                 format!("expected coarse, medium, fine or a level 1..{MAX_MESH_LEVEL}"),
             )),
         },
+    }
+}
+
+fn parse_element(kind: &'static str, s: Option<&str>) -> Result<N1Element, ModelError> {
+    match s.unwrap_or("quad4") {
+        "quad4" => Ok(N1Element::Quad4),
+        "quad9" => Ok(N1Element::Quad9),
+        other => Err(ModelError::new(
+            kind,
+            "element",
+            other,
+            "expected quad4 or quad9",
+        )),
     }
 }
 

@@ -340,3 +340,73 @@ fn simulate_c1_viscoelastic_ramp_and_hold() {
         assert_clean_failure(&palpate(&args), says);
     }
 }
+
+/// `simulate --benchmark Q1`: always timed (ramp then hold), `time_s`,
+/// 100 ramp samples and 200 hold samples, relaxing with a Prony series;
+/// bad timing and geometry-free options are clear errors.
+#[test]
+fn simulate_q1_ramp_and_hold() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = dir.path().join("q1.csv");
+    let o = palpate(&[
+        "simulate",
+        "--benchmark",
+        "Q1",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.001",
+        "--mesh",
+        "coarse",
+        "--depth",
+        "0.1",
+        "--prony",
+        "g1=0.3,tau1=0.2,g2=0.2,tau2=2",
+        "--ramp",
+        "0.05",
+        "--hold",
+        "2",
+        "--error-estimate",
+        "off",
+        "--csv",
+        csv.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let text = std::fs::read_to_string(&csv).unwrap();
+    assert!(
+        text.lines().any(|l| l == "time_s,displacement_mm,force_N"),
+        "{text}"
+    );
+    let t = palpate_core::Table::read(&csv).unwrap();
+    let time = t.column("time_s").unwrap();
+    let f = t.column("force_N").unwrap();
+    assert_eq!(time.len(), 101 + 200);
+    assert!((time[100] - 0.05).abs() < 1e-9 && (time[300] - 2.05).abs() < 1e-9);
+    // relaxes towards g_inf = 0.5 of the instantaneous force
+    assert!(
+        f[100] > f[300] && f[300] > 0.5 * f[100],
+        "{} {}",
+        f[100],
+        f[300]
+    );
+
+    let base = [
+        "simulate",
+        "--benchmark",
+        "Q1",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.001",
+    ];
+    for (extra, says) in [
+        (&["--hold=-1"][..], &["--hold", "zero or more"][..]),
+        (&["--ramp", "0"], &["--ramp", "positive"]),
+        (&["--prony", "g1=0.3,tau1=-1"], &["tau1", "positive"]),
+        (&["--element", "quad8"], &["--element", "quad4 or quad9"]),
+    ] {
+        let mut args = base.to_vec();
+        args.extend(extra);
+        assert_clean_failure(&palpate(&args), says);
+    }
+}

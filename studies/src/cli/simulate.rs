@@ -1,5 +1,5 @@
 //! `palpate simulate`: run a finite-element forward model (N1 needle
-//! indentation or C1 compression, BENCHMARKS.md) and write its force curve,
+//! indentation, C1 compression or Q1 flat-punch ramp-and-hold, BENCHMARKS.md) and write its force curve,
 //! with the volumetric treatment used and, unless `--error-estimate off`, an
 //! estimate of its discretisation error from one coarser solve (Richardson
 //! extrapolation with the model's documented order of convergence,
@@ -16,15 +16,15 @@ use palpate_fe::discretisation::{richardson, Coarser};
 use palpate_fe::{Bulk, Progress, Simulation};
 use palpate_material::Law;
 
-use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec};
+use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, Q1Spec};
 use crate::output::write_atomic;
 use crate::plot::{Plot, Series};
 
 /// Options of `palpate simulate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder) or C1 (compression of a 38 x 9 mm cylinder).
-    #[arg(long, value_parser = ["N1", "C1", "n1", "c1"])]
+    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), C1 (compression of a 38 x 9 mm cylinder) or Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm).
+    #[arg(long, value_parser = ["N1", "C1", "Q1", "n1", "c1", "q1"])]
     pub benchmark: String,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
     #[arg(long)]
@@ -44,16 +44,16 @@ pub struct Args {
     /// N1 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
-    /// N1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4].
+    /// N1 and Q1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4].
     #[arg(long, value_name = "quad4|quad9")]
     pub element: Option<String>,
-    /// Final tool displacement in mm (default: 10 for N1, 2 for C1).
+    /// Final tool displacement in mm (default: 10 for N1, 2 for C1, 5 for Q1).
     #[arg(long)]
     pub depth: Option<f64>,
-    /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1).
+    /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1, depth/100 for Q1).
     #[arg(long)]
     pub step: Option<f64>,
-    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements) [default: medium].
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch) [default: medium].
     #[arg(long)]
     pub mesh: Option<String>,
     /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
@@ -65,16 +65,16 @@ pub struct Args {
     /// Order of convergence P for the error estimate instead of the model's documented one (N1 1.22, C1 bonded 0.58); a smaller P gives a larger estimate.
     #[arg(long, value_name = "P")]
     pub order: Option<f64>,
-    /// C1: viscoelastic material, a Prony series g1=..,tau1=..,g2=..,tau2=.. on the law's isochoric stress (G(t) = 1 - sum g_i (1 - exp(-t/tau_i)), tau in s); the history becomes timed: ramp to --depth in --ramp seconds, then hold --hold seconds.
+    /// C1 and Q1: viscoelastic material, a Prony series g1=..,tau1=..,g2=..,tau2=.. on the law's isochoric stress (G(t) = 1 - sum g_i (1 - exp(-t/tau_i)), tau in s); the history becomes timed: ramp to --depth in --ramp seconds, then hold --hold seconds.
     #[arg(long, value_name = "g1=..,tau1=..")]
     pub prony: Option<String>,
-    /// With --prony: duration of the ramp to --depth in s [default: 1].
+    /// With --prony (C1) or Q1: duration of the ramp to --depth in s [default: 1; Q1: 0.5].
     #[arg(long, value_name = "SECONDS")]
     pub ramp: Option<f64>,
-    /// With --prony: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0].
+    /// With --prony (C1) or Q1: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0; Q1: 60].
     #[arg(long, value_name = "SECONDS")]
     pub hold: Option<f64>,
-    /// Write the force curve as CSV (columns [time_s,]displacement_mm,force_N[,error_estimate_N], time_s with --prony; `#` lines state the model, the volumetric treatment and the error estimate).
+    /// Write the force curve as CSV (columns [time_s,]displacement_mm,force_N[,error_estimate_N], time_s with --prony and for Q1; `#` lines state the model, the volumetric treatment and the error estimate).
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
     /// Write the final deformed state as a VTK .vtu file for ParaView.
@@ -123,10 +123,18 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
     Ok(p)
 }
 
-/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`
-/// (the settings a benchmark does not have are ignored).
+/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`,
+/// Q1 -> `q1` (the settings a benchmark does not have are ignored).
 pub fn model_spec(args: &Args) -> ModelSpec {
-    if args.benchmark.eq_ignore_ascii_case("n1") {
+    if is_q1(args) {
+        ModelSpec::Q1(Q1Spec {
+            law: args.law.clone(),
+            mesh: args.mesh.clone(),
+            bulk: args.bulk.clone(),
+            element: args.element.clone(),
+            prony: args.prony.clone(),
+        })
+    } else if args.benchmark.eq_ignore_ascii_case("n1") {
         ModelSpec::N1Needle(N1NeedleSpec {
             law: args.law.clone(),
             friction: args.friction,
@@ -147,6 +155,10 @@ pub fn model_spec(args: &Args) -> ModelSpec {
     }
 }
 
+fn is_q1(args: &Args) -> bool {
+    args.benchmark.eq_ignore_ascii_case("q1")
+}
+
 /// Runs `palpate simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let model = model_spec(&args)
@@ -158,8 +170,22 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map_err(|e| anyhow!("--law `{}`: {e}", args.law))?;
     let theta = parse_params(&law, &args.params)?;
     let n1 = args.benchmark.eq_ignore_ascii_case("n1");
-    let depth = args.depth.unwrap_or(if n1 { 10.0 } else { 2.0 });
-    let step = args.step.unwrap_or(if n1 { 0.25 } else { 0.1 });
+    let q1 = is_q1(&args);
+    let depth = args.depth.unwrap_or(if n1 {
+        10.0
+    } else if q1 {
+        5.0
+    } else {
+        2.0
+    });
+    // Q1: at least 100 samples in the ramp (BENCHMARKS.md)
+    let step = args.step.unwrap_or(if n1 {
+        0.25
+    } else if q1 {
+        depth / 100.0
+    } else {
+        0.1
+    });
     if !(depth > 0.0 && depth.is_finite() && step > 0.0 && step.is_finite()) {
         bail!("--depth and --step must be positive (got {depth} and {step})");
     }
@@ -188,7 +214,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             m.bulk,
             m.simulate(&theta, &loading, Some(&mut cb)),
         ),
-        _ => bail!("--benchmark {}: expected N1 or C1", args.benchmark),
+        Model::Q1(m) => (
+            m.name(),
+            m.bulk,
+            m.simulate(&theta, &loading, Some(&mut cb)),
+        ),
+        _ => bail!("--benchmark {}: expected N1, C1 or Q1", args.benchmark),
     };
     drop(cb);
     bar.finish_and_clear();
@@ -361,6 +392,11 @@ fn estimate(
             let r = model.simulate(theta, loading, Some(&mut cb));
             (ratio, mesh, m.convergence_order(), r)
         }
+        Model::Q1(m) => {
+            let Coarser { model, ratio, mesh } = m.coarser();
+            let r = model.simulate(theta, loading, Some(&mut cb));
+            (ratio, mesh, m.convergence_order(), r)
+        }
         _ => bail!("no error estimate for this model"),
     };
     drop(cb);
@@ -414,15 +450,17 @@ fn estimate(
     Ok(Estimate { line, errors })
 }
 
-/// The sample times of a viscoelastic (`--prony`) run: the drive samples
-/// spread over `--ramp` seconds, then `--hold` seconds at `depth` in 200
-/// samples appended to `drive`; `None` for an elastic run.
+/// The sample times of a viscoelastic (`--prony`) run or of any Q1 run
+/// (ramp-and-hold, BENCHMARKS.md): the drive samples spread over `--ramp`
+/// seconds, then `--hold` seconds at `depth` in 200 samples appended to
+/// `drive`; `None` for an elastic C1 or N1 run.
 fn timed_history(
     args: &Args,
     depth: f64,
     drive: &mut Vec<f64>,
 ) -> anyhow::Result<Option<Vec<f64>>> {
-    if args.prony.is_none() {
+    let q1 = is_q1(args);
+    if args.prony.is_none() && !q1 {
         if args.ramp.is_some() || args.hold.is_some() {
             bail!("--ramp and --hold time a viscoelastic run: they need --prony");
         }
@@ -431,8 +469,8 @@ fn timed_history(
     if args.benchmark.eq_ignore_ascii_case("n1") {
         bail!("--prony: only C1 has the viscoelastic material so far");
     }
-    let ramp = args.ramp.unwrap_or(1.0);
-    let hold = args.hold.unwrap_or(0.0);
+    let ramp = args.ramp.unwrap_or(if q1 { 0.5 } else { 1.0 });
+    let hold = args.hold.unwrap_or(if q1 { 60.0 } else { 0.0 });
     if !(ramp > 0.0 && ramp.is_finite()) {
         bail!("--ramp {ramp}: must be a positive duration in s");
     }
