@@ -564,6 +564,25 @@ mod tests {
     }
 
     #[test]
+    fn q1_reads_its_mesh_element_and_prony() {
+        let s: ModelSpec = toml::from_str(
+            "[q1]\nlaw = \"neo-hookean\"\nmesh = 1\nelement = \"quad9\"\nprony = \"g1=0.3,tau1=0.5\"\n",
+        )
+        .unwrap();
+        assert_eq!(s.kind(), "q1");
+        assert!(matches!(s.validate(),
+            Ok(Model::Q1(m)) if m.level == 1 && m.element == N1Element::Quad9 && m.prony.is_some()));
+        assert!(s.test().unwrap_err().to_string().contains("Q1 records"));
+        let s: ModelSpec =
+            toml::from_str("[q1]\nlaw = \"neo-hookean\"\nelement = \"tri3\"\n").unwrap();
+        assert!(s
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("q1.element"));
+    }
+
+    #[test]
     fn the_one_mesh_parser() {
         for (s, level) in [("coarse", 1), ("medium", 2), ("fine", 3), ("12", 12)] {
             assert_eq!(parse_mesh("n1_needle", Some(s)), Ok(level));

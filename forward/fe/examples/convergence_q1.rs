@@ -1,3 +1,7 @@
+//! Q1 mesh study (docs/validation/fe.md, "Q1"): the elastic flat-punch force
+//! at a small depth against Sneddon's 8 G a d on one grading.
+//! `cargo run --release -p palpate-fe --example convergence_q1 -- H_FINE GROWTH EDGE [DEPTH]`
+//! (env `AUG=20` for an inner augmentation loop, `PEN=` the penalty factor).
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
