@@ -55,6 +55,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(|f| table.factor(f.trim()))
         .collect::<Result<Vec<_>, _>>()?;
     let y = table.numeric(&args.response)?;
+    crate::limits::check_anova("--max-order", args.max_order, factors.len(), y.len())?;
     let options = AnovaOptions {
         max_order: args.max_order,
         alpha: args.alpha,

@@ -185,11 +185,25 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .iter()
         .map(String::as_str)
         .collect();
+    let levels: Vec<usize> = manifest.factors.iter().map(|f| f.levels.len()).collect();
+    let m = args.manifest.display();
+    crate::limits::check_runs(
+        &format!("{m}: [[factors]] and design.replicates = {}", manifest.design.replicates),
+        &levels,
+        gens.len(),
+        manifest.design.replicates,
+    )?;
     let mut design = if gens.is_empty() {
         Design::full_factorial(manifest.factors.clone(), manifest.design.replicates)?
     } else {
         Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)?
     };
+    crate::limits::check_anova(
+        &format!("{m}: analysis.max_order ="),
+        manifest.analysis.max_order,
+        design.factors.len(),
+        design.runs.len(),
+    )?;
     if let Some(seed) = manifest.design.seed {
         design = design.randomised(seed);
     }

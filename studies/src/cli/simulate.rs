@@ -168,7 +168,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             bail!("--order {p}: must be a positive order of convergence");
         }
     }
-    let n = (depth / step).ceil() as usize;
+    // Each sample keeps its drive, time, force and estimate, and a solve.
+    let n = crate::limits::check_count(
+        &format!(
+            "--depth {} / --step {}",
+            crate::limits::fmt_value(depth),
+            crate::limits::fmt_value(step)
+        ),
+        (depth / step).ceil() + 1.0,
+        "samples",
+        256.0,
+    )? - 1;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
     let time = timed_history(&args, depth, &mut drive)?;
     let loading = match &time {
