@@ -41,7 +41,9 @@ pub fn check_count_within(
     available: f64,
 ) -> anyhow::Result<usize> {
     let bytes_each = bytes_each.max(1.0);
-    let max = (available / bytes_each).floor().min(usize::MAX as f64 / 2.0);
+    let max = (available / bytes_each)
+        .floor()
+        .min(usize::MAX as f64 / 2.0);
     if !(count.is_finite() && count >= 0.0) || count > max {
         anyhow::bail!(
             "{what} gives {} {noun}; at most {} fit in memory (~{:.1} GiB free, ~{} bytes each)",
@@ -106,8 +108,7 @@ impl Progress {
         let done = self.done.fetch_add(n, Ordering::Relaxed) + n;
         let tenth = (self.total / 10).max(1);
         if let Ok(mut last) = self.last.lock() {
-            let due = done / tenth > last.1 / tenth
-                || last.0.elapsed() >= Duration::from_secs(10);
+            let due = done / tenth > last.1 / tenth || last.0.elapsed() >= Duration::from_secs(10);
             if due && done < self.total {
                 eprintln!(
                     "{}: {done}/{} ({:.0} %)",
@@ -125,26 +126,6 @@ impl Progress {
         if let Some(b) = &self.bar {
             b.finish_and_clear();
         }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn every_absurd_count_is_refused_with_its_estimate() {
-        let gib = 1024f64.powi(3);
-        assert_eq!(check_count_within("--n 3", 3.0, "samples", 8.0, gib).unwrap(), 3);
-        for bad in [2e300, f64::INFINITY, f64::NAN, 1e18, -1.0, 18446744073709551615.0] {
-            let e = check_count_within("--step 1e-300", bad, "samples", 64.0, gib)
-                .unwrap_err()
-                .to_string();
-            assert!(e.starts_with("--step 1e-300 gives "), "{e}");
-            assert!(e.contains("at most 16777216 fit in memory"), "{e}");
-            assert!(e.contains("1.0 GiB"), "{e}");
-        }
-        assert!(available_bytes() > 0.0);
     }
 }
 
@@ -184,7 +165,12 @@ pub fn check_anova(
 /// Checks the number of runs of a designed experiment (the product of the
 /// factors' level counts and the replicates, divided by 2 per generator)
 /// against the design's limit and the memory, before it is built.
-pub fn check_runs(what: &str, levels: &[usize], generators: usize, replicates: usize) -> anyhow::Result<usize> {
+pub fn check_runs(
+    what: &str,
+    levels: &[usize],
+    generators: usize,
+    replicates: usize,
+) -> anyhow::Result<usize> {
     let runs = levels.iter().map(|&l| l as f64).product::<f64>() * replicates as f64
         / 2f64.powi(generators.min(1000) as i32);
     let max = palpate_uq::doe::MAX_RUNS;
@@ -203,5 +189,35 @@ pub fn fmt_value(x: f64) -> String {
         format!("{x:e}")
     } else {
         format!("{x}")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_absurd_count_is_refused_with_its_estimate() {
+        let gib = 1024f64.powi(3);
+        assert_eq!(
+            check_count_within("--n 3", 3.0, "samples", 8.0, gib).unwrap(),
+            3
+        );
+        for bad in [
+            2e300,
+            f64::INFINITY,
+            f64::NAN,
+            1e18,
+            -1.0,
+            18446744073709551615.0,
+        ] {
+            let e = check_count_within("--step 1e-300", bad, "samples", 64.0, gib)
+                .unwrap_err()
+                .to_string();
+            assert!(e.starts_with("--step 1e-300 gives "), "{e}");
+            assert!(e.contains("at most 16777216 fit in memory"), "{e}");
+            assert!(e.contains("1.0 GiB"), "{e}");
+        }
+        assert!(available_bytes() > 0.0);
     }
 }

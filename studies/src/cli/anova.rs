@@ -48,6 +48,10 @@ pub struct Args {
 
 /// Runs `palpate anova`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    crate::output::check_outputs(
+        &[&args.data],
+        &crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]),
+    )?;
     let table = RunsTable::read(&args.data)?;
     let factors = args
         .factors

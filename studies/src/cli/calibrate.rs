@@ -7,6 +7,7 @@ use crate::report::{calibration_table, fit_plot};
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
+use std::path::Path;
 use std::path::PathBuf;
 
 /// Fit a hyperelastic law to measured data.
@@ -112,9 +113,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let v: f64 = value
             .parse()
             .map_err(|_| anyhow::anyhow!("--fix {f}: `{value}` is not a number"))?;
+        if fixed.iter().any(|(n, _)| n == name) {
+            anyhow::bail!("--fix {f}: {name} is fixed twice; give each parameter once");
+        }
         fixed.push((name.to_string(), v));
     }
     let data = read_data(&args.data, args.benchmark.as_deref())?;
+    let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
+    let outputs = crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
+    crate::output::check_outputs(&inputs, &outputs)?;
     let result = calibrate(Request {
         law,
         model: None,

@@ -188,7 +188,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let levels: Vec<usize> = manifest.factors.iter().map(|f| f.levels.len()).collect();
     let m = args.manifest.display();
     crate::limits::check_runs(
-        &format!("{m}: [[factors]] and design.replicates = {}", manifest.design.replicates),
+        &format!(
+            "{m}: [[factors]] and design.replicates = {}",
+            manifest.design.replicates
+        ),
         &levels,
         gens.len(),
         manifest.design.replicates,

@@ -117,7 +117,11 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
     let (units, per_unit, tune, draws, thin) = match sampler {
         Sampler::Ensemble(s) => (
             s.ensembles,
-            if s.walkers == 0 { (4 * dim).max(16) } else { s.walkers },
+            if s.walkers == 0 {
+                (4 * dim).max(16)
+            } else {
+                s.walkers
+            },
             s.tune,
             s.draws,
             s.thin,
@@ -154,6 +158,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let sampler = sampler_from(&args)?;
     check_sizes(&args, &sampler, law.params().len() + 2 * args.data.len())?;
     let data = read_data(&args.data, args.benchmark.as_deref())?;
+    let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
+    crate::output::check_outputs(
+        &inputs,
+        &crate::output::given(&[
+            ("--json", &args.json),
+            ("--chains", &args.chains_out),
+            ("--plot", &args.plot),
+        ]),
+    )?;
     if let Some(s) = args.sigma {
         anyhow::ensure!(
             s.is_finite() && s > 0.0,
@@ -195,6 +208,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for p in &args.prior {
         let (name, spec) =
             crate::cli::calibrate::split_pair(p, "NAME=SPEC, e.g. C10=lognormal:-7,1")?;
+        if args
+            .prior
+            .iter()
+            .take_while(|q| !std::ptr::eq(*q, p))
+            .any(|q| q.split_once('=').map(|x| x.0) == Some(name))
+        {
+            anyhow::bail!(
+                "--prior {p}: a prior for {name} is given twice; give each parameter one prior"
+            );
+        }
         let k = space.index_of(name).ok_or_else(|| {
             anyhow::anyhow!(
                 "--prior {p}: unknown parameter `{name}` (the law has {})",

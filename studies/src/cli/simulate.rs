@@ -106,6 +106,12 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
             .trim()
             .parse()
             .map_err(|_| anyhow!("--param `{g}`: `{value}` is not a number"))?;
+        if values[k].is_some() {
+            bail!(
+                "--param `{g}`: {} is given twice; give each parameter once",
+                specs[k].name
+            );
+        }
         values[k] = Some(v);
     }
     let missing: Vec<_> = specs
@@ -123,10 +129,65 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
     Ok(p)
 }
 
-/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`
-/// (the settings a benchmark does not have are ignored).
-pub fn model_spec(args: &Args) -> ModelSpec {
-    if args.benchmark.eq_ignore_ascii_case("n1") {
+/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`; an
+/// option of the other benchmark is refused by name, since it would be
+/// neither used nor visible in the result.
+pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
+    let n1 = args.benchmark.eq_ignore_ascii_case("n1");
+    let given = |on: bool, name: &str, shown: String| on.then(|| (name.to_string(), shown));
+    let foreign: Vec<(String, String)> = if n1 {
+        [
+            given(args.bonded, "--bonded", String::new()),
+            given(
+                args.prony.is_some(),
+                "--prony",
+                args.prony.clone().unwrap_or_default(),
+            ),
+            given(
+                args.ramp.is_some(),
+                "--ramp",
+                format!("{:?}", args.ramp.unwrap_or(0.0)),
+            ),
+            given(
+                args.hold.is_some(),
+                "--hold",
+                format!("{:?}", args.hold.unwrap_or(0.0)),
+            ),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    } else {
+        [
+            given(
+                args.friction.is_some(),
+                "--friction",
+                args.friction.map(|f| f.to_string()).unwrap_or_default(),
+            ),
+            given(args.sliding_base, "--sliding-base", String::new()),
+            given(
+                args.tool.is_some(),
+                "--tool",
+                args.tool.clone().unwrap_or_default(),
+            ),
+            given(
+                args.element.is_some(),
+                "--element",
+                args.element.clone().unwrap_or_default(),
+            ),
+        ]
+        .into_iter()
+        .flatten()
+        .collect()
+    };
+    if let Some((name, value)) = foreign.first() {
+        let (this, other) = if n1 { ("N1", "C1") } else { ("C1", "N1") };
+        bail!(
+            "{name}{}{value}: an option of benchmark {other}; --benchmark {this} does not use it",
+            if value.is_empty() { "" } else { " " }
+        );
+    }
+    Ok(if n1 {
         ModelSpec::N1Needle(N1NeedleSpec {
             law: args.law.clone(),
             friction: args.friction,
@@ -144,12 +205,12 @@ pub fn model_spec(args: &Args) -> ModelSpec {
             bulk: args.bulk.clone(),
             prony: args.prony.clone(),
         })
-    }
+    })
 }
 
 /// Runs `palpate simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let model = model_spec(&args)
+    let model = model_spec(&args)?
         .validate()
         .map_err(|e| anyhow!("{}", e.as_option()))?;
     let law: Law = args
@@ -157,6 +218,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .parse()
         .map_err(|e| anyhow!("--law `{}`: {e}", args.law))?;
     let theta = parse_params(&law, &args.params)?;
+    crate::output::check_outputs(
+        &[],
+        &crate::output::given(&[
+            ("--csv", &args.csv),
+            ("--vtu", &args.vtu),
+            ("--plot", &args.plot),
+        ]),
+    )?;
     let n1 = args.benchmark.eq_ignore_ascii_case("n1");
     let depth = args.depth.unwrap_or(if n1 { 10.0 } else { 2.0 });
     let step = args.step.unwrap_or(if n1 { 0.25 } else { 0.1 });
