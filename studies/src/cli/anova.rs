@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate anova --data table1.csv --response r2 --factors material,space --json anova.json --plot plots
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// CSV file, one row per run.
     #[arg(long)]

@@ -21,7 +21,7 @@ use std::path::PathBuf;
 ///
 /// Example: palpate calibrate --law mooney-rivlin --data uniaxial=u.csv --data biaxial=b.csv --json fit.json
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N (N = 1..6),
     /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N.

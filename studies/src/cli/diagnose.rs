@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate diagnose --benchmark C1 --data record.csv --base neo-hookean --json gap.json
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Benchmark the record comes from: C1 (analytic compression, seconds) or
     /// N1 (FE needle indentation on the coarse mesh, frictionless needle,

@@ -51,7 +51,7 @@ use std::path::{Path, PathBuf};
 /// response), design.json (with defining relation, resolution and aliases)
 /// and, when the response is computed, anova.json and plots/ into --out.
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// The design manifest (TOML).
     #[arg(long)]

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate sample --benchmark C1 --law reduced-polynomial:2 --data c1.csv --sampler nuts --json post.json --plot figs
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
     #[arg(long)]

@@ -22,6 +22,7 @@ use crate::plot::{Plot, Series};
 
 /// Options of `palpate simulate`.
 #[derive(Debug, clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder) or C1 (compression of a 38 x 9 mm cylinder).
     #[arg(long, value_parser = ["N1", "C1", "n1", "c1"])]
