@@ -603,6 +603,28 @@ fn bad_option_values_name_the_option() {
     ] {
         refused(&simulate(&s, "C1", &extra), &[needle]);
     }
+    let uni = format!("uniaxial={}", s.file("in.csv", UNI));
+    for law in [
+        "ogden:0",
+        "ogden:100",
+        "ogden:18446744073709551615",
+        "reduced-polynomial:1000000",
+    ] {
+        for cmd in ["calibrate", "sample"] {
+            let o = s.run(&[cmd, "--law", law, "--data", &uni]);
+            refused(&o, &[&format!("--law {law}"), "allowed: 1..="]);
+        }
+        let o = s.run(&[
+            "simulate",
+            "--benchmark",
+            "C1",
+            "--law",
+            law,
+            "--param",
+            "mu1=1",
+        ]);
+        refused(&o, &[law, "allowed: 1..="]);
+    }
     let o = s.run(&["simulate", "--benchmark", "C1", "--law", "nonsense"]);
     refused(&o, &["nonsense"]);
     let o = s.run(&[
