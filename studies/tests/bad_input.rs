@@ -181,6 +181,40 @@ fn anova_max_order_outside_the_factors_is_refused() {
             ],
         );
     }
+    for alpha in ["-0.1", "0", "1", "7", "NaN"] {
+        let o = s.run(&[
+            "anova",
+            "--data",
+            &t,
+            "--response",
+            "r2",
+            "--factors",
+            "law",
+            "--alpha",
+            alpha,
+        ]);
+        refused(&o, &[&format!("--alpha {alpha}"), "between 0 and 1"]);
+    }
+    let o = s.run(&[
+        "anova",
+        "--data",
+        &t,
+        "--response",
+        "r2",
+        "--factors",
+        "law,r2",
+    ]);
+    refused(&o, &["--factors law,r2", "`r2` is the response"]);
+    let o = s.run(&[
+        "anova",
+        "--data",
+        &t,
+        "--response",
+        "r2",
+        "--factors",
+        "law,law",
+    ]);
+    refused(&o, &["`law` appears twice"]);
     let o = s.run(&[
         "anova",
         "--data",
@@ -220,6 +254,11 @@ fn doe_run_counts_and_orders_are_checked_before_the_design_is_built() {
     refused(
         &s.run(&["doe", "--manifest", &m]),
         &["order.toml", "analysis.max_order", "0"],
+    );
+    let m = s.file("alpha.toml", &format!("{two}[analysis]\nalpha = 5\n"));
+    refused(
+        &s.run(&["doe", "--manifest", &m]),
+        &["alpha.toml", "analysis.alpha", "5"],
     );
     let m = s.file("ok.toml", two);
     accepted(&s.run(&["doe", "--manifest", &m]));

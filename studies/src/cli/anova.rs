@@ -52,6 +52,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         &[&args.data],
         &crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]),
     )?;
+    check_alpha("--alpha", args.alpha)?;
+    if let Some(f) = args.factors.iter().find(|f| f.trim() == args.response) {
+        anyhow::bail!(
+            "--factors {}: `{f}` is the response (--response {}); a column cannot explain itself",
+            args.factors.join(","),
+            args.response
+        );
+    }
     let table = RunsTable::read(&args.data)?;
     let factors = args
         .factors
@@ -69,6 +77,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("ANOVA of `{}` in {}", args.response, args.data.display()))?;
     print!("{}", format_analysis(&analysis));
     write_outputs(&analysis, args.json.as_deref(), args.plot.as_deref())
+}
+
+/// Checks a significance level (`what` names the option or field): a
+/// probability strictly between 0 and 1.
+pub fn check_alpha(what: &str, alpha: f64) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        alpha > 0.0 && alpha < 1.0,
+        "{what} {alpha}: expected a significance level strictly between 0 and 1, such as 0.05"
+    );
+    Ok(())
 }
 
 /// Writes the JSON record and the plots where asked.

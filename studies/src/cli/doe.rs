@@ -207,6 +207,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         design.factors.len(),
         design.runs.len(),
     )?;
+    if let Some(a) = manifest.analysis.alpha {
+        super::anova::check_alpha(&format!("{m}: analysis.alpha ="), a)?;
+    }
     if let Some(seed) = manifest.design.seed {
         design = design.randomised(seed);
     }
