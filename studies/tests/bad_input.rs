@@ -260,6 +260,38 @@ fn doe_run_counts_and_orders_are_checked_before_the_design_is_built() {
         &s.run(&["doe", "--manifest", &m]),
         &["alpha.toml", "analysis.alpha", "5"],
     );
+    for (name, text, needle) in [
+        (
+            "e1.toml",
+            "[[factors]]\nname = \"a\"\nlevels = []\n",
+            "at least 2 levels",
+        ),
+        (
+            "e2.toml",
+            "[[factors]]\nname = \"a\"\nlevels = [\"x\", \"x\"]\n",
+            "twice",
+        ),
+        ("e3.toml", "factors = []\n", "at least one factor"),
+        (
+            "e4.toml",
+            &format!("[design]\nreplicates = 0\n{two}"),
+            "replicates",
+        ),
+        (
+            "e5.toml",
+            &format!("[design]\ngenerators = [\"C=AB\"]\n{two}"),
+            "C=AB",
+        ),
+        (
+            "e6.toml",
+            &format!("{two}[[factors]]\nname = \"a\"\nlevels = [\"p\", \"q\"]\n"),
+            "`a`",
+        ),
+        ("e7.toml", &format!("{two}colour = 1\n"), "colour"),
+    ] {
+        let m = s.file(name, text);
+        refused(&s.run(&["doe", "--manifest", &m]), &[name, needle]);
+    }
     let m = s.file("ok.toml", two);
     accepted(&s.run(&["doe", "--manifest", &m]));
 }

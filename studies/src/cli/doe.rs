@@ -197,10 +197,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         manifest.design.replicates,
     )?;
     let mut design = if gens.is_empty() {
-        Design::full_factorial(manifest.factors.clone(), manifest.design.replicates)?
+        Design::full_factorial(manifest.factors.clone(), manifest.design.replicates)
     } else {
-        Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)?
-    };
+        Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)
+    }
+    .map_err(|e| anyhow::anyhow!("{m}: {e}"))?;
     crate::limits::check_anova(
         &format!("{m}: analysis.max_order ="),
         manifest.analysis.max_order,
