@@ -135,6 +135,18 @@ fn absurd_sampler_sizes_are_refused_with_the_estimate() {
             refused(&o, &[needle, "fit in memory"]);
         }
     }
+    for (flag, value) in [("--draws", "0"), ("--draws", "3"), ("--parallel", "0")] {
+        let o = s.run(&[
+            "sample",
+            "--law",
+            "neo-hookean",
+            "--data",
+            &uni,
+            flag,
+            value,
+        ]);
+        refused(&o, &[&format!("{flag} {value}")]);
+    }
     let o = s.run(&[
         "sample",
         "--law",
@@ -696,6 +708,29 @@ fn bad_option_values_name_the_option() {
         ]);
         refused(&o, &[law, "allowed: 1..="]);
     }
+    for v in ["nan", "inf", "x"] {
+        let fix = format!("C01={v}");
+        let o = s.run(&[
+            "calibrate",
+            "--law",
+            "mooney-rivlin",
+            "--data",
+            &uni,
+            "--fix",
+            &fix,
+        ]);
+        refused(&o, &[&format!("--fix {fix}")]);
+    }
+    let o = s.run(&[
+        "calibrate",
+        "--benchmark",
+        "C1",
+        "--law",
+        "neo-hookean",
+        "--data",
+        "uniaxial=F",
+    ]);
+    refused(&o, &["--data uniaxial=F", "C1=FILE"]);
     let o = s.run(&["simulate", "--benchmark", "C1", "--law", "nonsense"]);
     refused(&o, &["nonsense"]);
     let o = s.run(&[

@@ -72,6 +72,13 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
                     .strip_prefix("C1=")
                     .or_else(|| d.strip_prefix("c1="))
                     .unwrap_or(d);
+                if let Some((test, _)) = path.split_once('=') {
+                    if !std::path::Path::new(path).exists() {
+                        anyhow::bail!(
+                            "--data {d}: with --benchmark C1 every record is a C1 force record; give FILE or C1=FILE, not {test}=FILE"
+                        );
+                    }
+                }
                 out.push(TestData::read(
                     "C1",
                     TestKind::C1,
@@ -112,7 +119,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let (name, value) = split_pair(f, "NAME=VALUE, e.g. C01=0")?;
         let v: f64 = value
             .parse()
-            .map_err(|_| anyhow::anyhow!("--fix {f}: `{value}` is not a number"))?;
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| anyhow::anyhow!("--fix {f}: `{value}` is not a finite number"))?;
         if fixed.iter().any(|(n, _)| n == name) {
             anyhow::bail!("--fix {f}: {name} is fixed twice; give each parameter once");
         }

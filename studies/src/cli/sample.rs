@@ -129,6 +129,14 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
         Sampler::Demc(s) => (s.populations, s.chains, s.tune, s.draws, s.thin),
         Sampler::Nuts(s) => (s.chains, 1, s.tune, s.draws, 1),
     };
+    anyhow::ensure!(
+        draws >= 4,
+        "--draws {draws}: at least 4 draws per chain are needed for the diagnostics"
+    );
+    anyhow::ensure!(
+        units >= 1 && per_unit >= 1,
+        "--parallel {units}: at least 1 parallel unit is needed"
+    );
     let what = format!(
         "--draws {draws} x --parallel {units} ({} chains each)",
         per_unit
