@@ -542,12 +542,10 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
             Ok((model, theta))
         })
         .collect::<anyhow::Result<_>>()?;
-    let bar = indicatif::ProgressBar::new(d.runs.len() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:30} {pos}/{len} N1 runs [{elapsed_precise}, eta {eta}]",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = crate::limits::Progress::new(
+        d.runs.len() as u64,
+        "N1 runs",
+        "{bar:30} {pos}/{len} N1 runs [{elapsed_precise}, eta {eta}]",
     );
     let out = d
         .runs
@@ -566,6 +564,6 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
             Ok(if spec.metric == "r2" { r2 } else { rms })
         })
         .collect();
-    bar.finish_and_clear();
+    bar.finish();
     out
 }
