@@ -99,6 +99,27 @@ impl TestData {
                 (loading, table.column(Column::FORCE)?.to_vec())
             }
         };
+        // A record must carry a curve: two samples at least, and not zero
+        // everywhere (a fit to zeros "converges" to nothing with R^2 -inf).
+        let column = match test {
+            TestKind::Homogeneous(_) => Column::STRESS,
+            _ => Column::FORCE,
+        };
+        if observed.len() < 2 {
+            anyhow::bail!(
+                "{}:{}: a single data row; a record needs at least 2 rows of `{column}`",
+                path.display(),
+                table.lines[0]
+            );
+        }
+        if observed.iter().all(|&v| v == 0.0) {
+            anyhow::bail!(
+                "{}: column `{column}` is zero on every row (lines {}-{}): nothing to fit",
+                path.display(),
+                table.lines[0],
+                table.lines[table.lines.len() - 1]
+            );
+        }
         Ok(TestData {
             name: name.to_string(),
             test,

@@ -252,6 +252,27 @@ impl Manifest {
     pub fn validate(&self, manifest_path: &Path) -> anyhow::Result<()> {
         let where_ = manifest_path.display();
         let dir = manifest_path.parent().unwrap_or(Path::new("."));
+        // The study name is the run folder under runs/ and each step name a
+        // file-name prefix in it: one plain name each, no two steps alike.
+        check_file_name(&self.study.name)
+            .map_err(|e| anyhow::anyhow!("{where_}: study.name = {:?}: {e}", self.study.name))?;
+        anyhow::ensure!(
+            !self.steps.is_empty(),
+            "{where_}: steps: no steps; give at least one [[steps]] table"
+        );
+        for (i, step) in self.steps.iter().enumerate() {
+            let (kind, name) = match step {
+                Step::Calibrate(c) => ("calibrate", &c.name),
+                Step::Diagnose(d) => ("diagnose", &d.name),
+            };
+            check_file_name(name)
+                .map_err(|e| anyhow::anyhow!("{where_}: steps[{i}].{kind}.name = {name:?}: {e}"))?;
+            if let Some(j) = self.steps[..i].iter().position(|s| s.name() == name) {
+                anyhow::bail!(
+                    "{where_}: steps[{i}].{kind}.name = {name:?}: steps[{j}] has the same name (their outputs would overwrite each other)"
+                );
+            }
+        }
         for (name, d) in &self.data {
             if !TESTS.contains(&d.test.as_str()) {
                 anyhow::bail!(
@@ -283,6 +304,18 @@ impl Manifest {
             match step {
                 Step::Calibrate(c) => {
                     let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
+                    for (field, list) in [
+                        ("models", &c.models),
+                        ("residuals", &c.residuals),
+                        ("predict", &c.predict),
+                    ] {
+                        if list.is_empty() && field != "predict" {
+                            anyhow::bail!("{where_}: {at}.{field} = []: give at least one");
+                        }
+                        if let Some(d) = duplicate(list) {
+                            anyhow::bail!("{where_}: {at}.{field}: \"{d}\" is listed twice");
+                        }
+                    }
                     for m in &c.models {
                         if !self.models.contains_key(m) {
                             anyhow::bail!(
@@ -372,9 +405,33 @@ impl Manifest {
                             "{where_}: {at}: give exactly one of `base` (a law) and `model` (a model name)"
                         ),
                     }
+                    anyhow::ensure!(
+                        !d.data.is_empty(),
+                        "{where_}: {at}.data = []: give at least one record"
+                    );
+                    let mut effects = Vec::new();
                     for e in d.effects.iter().flatten() {
-                        if let Err(m) = e.parse::<palpate_core::Effect>() {
-                            anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}");
+                        match e.parse::<palpate_core::Effect>() {
+                            Ok(e) => effects.push(e),
+                            Err(m) => anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}"),
+                        }
+                    }
+                    if let Some(list) = &d.effects {
+                        anyhow::ensure!(
+                            !list.is_empty(),
+                            "{where_}: {at}.effects = []: give at least one effect, or leave `effects` out for the default candidates"
+                        );
+                        if let Some(e) = duplicate(list) {
+                            anyhow::bail!("{where_}: {at}.effects: \"{e}\" is listed twice");
+                        }
+                    }
+                    for s in &d.data {
+                        let Some(spec) = self.diagnose_model(d, s) else {
+                            continue;
+                        };
+                        if let Ok(model) = crate::models::build(&spec) {
+                            crate::models::check_effects(model.as_ref(), &effects)
+                                .map_err(|e| anyhow::anyhow!("{where_}: {at}.effects: {e}"))?;
                         }
                     }
                 }
@@ -384,7 +441,63 @@ impl Manifest {
     }
 }
 
+impl Step {
+    /// The step's name.
+    pub fn name(&self) -> &str {
+        match self {
+            Step::Calibrate(c) => &c.name,
+            Step::Diagnose(d) => &d.name,
+        }
+    }
+}
+
+/// The first entry of a list that appears twice.
+fn duplicate(list: &[String]) -> Option<&String> {
+    list.iter()
+        .enumerate()
+        .find(|(i, x)| list[..*i].contains(x))
+        .map(|(_, x)| x)
+}
+
+/// Checks a name used as a file or folder name inside the run folder: not
+/// empty, no path separator, not `.` or `..`, no control character, so that
+/// nothing is written outside `runs/` or into `runs/` itself.
+pub fn check_file_name(name: &str) -> Result<(), String> {
+    if name.trim().is_empty() {
+        return Err("empty; expected a plain name such as \"treloar-laws\"".into());
+    }
+    if name.contains(['/', '\\']) || Path::new(name).is_absolute() {
+        return Err(
+            "contains a path separator; expected a plain name (it names a folder inside runs/)"
+                .into(),
+        );
+    }
+    if name == "." || name == ".." {
+        return Err("expected a plain name, not a reference to a folder".into());
+    }
+    if name.chars().any(char::is_control) {
+        return Err("contains a control character".into());
+    }
+    Ok(())
+}
+
 impl Manifest {
+    /// The base model a diagnose step uses on data set `data` (None when
+    /// the step or the data set is wrong: reported elsewhere).
+    fn diagnose_model(&self, d: &DiagnoseStep, data: &str) -> Option<ModelSpec> {
+        match (&d.base, &d.model) {
+            (Some(base), None) => {
+                let test = crate::calibration::TestKind::parse(&self.data.get(data)?.test).ok()?;
+                crate::models::gap_base(test, base.parse().ok()?).ok()
+            }
+            (None, Some(m)) => match &self.models.get(m)?.model {
+                ModelForm::Spec(s) => Some(s.clone()),
+                ModelForm::Law(_) => None,
+            },
+            _ => None,
+        }
+    }
+
     /// Checks that a model spec predicts the records of data set `data`.
     fn check_predicts(
         &self,

@@ -520,6 +520,27 @@ pub fn default_effects(base: &ModelSpec) -> Option<Vec<Effect>> {
         .then(|| vec![Effect::Friction, Effect::BoundaryCondition])
 }
 
+/// Checks that a model offers every requested effect; the error (`E: ...`)
+/// names the first one it does not offer and lists those it does.
+pub fn check_effects(model: &dyn ForwardModel, effects: &[Effect]) -> Result<(), String> {
+    let offered = palpate_core::enrichable::effects_of(model);
+    match effects.iter().find(|e| !offered.contains(e)) {
+        None => Ok(()),
+        Some(e) => {
+            let names: Vec<String> = offered.iter().map(|e| e.to_string()).collect();
+            Err(format!(
+                "{e}: {} does not offer this effect (it offers: {})",
+                model.name(),
+                if names.is_empty() {
+                    "none".into()
+                } else {
+                    names.join(", ")
+                }
+            ))
+        }
+    }
+}
+
 /// Effect names (GAP.md) parsed, the error naming the bad one.
 pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
     names

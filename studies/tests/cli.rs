@@ -410,3 +410,31 @@ fn simulate_q1_ramp_and_hold() {
         assert_clean_failure(&palpate(&args), says);
     }
 }
+
+/// With stderr not a terminal (a log file, CI), a long `sample` run still
+/// shows that it is alive: plain progress lines instead of a hidden bar.
+#[test]
+fn sample_reports_progress_when_stderr_is_not_a_terminal() {
+    let uni = format!("uniaxial={}", treloar("uniaxial.csv"));
+    let o = palpate(&[
+        "sample",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &uni,
+        "--draws",
+        "200",
+        "--tune",
+        "200",
+        "--parallel",
+        "2",
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let lines: Vec<String> = stderr(&o)
+        .lines()
+        .filter(|l| l.starts_with("nuts: ") && l.ends_with("%)"))
+        .map(String::from)
+        .collect();
+    assert!(lines.len() >= 3, "progress lines: {lines:?}");
+    assert!(lines.iter().any(|l| l.contains("/800 (")), "{lines:?}");
+}

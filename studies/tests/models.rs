@@ -140,7 +140,7 @@ fn simulate_spec(args: &[&str]) -> ModelSpec {
     let mut argv = vec!["palpate", "simulate"];
     argv.extend_from_slice(args);
     match Cli::try_parse_from(argv).unwrap().command {
-        Command::Simulate(a) => palpate_studies::cli::simulate::model_spec(&a),
+        Command::Simulate(a) => palpate_studies::cli::simulate::model_spec(&a).unwrap(),
         other => panic!("{other:?}"),
     }
 }

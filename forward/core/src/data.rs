@@ -124,6 +124,17 @@ impl TextTable {
     /// Parses text as if read from `file`.
     pub fn parse(file: impl AsRef<Path>, text: &str) -> Result<TextTable, DataError> {
         let file = file.as_ref().to_path_buf();
+        // A UTF-8 byte-order mark (what Excel writes) is not part of the
+        // first column's name; lines may end in LF, CR LF or CR alone (old
+        // Mac files), and each ending counts as one line in messages.
+        let text = text.strip_prefix('\u{feff}').unwrap_or(text);
+        let unified;
+        let text = if text.contains('\r') {
+            unified = text.replace("\r\n", "\n").replace('\r', "\n");
+            unified.as_str()
+        } else {
+            text
+        };
         let mut names: Option<Vec<String>> = None;
         let (mut rows, mut lines, mut comments) = (Vec::new(), Vec::new(), Vec::new());
         for (i, raw) in text.lines().enumerate() {
@@ -319,5 +330,27 @@ mod tests {
         let e = t.column("displacement_mm").unwrap_err().to_string();
         assert!(e.contains("a.csv") && e.contains("displacement_mm"), "{e}");
         assert!(Table::parse("a.csv", "# only comments\n").is_err());
+    }
+
+    #[test]
+    fn a_byte_order_mark_and_every_line_ending_read_the_same() {
+        let plain = "# c\ntime_s,force_N\n0,1\n0.5,2.5\n";
+        let want = Table::parse("x.csv", plain).unwrap();
+        for text in [
+            format!("\u{feff}{plain}"),
+            plain.replace('\n', "\r\n"),
+            plain.replace('\n', "\r"),
+            format!("\u{feff}{}", plain.replace('\n', "\r")),
+            format!("\u{feff}{}", plain.replace('\n', "\r\n")),
+        ] {
+            let t = Table::parse("x.csv", &text).unwrap();
+            assert_eq!(t, want, "{text:?}");
+            assert_eq!(t.names[0], "time_s");
+        }
+        // The checks that depend on the first column still run, at the right line.
+        let e = Table::parse("b.csv", "\u{feff}time_s,force_N\r1,1\r0.5,2\r")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("b.csv:3") && e.contains("monotonic"), "{e}");
     }
 }

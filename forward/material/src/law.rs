@@ -14,6 +14,10 @@ use crate::{
 
 /// Highest order of the reduced polynomial law.
 pub const MAX_POLYNOMIAL_ORDER: usize = 6;
+/// The most Ogden terms accepted: each term has its own start exponent
+/// (2, -2, 4, -4, 6, -6), and more terms than data can identify only make a
+/// fit fail later on an internal start value or an allocation.
+pub const MAX_OGDEN_TERMS: usize = 6;
 
 /// An isotropic hyperelastic law with an isochoric energy `W` (Abaqus conventions, see each module).
 ///
@@ -36,7 +40,7 @@ pub enum Law {
     ReducedPolynomial(usize),
     /// 5-term Arruda-Boyce series.
     ArrudaBoyce,
-    /// `W = sum_{i=1..N} 2 mu_i / alpha_i^2 (l1^a_i + l2^a_i + l3^a_i - 3)`, `N >= 1`.
+    /// `W = sum_{i=1..N} 2 mu_i / alpha_i^2 (l1^a_i + l2^a_i + l3^a_i - 3)`, `N = 1..=6` ([`MAX_OGDEN_TERMS`]).
     Ogden(usize),
 }
 
@@ -165,11 +169,11 @@ impl Law {
                     allowed: format!("1..={MAX_POLYNOMIAL_ORDER}"),
                 })
             }
-            Law::Ogden(0) => {
+            Law::Ogden(n) if !(1..=MAX_OGDEN_TERMS).contains(&n) => {
                 return Err(MaterialError::BadOrder {
                     law: "ogden".into(),
-                    order: 0,
-                    allowed: ">= 1".into(),
+                    order: n,
+                    allowed: format!("1..={MAX_OGDEN_TERMS}"),
                 })
             }
             _ => {}
@@ -329,7 +333,7 @@ impl FromStr for Law {
     type Err = MaterialError;
 
     /// Parses `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N` (N = 1..=6), `yeoh`
-    /// (= `reduced-polynomial:3`), `arruda-boyce`, `ogden:N` (N >= 1); case and surrounding blanks ignored.
+    /// (= `reduced-polynomial:3`), `arruda-boyce`, `ogden:N` (N = 1..=6); case and surrounding blanks ignored.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let text = s.trim().to_ascii_lowercase();
         let unknown = || MaterialError::UnknownLaw {
@@ -358,11 +362,11 @@ impl FromStr for Law {
                 Law::ReducedPolynomial(n)
             }
             ("ogden", Some(n)) => {
-                if n == 0 {
+                if !(1..=MAX_OGDEN_TERMS).contains(&n) {
                     return Err(MaterialError::BadOrder {
                         law: "ogden".into(),
-                        order: 0,
-                        allowed: ">= 1".into(),
+                        order: n,
+                        allowed: format!("1..={MAX_OGDEN_TERMS}"),
                     });
                 }
                 Law::Ogden(n)

@@ -735,3 +735,27 @@ fn benchmark_materials_are_valid_and_drucker_stable() {
         }
     }
 }
+
+/// Ogden terms are bounded like polynomial orders: every accepted count
+/// starts inside its bounds, and an absurd count (up to usize::MAX) is a
+/// named error, not a failing start value or a capacity-overflow panic.
+#[test]
+fn ogden_terms_are_bounded_like_polynomial_orders() {
+    for n in 1..=6 {
+        let law: Law = format!("ogden:{n}").parse().unwrap();
+        assert!(law
+            .params()
+            .iter()
+            .all(|p| p.initial > p.lower && p.initial < p.upper));
+    }
+    for bad in [
+        "ogden:0",
+        "ogden:7",
+        "ogden:100",
+        "ogden:18446744073709551615",
+    ] {
+        let e = bad.parse::<Law>().unwrap_err().to_string();
+        assert!(e.contains("1..=6"), "{bad}: {e}");
+    }
+    assert!(Law::Ogden(7).check(&[0.0; 14]).is_err());
+}

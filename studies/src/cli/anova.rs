@@ -20,7 +20,7 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate anova --data table1.csv --response r2 --factors material,space --json anova.json --plot plots
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// CSV file, one row per run.
     #[arg(long)]
@@ -48,6 +48,18 @@ pub struct Args {
 
 /// Runs `palpate anova`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    crate::output::check_outputs(
+        &[&args.data],
+        &crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]),
+    )?;
+    check_alpha("--alpha", args.alpha)?;
+    if let Some(f) = args.factors.iter().find(|f| f.trim() == args.response) {
+        anyhow::bail!(
+            "--factors {}: `{f}` is the response (--response {}); a column cannot explain itself",
+            args.factors.join(","),
+            args.response
+        );
+    }
     let table = RunsTable::read(&args.data)?;
     let factors = args
         .factors
@@ -55,6 +67,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(|f| table.factor(f.trim()))
         .collect::<Result<Vec<_>, _>>()?;
     let y = table.numeric(&args.response)?;
+    crate::limits::check_anova("--max-order", args.max_order, factors.len(), y.len())?;
     let options = AnovaOptions {
         max_order: args.max_order,
         alpha: args.alpha,
@@ -64,6 +77,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("ANOVA of `{}` in {}", args.response, args.data.display()))?;
     print!("{}", format_analysis(&analysis));
     write_outputs(&analysis, args.json.as_deref(), args.plot.as_deref())
+}
+
+/// Checks a significance level (`what` names the option or field): a
+/// probability strictly between 0 and 1.
+pub fn check_alpha(what: &str, alpha: f64) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        alpha > 0.0 && alpha < 1.0,
+        "{what} {alpha}: expected a significance level strictly between 0 and 1, such as 0.05"
+    );
+    Ok(())
 }
 
 /// Writes the JSON record and the plots where asked.

@@ -7,6 +7,7 @@ use crate::report::{calibration_table, fit_plot};
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
+use std::path::Path;
 use std::path::PathBuf;
 
 /// Fit a hyperelastic law to measured data.
@@ -20,7 +21,7 @@ use std::path::PathBuf;
 ///
 /// Example: palpate calibrate --law mooney-rivlin --data uniaxial=u.csv --data biaxial=b.csv --json fit.json
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N (N = 1..6),
     /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N.
@@ -71,6 +72,13 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
                     .strip_prefix("C1=")
                     .or_else(|| d.strip_prefix("c1="))
                     .unwrap_or(d);
+                if let Some((test, _)) = path.split_once('=') {
+                    if !std::path::Path::new(path).exists() {
+                        anyhow::bail!(
+                            "--data {d}: with --benchmark C1 every record is a C1 force record; give FILE or C1=FILE, not {test}=FILE"
+                        );
+                    }
+                }
                 out.push(TestData::read(
                     "C1",
                     TestKind::C1,
@@ -111,10 +119,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let (name, value) = split_pair(f, "NAME=VALUE, e.g. C01=0")?;
         let v: f64 = value
             .parse()
-            .map_err(|_| anyhow::anyhow!("--fix {f}: `{value}` is not a number"))?;
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| anyhow::anyhow!("--fix {f}: `{value}` is not a finite number"))?;
+        if fixed.iter().any(|(n, _)| n == name) {
+            anyhow::bail!("--fix {f}: {name} is fixed twice; give each parameter once");
+        }
         fixed.push((name.to_string(), v));
     }
     let data = read_data(&args.data, args.benchmark.as_deref())?;
+    let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
+    let outputs = crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
+    crate::output::check_outputs(&inputs, &outputs)?;
     let result = calibrate(Request {
         law,
         model: None,

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate diagnose --benchmark C1 --data record.csv --base neo-hookean --json gap.json
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Benchmark the record comes from: C1 (analytic compression, seconds) or
     /// N1 (FE needle indentation on the coarse mesh, frictionless needle,
@@ -83,6 +83,10 @@ pub fn diagnose_file(
     if options.effects.is_none() {
         options.effects = default_effects(&spec);
     }
+    if let Some(effects) = &options.effects {
+        crate::models::check_effects(model.as_ref(), effects)
+            .map_err(|e| anyhow::anyhow!("--effects {e} (--benchmark {benchmark})"))?;
+    }
     diagnose(model.as_ref(), &record.loading, &record.observed, &options)
         .with_context(|| format!("diagnosing {}", data.display()))
 }
@@ -97,6 +101,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if !args.effects.is_empty() {
         options.effects = Some(parse_effects(&args.effects).context("--effects")?);
     }
+    crate::output::check_outputs(
+        &[&args.data],
+        &crate::output::given(&[
+            ("--json", &args.json),
+            ("--report", &args.report),
+            ("--plot", &args.plot),
+        ]),
+    )?;
     let report = diagnose_file(&args.benchmark, &args.base, &args.data, &options)?;
     println!("{}", gap_summary(&report));
     if let Some(p) = &args.json {

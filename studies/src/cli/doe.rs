@@ -51,7 +51,7 @@ use std::path::{Path, PathBuf};
 /// response), design.json (with defining relation, resolution and aliases)
 /// and, when the response is computed, anova.json and plots/ into --out.
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// The design manifest (TOML).
     #[arg(long)]
@@ -185,11 +185,32 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .iter()
         .map(String::as_str)
         .collect();
+    let levels: Vec<usize> = manifest.factors.iter().map(|f| f.levels.len()).collect();
+    let m = args.manifest.display();
+    crate::limits::check_runs(
+        &format!(
+            "{m}: [[factors]] and design.replicates = {}",
+            manifest.design.replicates
+        ),
+        &levels,
+        gens.len(),
+        manifest.design.replicates,
+    )?;
     let mut design = if gens.is_empty() {
-        Design::full_factorial(manifest.factors.clone(), manifest.design.replicates)?
+        Design::full_factorial(manifest.factors.clone(), manifest.design.replicates)
     } else {
-        Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)?
-    };
+        Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)
+    }
+    .map_err(|e| anyhow::anyhow!("{m}: {e}"))?;
+    crate::limits::check_anova(
+        &format!("{m}: analysis.max_order ="),
+        manifest.analysis.max_order,
+        design.factors.len(),
+        design.runs.len(),
+    )?;
+    if let Some(a) = manifest.analysis.alpha {
+        super::anova::check_alpha(&format!("{m}: analysis.alpha ="), a)?;
+    }
     if let Some(seed) = manifest.design.seed {
         design = design.randomised(seed);
     }
@@ -521,12 +542,10 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
             Ok((model, theta))
         })
         .collect::<anyhow::Result<_>>()?;
-    let bar = indicatif::ProgressBar::new(d.runs.len() as u64);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template(
-            "{bar:30} {pos}/{len} N1 runs [{elapsed_precise}, eta {eta}]",
-        )
-        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = crate::limits::Progress::new(
+        d.runs.len() as u64,
+        "N1 runs",
+        "{bar:30} {pos}/{len} N1 runs [{elapsed_precise}, eta {eta}]",
     );
     let out = d
         .runs
@@ -545,6 +564,6 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
             Ok(if spec.metric == "r2" { r2 } else { rms })
         })
         .collect();
-    bar.finish_and_clear();
+    bar.finish();
     out
 }

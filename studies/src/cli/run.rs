@@ -10,7 +10,7 @@ use std::path::PathBuf;
 /// seed, thread count). Data file paths in the manifest are relative to it.
 /// See studies/*.toml for examples and docs/guide.md for every field.
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// The study manifest (TOML).
     pub manifest: PathBuf,

@@ -32,7 +32,7 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate sample --benchmark C1 --law reduced-polynomial:2 --data c1.csv --sampler nuts --json post.json --plot figs
 #[derive(Debug, clap::Args)]
-#[command(verbatim_doc_comment)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
     #[arg(long)]
@@ -110,6 +110,53 @@ fn sampler_from(args: &Args) -> anyhow::Result<Sampler> {
     })
 }
 
+/// The stored draws (units x chains per unit x draws, `dim` numbers each)
+/// must fit in memory and the iteration count in a counter, checked before
+/// anything is allocated; `dim` is an upper bound of the sampled dimension.
+fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()> {
+    let (units, per_unit, tune, draws, thin) = match sampler {
+        Sampler::Ensemble(s) => (
+            s.ensembles,
+            if s.walkers == 0 {
+                (4 * dim).max(16)
+            } else {
+                s.walkers
+            },
+            s.tune,
+            s.draws,
+            s.thin,
+        ),
+        Sampler::Demc(s) => (s.populations, s.chains, s.tune, s.draws, s.thin),
+        Sampler::Nuts(s) => (s.chains, 1, s.tune, s.draws, 1),
+    };
+    anyhow::ensure!(
+        draws >= 4,
+        "--draws {draws}: at least 4 draws per chain are needed for the diagnostics"
+    );
+    anyhow::ensure!(
+        units >= 1 && per_unit >= 1,
+        "--parallel {units}: at least 1 parallel unit is needed"
+    );
+    let what = format!(
+        "--draws {draws} x --parallel {units} ({} chains each)",
+        per_unit
+    );
+    crate::limits::check_count(
+        &what,
+        draws as f64 * units as f64 * per_unit as f64,
+        "stored draws",
+        8.0 * (dim as f64 + 2.0),
+    )?;
+    let iterations = units as f64 * (tune as f64 + draws as f64 * thin as f64);
+    anyhow::ensure!(
+        iterations <= 2f64.powi(53),
+        "--tune {} / --draws {}: {iterations:.3e} iterations, more than can be counted (2^53)",
+        args.tune.unwrap_or(tune),
+        draws
+    );
+    Ok(())
+}
+
 /// Runs `palpate sample`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let law: Law = args
@@ -117,7 +164,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .parse()
         .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
     let sampler = sampler_from(&args)?;
+    check_sizes(&args, &sampler, law.params().len() + 2 * args.data.len())?;
     let data = read_data(&args.data, args.benchmark.as_deref())?;
+    let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
+    crate::output::check_outputs(
+        &inputs,
+        &crate::output::given(&[
+            ("--json", &args.json),
+            ("--chains", &args.chains_out),
+            ("--plot", &args.plot),
+        ]),
+    )?;
     if let Some(s) = args.sigma {
         anyhow::ensure!(
             s.is_finite() && s > 0.0,
@@ -159,6 +216,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     for p in &args.prior {
         let (name, spec) =
             crate::cli::calibrate::split_pair(p, "NAME=SPEC, e.g. C10=lognormal:-7,1")?;
+        if args
+            .prior
+            .iter()
+            .take_while(|q| !std::ptr::eq(*q, p))
+            .any(|q| q.split_once('=').map(|x| x.0) == Some(name))
+        {
+            anyhow::bail!(
+                "--prior {p}: a prior for {name} is given twice; give each parameter one prior"
+            );
+        }
         let k = space.index_of(name).ok_or_else(|| {
             anyhow::anyhow!(
                 "--prior {p}: unknown parameter `{name}` (the law has {})",
@@ -180,15 +247,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let start = fit_and_laplace(&post).context("finding the start of the chains")?;
     let (lap_mean, lap_sd) = start.laplace_physical(&post);
 
-    let bar = indicatif::ProgressBar::new(sampler.total_iterations());
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} iterations ({eta})")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    let bar = crate::limits::Progress::new(
+        sampler.total_iterations(),
+        &args.sampler,
+        "{msg} [{bar:40}] {pos}/{len} iterations ({eta})",
     );
-    bar.set_message(args.sampler.clone());
     let tick = |n: u64| bar.inc(n);
     let run = sampler.run(&post, &start.start, args.seed, Some(&tick))?;
-    bar.finish_and_clear();
+    bar.finish();
 
     let x = run.chains.map(|z| post.space().from_unbounded(z));
     let summary = summarize(&x, &names);

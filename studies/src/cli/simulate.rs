@@ -22,6 +22,7 @@ use crate::plot::{Plot, Series};
 
 /// Options of `palpate simulate`.
 #[derive(Debug, clap::Args)]
+#[command(allow_negative_numbers = true)]
 pub struct Args {
     /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), C1 (compression of a 38 x 9 mm cylinder) or Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm).
     #[arg(long, value_parser = ["N1", "C1", "Q1", "n1", "c1", "q1"])]
@@ -106,6 +107,12 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
             .trim()
             .parse()
             .map_err(|_| anyhow!("--param `{g}`: `{value}` is not a number"))?;
+        if values[k].is_some() {
+            bail!(
+                "--param `{g}`: {} is given twice; give each parameter once",
+                specs[k].name
+            );
+        }
         values[k] = Some(v);
     }
     let missing: Vec<_> = specs
@@ -124,9 +131,68 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
 }
 
 /// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`,
-/// Q1 -> `q1` (the settings a benchmark does not have are ignored).
-pub fn model_spec(args: &Args) -> ModelSpec {
-    if is_q1(args) {
+/// Q1 -> `q1`; an option of another benchmark is refused by name, since it
+/// would be neither used nor visible in the result.
+pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
+    let kind = if is_q1(args) {
+        "Q1"
+    } else if args.benchmark.eq_ignore_ascii_case("n1") {
+        "N1"
+    } else {
+        "C1"
+    };
+    // (option, value shown, the benchmarks that use it)
+    let options: [(bool, &str, String, &[&str]); 8] = [
+        (args.bonded, "--bonded", String::new(), &["C1"]),
+        (
+            args.prony.is_some(),
+            "--prony",
+            args.prony.clone().unwrap_or_default(),
+            &["C1", "Q1"],
+        ),
+        (
+            args.ramp.is_some(),
+            "--ramp",
+            format!("{:?}", args.ramp.unwrap_or(0.0)),
+            &["C1", "Q1"],
+        ),
+        (
+            args.hold.is_some(),
+            "--hold",
+            format!("{:?}", args.hold.unwrap_or(0.0)),
+            &["C1", "Q1"],
+        ),
+        (
+            args.friction.is_some(),
+            "--friction",
+            args.friction.map(|f| f.to_string()).unwrap_or_default(),
+            &["N1"],
+        ),
+        (args.sliding_base, "--sliding-base", String::new(), &["N1"]),
+        (
+            args.tool.is_some(),
+            "--tool",
+            args.tool.clone().unwrap_or_default(),
+            &["N1"],
+        ),
+        (
+            args.element.is_some(),
+            "--element",
+            args.element.clone().unwrap_or_default(),
+            &["N1", "Q1"],
+        ),
+    ];
+    if let Some((_, name, value, users)) = options
+        .iter()
+        .find(|(given, _, _, users)| *given && !users.contains(&kind))
+    {
+        bail!(
+            "{name}{}{value}: an option of benchmark {}; --benchmark {kind} does not use it",
+            if value.is_empty() { "" } else { " " },
+            users.join(" and ")
+        );
+    }
+    Ok(if kind == "Q1" {
         ModelSpec::Q1(Q1Spec {
             law: args.law.clone(),
             mesh: args.mesh.clone(),
@@ -134,7 +200,7 @@ pub fn model_spec(args: &Args) -> ModelSpec {
             element: args.element.clone(),
             prony: args.prony.clone(),
         })
-    } else if args.benchmark.eq_ignore_ascii_case("n1") {
+    } else if kind == "N1" {
         ModelSpec::N1Needle(N1NeedleSpec {
             law: args.law.clone(),
             friction: args.friction,
@@ -152,7 +218,7 @@ pub fn model_spec(args: &Args) -> ModelSpec {
             bulk: args.bulk.clone(),
             prony: args.prony.clone(),
         })
-    }
+    })
 }
 
 fn is_q1(args: &Args) -> bool {
@@ -161,7 +227,7 @@ fn is_q1(args: &Args) -> bool {
 
 /// Runs `palpate simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let model = model_spec(&args)
+    let model = model_spec(&args)?
         .validate()
         .map_err(|e| anyhow!("{}", e.as_option()))?;
     let law: Law = args
@@ -169,6 +235,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .parse()
         .map_err(|e| anyhow!("--law `{}`: {e}", args.law))?;
     let theta = parse_params(&law, &args.params)?;
+    crate::output::check_outputs(
+        &[],
+        &crate::output::given(&[
+            ("--csv", &args.csv),
+            ("--vtu", &args.vtu),
+            ("--plot", &args.plot),
+        ]),
+    )?;
     let n1 = args.benchmark.eq_ignore_ascii_case("n1");
     let q1 = is_q1(&args);
     let depth = args.depth.unwrap_or(if n1 {
@@ -194,7 +268,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             bail!("--order {p}: must be a positive order of convergence");
         }
     }
-    let n = (depth / step).ceil() as usize;
+    // Each sample keeps its drive, time, force and estimate, and a solve.
+    let n = crate::limits::check_count(
+        &format!(
+            "--depth {} / --step {}",
+            crate::limits::fmt_value(depth),
+            crate::limits::fmt_value(step)
+        ),
+        (depth / step).ceil() + 1.0,
+        "samples",
+        256.0,
+    )? - 1;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
     let time = timed_history(&args, depth, &mut drive)?;
     let loading = match &time {

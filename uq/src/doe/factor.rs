@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 /// A factor and its levels. For two-level designs the first level is the low
 /// (-1) setting and the second the high (+1) setting.
 #[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Factor {
     pub name: String,
     pub levels: Vec<String>,

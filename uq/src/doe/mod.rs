@@ -12,7 +12,7 @@ mod error;
 mod factor;
 mod fractional;
 
-pub use design::{Design, Run};
+pub use design::{Design, Run, MAX_RUNS};
 pub use error::DoeError;
 pub use factor::Factor;
 pub use fractional::{AliasChain, Generator, Word};
