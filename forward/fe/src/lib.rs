@@ -3,7 +3,7 @@
 //! Large-deformation finite elements with frictional rigid-tool contact, as
 //! one composable layer (docs/architecture.md has the map and how to add a
 //! model, kernel, surface or effect), and the forward models built on it:
-//! N1 needle indentation and C1 compression (`BENCHMARKS.md`).
+//! N1 and N3 needle indentation and C1 compression (`BENCHMARKS.md`).
 //!
 //! * [`mesh`] — meshes of any cell type with node sets, facet sets and
 //!   regions; generators, a Gmsh reader, VTU output.
@@ -20,7 +20,7 @@
 //! * [`system`], [`stepper`] — Newton (chord steps, line search) on a faer
 //!   sparse LU that keeps its symbolic factorisation, apart from the
 //!   stepper (channels along a path with time, cut-back, partial results).
-//! * [`n1`], [`c1`] — the forward models; [`discretisation`] — the
+//! * [`n1`], [`n3`], [`c1`] — the forward models; [`discretisation`] — the
 //!   Richardson estimate of their discretisation error from one coarser solve.
 
 // Index loops mirror the index notation of the equations; negated comparisons
@@ -46,6 +46,7 @@ pub mod mesh;
 pub mod model;
 pub mod motion;
 pub mod n1;
+pub mod n3;
 pub mod quadrature;
 pub mod shape;
 pub mod sparse;
@@ -63,6 +64,7 @@ pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Element, N1Needle};
+pub use n3::{n3_grading, N3Needle};
 pub use stepper::{LoadPath, Progress};
 pub use surface::{Cylinder3d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};
 pub use system::{RunStats, SolverOptions, System};
