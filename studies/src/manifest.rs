@@ -88,15 +88,23 @@ pub enum ModelForm {
 
 impl<'de> Deserialize<'de> for ModelEntry {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use crate::models::{C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec};
+        use crate::models::{C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec, N3NeedleSpec};
         use serde::de::{Error, MapAccess, Visitor};
-        const FIELDS: &[&str] = &["law", "fixed", "homogeneous", "c1", "c1_fe", "n1_needle"];
+        const FIELDS: &[&str] = &[
+            "law",
+            "fixed",
+            "homogeneous",
+            "c1",
+            "c1_fe",
+            "n1_needle",
+            "n3_needle",
+        ];
         struct V;
         impl<'de> Visitor<'de> for V {
             type Value = ModelEntry;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str(
-                    "a model: `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle",
+                    "a model: `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle",
                 )
             }
             fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<ModelEntry, A::Error> {
@@ -119,6 +127,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         "c1" => Some(ModelSpec::C1(map.next_value::<C1Spec>()?)),
                         "c1_fe" => Some(ModelSpec::C1Fe(map.next_value::<C1FeSpec>()?)),
                         "n1_needle" => Some(ModelSpec::N1Needle(map.next_value::<N1NeedleSpec>()?)),
+                        "n3_needle" => Some(ModelSpec::N3Needle(map.next_value::<N3NeedleSpec>()?)),
                         other => return Err(A::Error::unknown_field(other, FIELDS)),
                     };
                     if let Some(n) = next {
@@ -144,7 +153,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                     }
                     (None, None) => {
                         return Err(A::Error::custom(
-                            "no model: expected `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle",
+                            "no model: expected `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle",
                         ))
                     }
                 };

@@ -15,6 +15,13 @@
 //! base = "bonded"             # bonded | sliding
 //! tool = "needle"             # needle | sphere:R | punch:R | platen
 //!
+//! [models.needle3d.n3_needle] # N3 needle indentation, 3D quarter block (finite elements)
+//! law = "neo-hookean"
+//! friction = 0.8
+//! mesh = "coarse"             # coarse (default for N3) | medium | fine | N: 0.8/N mm hexahedra under the tool
+//! bulk = "exact"
+//! tool = "needle"
+//!
 //! [models.press.c1_fe]        # C1 compression (finite elements)
 //! law = "neo-hookean"
 //! platens = "frictionless"    # frictionless | bonded
@@ -42,7 +49,9 @@
 use crate::calibration::TestKind;
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Effect, ForwardModel};
-use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, Prony, ToolShape};
+use palpate_fe::{
+    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Needle, Platens, Prony, ToolShape,
+};
 use palpate_material::Law;
 use serde::Deserialize;
 use std::fmt;
@@ -67,6 +76,8 @@ pub enum ModelSpec {
     C1Fe(C1FeSpec),
     /// Benchmark N1, needle indentation by finite elements.
     N1Needle(N1NeedleSpec),
+    /// Benchmark N3, needle indentation of a block in 3D by finite elements.
+    N3Needle(N3NeedleSpec),
 }
 
 /// `[... .homogeneous]`
@@ -131,6 +142,33 @@ pub struct N1NeedleSpec {
     pub element: Option<String>,
 }
 
+/// `[... .n3_needle]`
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct N3NeedleSpec {
+    pub law: String,
+    /// Coulomb friction coefficient (default 0.8).
+    #[serde(default)]
+    pub friction: Option<f64>,
+    /// `coarse` (default for N3), `medium`, `fine` or a level 1..N3_MAX_LEVEL:
+    /// hexahedra of 0.8/N mm under the tool.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub mesh: Option<String>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub bulk: Option<String>,
+    /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
+    #[serde(default)]
+    pub tool: Option<String>,
+}
+
+/// The default N3 mesh: level 1 (0.8 mm hexahedra; level 2 is ~5x the
+/// unknowns and far slower in 3D).
+pub const N3_DEFAULT_MESH: &str = "coarse";
+/// The finest N3 level accepted: level 3 (~40,000 hexahedra) would need
+/// more memory and time than a 2-core, few-GiB machine has.
+pub const N3_MAX_LEVEL: usize = 2;
+
 /// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
 pub fn text_or_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     #[derive(Deserialize)]
@@ -191,6 +229,7 @@ pub enum Model {
     C1(C1Compression),
     C1Fe(C1Fe),
     N1Needle(N1Needle),
+    N3Needle(N3Needle),
 }
 
 impl Model {
@@ -201,6 +240,7 @@ impl Model {
             Model::C1(m) => Box::new(m),
             Model::C1Fe(m) => Box::new(m),
             Model::N1Needle(m) => Box::new(m),
+            Model::N3Needle(m) => Box::new(m),
         }
     }
 }
@@ -212,7 +252,7 @@ pub fn build(spec: &ModelSpec) -> Result<Box<dyn ForwardModel>, ModelError> {
 
 impl ModelSpec {
     /// The kinds, as spelled in manifests.
-    pub const KINDS: [&'static str; 4] = ["homogeneous", "c1", "c1_fe", "n1_needle"];
+    pub const KINDS: [&'static str; 5] = ["homogeneous", "c1", "c1_fe", "n1_needle", "n3_needle"];
 
     /// The kind, as spelled in manifests.
     pub fn kind(&self) -> &'static str {
@@ -221,6 +261,7 @@ impl ModelSpec {
             ModelSpec::C1(_) => "c1",
             ModelSpec::C1Fe(_) => "c1_fe",
             ModelSpec::N1Needle(_) => "n1_needle",
+            ModelSpec::N3Needle(_) => "n3_needle",
         }
     }
 
@@ -231,6 +272,7 @@ impl ModelSpec {
             ModelSpec::C1(s) => &s.law,
             ModelSpec::C1Fe(s) => &s.law,
             ModelSpec::N1Needle(s) => &s.law,
+            ModelSpec::N3Needle(s) => &s.law,
         }
     }
 
@@ -246,7 +288,8 @@ impl ModelSpec {
         Ok(match self {
             ModelSpec::Homogeneous(s) => TestKind::Homogeneous(parse_mode(&s.mode)?),
             ModelSpec::C1(_) | ModelSpec::C1Fe(_) => TestKind::C1,
-            ModelSpec::N1Needle(_) => TestKind::N1,
+            // needle force records, as N1's
+            ModelSpec::N1Needle(_) | ModelSpec::N3Needle(_) => TestKind::N1,
         })
     }
 
@@ -328,8 +371,47 @@ impl ModelSpec {
                 };
                 Model::N1Needle(m)
             }
+            ModelSpec::N3Needle(s) => {
+                const K: &str = "n3_needle";
+                let mut m = N3Needle::new(law);
+                let friction = s.friction.unwrap_or(DEFAULT_FRICTION);
+                if !(friction >= 0.0 && friction.is_finite()) {
+                    return Err(ModelError::new(
+                        K,
+                        "friction",
+                        friction,
+                        "expected a coefficient >= 0",
+                    ));
+                }
+                m.friction = friction;
+                let text = s.mesh.as_deref().unwrap_or(N3_DEFAULT_MESH);
+                let level = parse_mesh(K, Some(text))?;
+                if level > N3_MAX_LEVEL {
+                    return Err(ModelError::new(
+                        K,
+                        "mesh",
+                        text,
+                        format!(
+                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} unknowns, beyond this machine's memory and time (level 1 takes ~0.4 GiB)",
+                            n3_unknowns(level)
+                        ),
+                    ));
+                }
+                m.level = level;
+                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+                m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
+                Model::N3Needle(m)
+            }
         })
     }
+}
+
+/// The displacement unknowns of N3 mesh `level` (3 per node), counted from
+/// its grading without building the mesh.
+fn n3_unknowns(level: usize) -> usize {
+    let g = palpate_fe::n3_grading(level);
+    let n = |l: f64| g.positions(l).map_or(0, |p| p.len());
+    3 * n(35.0) * n(40.0) * n(80.0)
 }
 
 fn parse_mode(s: &str) -> Result<Mode, ModelError> {

@@ -121,8 +121,9 @@ fn main() {
                         .get(((d / 0.25).round() as usize).wrapping_sub(1))
                         .map_or("-".to_string(), |f| format!("{f:.6}"))
                 };
-                let (inc, iters, fact) =
-                    stats.map_or((0, 0, 0), |s| (s.increments, s.iterations, s.factorisations));
+                let (inc, iters, fact) = stats.map_or((0, 0, 0), |s| {
+                    (s.increments, s.iterations, s.factorisations)
+                });
                 println!(
                     "{label:<28} {law:>5} {mu:>4} {cells:>7} {unknowns:>8} {inc:>5} {iters:>5} {fact:>5} {wall:>7.1} {cpu:>7.1} {:>8.0} {:>10} {:>10} {:>10}  {reached} mm",
                     peak_rss_mib(),

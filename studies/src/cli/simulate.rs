@@ -1,5 +1,5 @@
 //! `palpate simulate`: run a finite-element forward model (N1 needle
-//! indentation or C1 compression, BENCHMARKS.md) and write its force curve,
+//! indentation, N3 needle indentation in 3D, or C1 compression, BENCHMARKS.md) and write its force curve,
 //! with the volumetric treatment used and, unless `--error-estimate off`, an
 //! estimate of its discretisation error from one coarser solve (Richardson
 //! extrapolation with the model's documented order of convergence,
@@ -16,15 +16,15 @@ use palpate_fe::discretisation::{richardson, Coarser};
 use palpate_fe::{Bulk, Progress, Simulation};
 use palpate_material::Law;
 
-use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec};
+use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, N3NeedleSpec};
 use crate::output::write_atomic;
 use crate::plot::{Plot, Series};
 
 /// Options of `palpate simulate`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder) or C1 (compression of a 38 x 9 mm cylinder).
-    #[arg(long, value_parser = ["N1", "C1", "n1", "c1"])]
+    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), N3 (the same needle into a 70 x 80 x 80 mm block, 3D quarter model) or C1 (compression of a 38 x 9 mm cylinder).
+    #[arg(long, value_parser = ["N1", "N3", "C1", "n1", "n3", "c1"])]
     pub benchmark: String,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
     #[arg(long)]
@@ -32,7 +32,7 @@ pub struct Args {
     /// A law parameter in MPa (or 1), e.g. --param C10=0.001101295; repeat for each parameter of the law.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     pub params: Vec<String>,
-    /// N1: Coulomb friction coefficient between needle and material [default: 0.8].
+    /// N1, N3: Coulomb friction coefficient between needle and material [default: 0.8].
     #[arg(long)]
     pub friction: Option<f64>,
     /// C1: bonded (no-slip) platens instead of frictionless ones.
@@ -41,7 +41,7 @@ pub struct Args {
     /// N1: bottom face free to slide radially instead of fixed.
     #[arg(long)]
     pub sliding_base: bool,
-    /// N1 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
+    /// N1, N3 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
     /// N1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4].
@@ -53,7 +53,7 @@ pub struct Args {
     /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1).
     #[arg(long)]
     pub step: Option<f64>,
-    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements) [default: medium].
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; N3: hexahedra of 0.8/N mm, levels 1..2, default coarse) [default: medium].
     #[arg(long)]
     pub mesh: Option<String>,
     /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
@@ -123,10 +123,18 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
     Ok(p)
 }
 
-/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`
-/// (the settings a benchmark does not have are ignored).
+/// The model the options describe: N1 -> `n1_needle`, N3 -> `n3_needle`,
+/// C1 -> `c1_fe` (the settings a benchmark does not have are ignored).
 pub fn model_spec(args: &Args) -> ModelSpec {
-    if args.benchmark.eq_ignore_ascii_case("n1") {
+    if args.benchmark.eq_ignore_ascii_case("n3") {
+        ModelSpec::N3Needle(N3NeedleSpec {
+            law: args.law.clone(),
+            friction: args.friction,
+            mesh: args.mesh.clone(),
+            bulk: args.bulk.clone(),
+            tool: args.tool.clone(),
+        })
+    } else if args.benchmark.eq_ignore_ascii_case("n1") {
         ModelSpec::N1Needle(N1NeedleSpec {
             law: args.law.clone(),
             friction: args.friction,
@@ -157,7 +165,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .parse()
         .map_err(|e| anyhow!("--law `{}`: {e}", args.law))?;
     let theta = parse_params(&law, &args.params)?;
-    let n1 = args.benchmark.eq_ignore_ascii_case("n1");
+    // needle benchmarks: 10 mm every 0.25 mm
+    let n1 = args.benchmark.eq_ignore_ascii_case("n1") || args.benchmark.eq_ignore_ascii_case("n3");
     let depth = args.depth.unwrap_or(if n1 { 10.0 } else { 2.0 });
     let step = args.step.unwrap_or(if n1 { 0.25 } else { 0.1 });
     if !(depth > 0.0 && depth.is_finite() && step > 0.0 && step.is_finite()) {
@@ -183,12 +192,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             m.bulk,
             m.simulate(&theta, &loading, Some(&mut cb)),
         ),
+        Model::N3Needle(m) => (
+            m.name(),
+            m.bulk,
+            m.simulate(&theta, &loading, Some(&mut cb)),
+        ),
         Model::C1Fe(m) => (
             m.name(),
             m.bulk,
             m.simulate(&theta, &loading, Some(&mut cb)),
         ),
-        _ => bail!("--benchmark {}: expected N1 or C1", args.benchmark),
+        _ => bail!("--benchmark {}: expected N1, N3 or C1", args.benchmark),
     };
     drop(cb);
     bar.finish_and_clear();
@@ -354,6 +368,11 @@ fn estimate(
             let r = model.simulate(theta, loading, Some(&mut cb));
             (ratio, mesh, m.convergence_order(), r)
         }
+        Model::N3Needle(m) => {
+            let Coarser { model, ratio, mesh } = m.coarser();
+            let r = model.simulate(theta, loading, Some(&mut cb));
+            (ratio, mesh, m.convergence_order(), r)
+        }
         Model::C1Fe(m) => {
             let Coarser { model, ratio, mesh } = m
                 .coarser()
@@ -428,7 +447,7 @@ fn timed_history(
         }
         return Ok(None);
     }
-    if args.benchmark.eq_ignore_ascii_case("n1") {
+    if !args.benchmark.eq_ignore_ascii_case("c1") {
         bail!("--prony: only C1 has the viscoelastic material so far");
     }
     let ramp = args.ramp.unwrap_or(1.0);
