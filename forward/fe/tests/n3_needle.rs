@@ -3,7 +3,7 @@
 
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::mesh::Grading;
-use palpate_fe::{n3_grading, N1Needle, N3Needle, ToolShape};
+use palpate_fe::{N1Needle, N3Needle, ToolShape};
 
 const C10: f64 = 1101.295e-6;
 const MU: f64 = 2.0 * C10;
@@ -34,48 +34,95 @@ fn sneddon(r: f64, d: f64) -> f64 {
     0.5 * 4.0 * MU * ((a * a + r * r) * l - 2.0 * a * r)
 }
 
-/// A frictionless sphere of radius 10 mm at 0.25 and 0.5 mm (a / R = 0.16
-/// and 0.22) on the N3 block, 0.4 mm hexahedra over 3 mm growing by 1.5.
-#[test]
-fn frictionless_sphere_against_sneddon() {
+/// A frictionless sphere of radius 10 mm on the N3 block, mesh graded from
+/// `h` over 3 mm with `growth`: forces at `depths` and their deviation from
+/// Sneddon.
+fn sphere(h: f64, growth: f64, depths: &[f64]) -> (Vec<f64>, Vec<f64>) {
     let r = 10.0;
-    let depths = [0.25, 0.5];
     let mut m = N3Needle::new(nh());
     m.tool = ToolShape::Sphere { radius: r };
     m.friction = 0.0;
     m.grading = Some(Grading {
-        h_fine: 0.4,
+        h_fine: h,
         fine_length: 3.0,
-        growth: 1.5,
+        growth,
     });
-    m.options.first_step = 0.125;
-    let f = m.predict(&[C10], &quasi_static(&depths)).unwrap();
-    let dev: Vec<f64> = depths
+    m.options.first_step = 0.5 * depths[0];
+    m.options.max_step = depths[0];
+    let f = m.predict(&[C10], &quasi_static(depths)).unwrap();
+    let dev = depths
         .iter()
         .zip(&f)
         .map(|(d, f)| f / sneddon(r, *d) - 1.0)
         .collect();
-    eprintln!("N3 sphere: {f:?}, / Sneddon - 1 = {dev:?}");
-    assert!(dev.iter().all(|e| e.abs() < 0.05), "{dev:?}");
+    (f, dev)
 }
 
-/// N3 against N1 with the needle at 1 and 2 mm, friction 0.8, both on
-/// the level-1 N3 grading (0.8 mm elements over 4 mm).
+/// The frictionless sphere (R = 10 mm) at 0.25 mm (a / R = 0.16) on a
+/// coarse mesh (0.75 mm hexahedra, 2 across the contact radius): within
+/// 8 % of Sneddon's half-space force (measured +2.2 %, the coarse mesh
+/// being stiff; 0.4 mm hexahedra give -0.8 % at 0.25 mm and -1.5 % at
+/// 0.5 mm, `sphere_on_level_1_like_mesh_within_2_percent`).
 #[test]
+fn frictionless_sphere_against_sneddon() {
+    let (f, dev) = sphere(0.75, 2.0, &[0.25]);
+    eprintln!("N3 sphere, coarse: {f:?}, / Sneddon - 1 = {dev:?}");
+    assert!(dev.iter().all(|e| e.abs() < 0.08), "{dev:?}");
+}
+
+/// The same on 0.4 mm hexahedra (growth 1.5) at 0.25 and 0.5 mm: within
+/// 2 % of Sneddon (measured -0.8 / -1.5 %, the finite-deformation and
+/// finite-block deviations of tests/hertz.rs). ~40 s of CPU:
+/// `cargo test -p palpate-fe --test n3_needle -- --ignored`.
+#[test]
+#[ignore]
+fn sphere_on_level_1_like_mesh_within_2_percent() {
+    let (f, dev) = sphere(0.4, 1.5, &[0.25, 0.5]);
+    eprintln!("N3 sphere: {f:?}, / Sneddon - 1 = {dev:?}");
+    assert!(dev.iter().all(|e| e.abs() < 0.02), "{dev:?}");
+}
+
+/// N3 and N1 with the needle at 1 and 2 mm, friction 0.8. N3 on level 1
+/// against N1 on level 2 (0.2 mm, near converged at 2 mm): N3 is
+/// 2.7 / 2.9 % stiffer. The square 70 x 80 mm block has 1.46 x the
+/// cylinder's cross-section (stiffer far field, ~+1 % for a body this much
+/// larger, tests/hertz.rs) and the 0.8 mm hexahedra are stiffer than a
+/// converged mesh (N1 on the same 0.8 mm grading is -1.2 / +3.9 % from
+/// level 2, so roughly that much again). ~60 s of CPU: `-- --ignored`.
+#[test]
+#[ignore]
 fn n3_against_n1() {
     let depths = [1.0, 2.0];
-    let g = n3_grading(1);
-    let n3 = N3Needle::new(nh());
-    let f3 = n3.predict(&[C10], &quasi_static(&depths)).unwrap();
-    let mut n1 = N1Needle::new(nh());
-    n1.grading = Some(g);
+    let f3 = N3Needle::new(nh())
+        .predict(&[C10], &quasi_static(&depths))
+        .unwrap();
+    let n1 = N1Needle::new(nh());
     let f1 = n1.predict(&[C10], &quasi_static(&depths)).unwrap();
-    let mut n1_fine = N1Needle::new(nh());
-    n1_fine.mesh = palpate_fe::MeshDensity::MEDIUM;
-    let f1f = n1_fine.predict(&[C10], &quasi_static(&depths)).unwrap();
     let rel: Vec<f64> = f3.iter().zip(&f1).map(|(a, b)| a / b - 1.0).collect();
-    let relf: Vec<f64> = f3.iter().zip(&f1f).map(|(a, b)| a / b - 1.0).collect();
-    eprintln!("N3 {f3:?} N1 same grading {f1:?} N1 level 2 {f1f:?}: N3/N1 - 1 = {rel:?}, N3/N1(level 2) - 1 = {relf:?}");
+    eprintln!("N3 level 1 {f3:?}, N1 level 2 {f1:?}: N3 / N1 - 1 = {rel:?}");
+    assert!(rel.iter().all(|r| *r > 0.0 && *r < 0.05), "{rel:?}");
+}
+
+/// The fast N3-N1 check: on 1 mm hexahedra (growth 1.8) at 0.5 and 1 mm
+/// the 3D block is within 15 % of N1 (level 2) and stiffer (measured +12.6
+/// / +6.4 %: the coarse mesh, 1 mm elements for a contact radius of 1-1.5 mm,
+/// and the larger block both stiffen it).
+#[test]
+fn n3_coarse_against_n1() {
+    let depths = [0.5, 1.0];
+    let mut n3 = N3Needle::new(nh());
+    n3.grading = Some(Grading {
+        h_fine: 1.0,
+        fine_length: 3.0,
+        growth: 1.8,
+    });
+    let f3 = n3.predict(&[C10], &quasi_static(&depths)).unwrap();
+    let f1 = N1Needle::new(nh())
+        .predict(&[C10], &quasi_static(&depths))
+        .unwrap();
+    let rel: Vec<f64> = f3.iter().zip(&f1).map(|(a, b)| a / b - 1.0).collect();
+    eprintln!("N3 coarse {f3:?}, N1 level 2 {f1:?}: N3 / N1 - 1 = {rel:?}");
+    assert!(rel.iter().all(|r| *r > 0.0 && *r < 0.15), "{rel:?}");
 }
 
 /// A needle that starts inside the block and a negative friction are
