@@ -163,7 +163,7 @@ pub struct N3NeedleSpec {
 }
 
 /// The default N3 mesh: level 1 (0.8 mm hexahedra, 10,125 unknowns, peak
-/// 0.4 GiB; level 2 has ~5x the unknowns and its sparse LU peaks above
+/// 0.4 GiB; level 2 (17,400 cells) has ~7x the unknowns and its sparse LU peaks above
 /// 10 GiB, docs/validation/fe.md "N3").
 pub const N3_DEFAULT_MESH: &str = "coarse";
 /// The finest N3 level accepted: level 3 (~40,000 hexahedra) would need
@@ -393,7 +393,7 @@ impl ModelSpec {
                         "mesh",
                         text,
                         format!(
-                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} unknowns, beyond this machine's memory and time (measured peaks: level 1 0.4 GiB, level 2 over 10 GiB)",
+                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} displacement unknowns, beyond this machine's memory and time (measured peaks: level 1 0.4 GiB, level 2 over 10 GiB)",
                             n3_unknowns(level)
                         ),
                     ));

@@ -39,8 +39,8 @@ use crate::FeError;
 /// The N3 grading of mesh level `n` (the same in x, y and z from the
 /// needle): elements of `0.8 / n` mm over a 4 mm zone, growing by
 /// `1 + 0.4 / n` beyond it. Level 1 has 2,340 hexahedra (10,125 unknowns,
-/// 0.43 GiB peak, 25-41 s of CPU to 10 mm); level 2 has ~5x the unknowns
-/// and its LU does not fit in 10 GiB (docs/validation/fe.md, N3).
+/// 0.43 GiB peak, 25-41 s of CPU to 10 mm); level 2 has ~7x the unknowns
+/// (17,400 cells) and its LU does not fit in 10 GiB (docs/validation/fe.md, N3).
 pub fn n3_grading(level: usize) -> Grading {
     let n = level.max(1) as f64;
     Grading {
@@ -109,6 +109,27 @@ impl N3Needle {
         self.grading.unwrap_or_else(|| n3_grading(self.level))
     }
 
+    /// The estimated peak memory of a run (bytes) from the number of
+    /// equations, counted from the grading without building anything:
+    /// `1.6 GiB x (equations / 24,500)^1.8`, through the measured peak of
+    /// the 0.6 mm mesh (24,500 equations, 1.6 GiB) with the exponent that
+    /// level 2's lower bound needs (> 10.5 GiB at ~70,000; level 1 at 10,125
+    /// equations measured 0.43 GiB, estimated 0.33). docs/validation/fe.md, N3.
+    pub fn memory_estimate(&self) -> Result<f64, FeError> {
+        let g = self.effective_grading();
+        let [lx, ly, lz] = self.size;
+        let (nx, ny, nz) = (
+            g.positions(lx)?.len(),
+            g.positions(ly)?.len(),
+            g.positions(lz)?.len(),
+        );
+        let cells = (nx - 1) * (ny - 1) * (nz - 1);
+        // displacements less the fixed ones (bottom, two symmetry planes),
+        // plus one pressure per cell
+        let equations = (3 * nx * ny * nz).saturating_sub(3 * nx * ny + ny * nz + nx * nz) + cells;
+        Ok(1.6 * GIB * (equations as f64 / 24_500.0).powf(1.8))
+    }
+
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
@@ -174,6 +195,21 @@ impl N3Needle {
     }
 }
 
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// `MemAvailable` of `/proc/meminfo` (bytes); `None` off Linux.
+fn available_memory() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib: f64 = s
+        .lines()
+        .find(|l| l.starts_with("MemAvailable:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
+    Some(kib * 1024.0)
+}
+
 impl Setup for N3Needle {
     fn law(&self) -> &Law {
         &self.law
@@ -196,6 +232,19 @@ impl Setup for N3Needle {
                 field: "start_gap".into(),
                 reason: format!("{} is not a height", self.start_gap),
             });
+        }
+        let need = self.memory_estimate()?;
+        if let Some(available) = available_memory() {
+            if need > available {
+                return Err(FeError::InvalidConfig {
+                    field: "mesh".into(),
+                    reason: format!(
+                        "this N3 mesh would need about {:.1} GiB, more than the {:.1} GiB available; use a coarser mesh",
+                        need / GIB,
+                        available / GIB
+                    ),
+                });
+            }
         }
         let mesh = self.build_mesh()?;
         let kin = Kinematics::ThreeD;

@@ -145,4 +145,17 @@ fn bad_input_is_named() {
         Ok(_) => panic!("a 45 mm depth was accepted"),
     };
     assert!(e.contains("beyond what the 80 mm block allows"), "{e}");
+    // 0.05 mm hexahedra: refused with the estimate, before allocating
+    let mut m = N3Needle::new(nh());
+    m.grading = Some(Grading {
+        h_fine: 0.05,
+        fine_length: 4.0,
+        growth: 1.05,
+    });
+    assert!(m.memory_estimate().unwrap() > 1e12);
+    let e = m.predict(&[C10], &loading).unwrap_err().to_string();
+    assert!(e.contains("would need about") && e.contains("GiB"), "{e}");
+    // level 1: 0.3 GiB estimated (0.43 measured)
+    let est = N3Needle::new(nh()).memory_estimate().unwrap() / (1u64 << 30) as f64;
+    assert!(est > 0.2 && est < 0.5, "{est}");
 }
