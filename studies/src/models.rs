@@ -576,6 +576,32 @@ mod tests {
         assert!(e.contains("mesh"), "{e}");
     }
 
+    /// `[n3_needle]`: coarse by default, friction and mesh checked by name.
+    #[test]
+    fn n3_needle_spec() {
+        let s: ModelSpec =
+            toml::from_str("[n3_needle]\nlaw = \"neo-hookean\"\nfriction = 0\n").unwrap();
+        assert_eq!(s.kind(), "n3_needle");
+        assert!(
+            matches!(s.validate(), Ok(Model::N3Needle(m)) if m.level == 1 && m.friction == 0.0)
+        );
+        let n3 = |f: fn(&mut N3NeedleSpec)| {
+            let mut s = N3NeedleSpec {
+                law: "neo-hookean".into(),
+                ..Default::default()
+            };
+            f(&mut s);
+            ModelSpec::N3Needle(s).validate().unwrap_err().to_string()
+        };
+        assert!(n3(|s| s.friction = Some(-0.1)).starts_with("n3_needle.friction"));
+        let e = n3(|s| s.mesh = Some("fine".into()));
+        assert!(
+            e.starts_with("n3_needle.mesh") && e.contains("190476"),
+            "{e}"
+        );
+        assert!(n3(|s| s.tool = Some("cone".into())).starts_with("n3_needle.tool"));
+    }
+
     #[test]
     fn c1_fe_takes_a_prony_series() {
         let s: ModelSpec =
