@@ -88,7 +88,9 @@ pub enum ModelForm {
 
 impl<'de> Deserialize<'de> for ModelEntry {
     fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        use crate::models::{C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec, Q1Spec};
+        use crate::models::{
+            C1FeSpec, C1Spec, HomogeneousSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec,
+        };
         use serde::de::{Error, MapAccess, Visitor};
         const FIELDS: &[&str] = &[
             "law",
@@ -98,13 +100,14 @@ impl<'de> Deserialize<'de> for ModelEntry {
             "c1_fe",
             "n1_needle",
             "q1",
+            "n3_needle",
         ];
         struct V;
         impl<'de> Visitor<'de> for V {
             type Value = ModelEntry;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str(
-                    "a model: `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle",
+                    "a model: `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle",
                 )
             }
             fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<ModelEntry, A::Error> {
@@ -128,6 +131,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         "c1_fe" => Some(ModelSpec::C1Fe(map.next_value::<C1FeSpec>()?)),
                         "n1_needle" => Some(ModelSpec::N1Needle(map.next_value::<N1NeedleSpec>()?)),
                         "q1" => Some(ModelSpec::Q1(map.next_value::<Q1Spec>()?)),
+                        "n3_needle" => Some(ModelSpec::N3Needle(map.next_value::<N3NeedleSpec>()?)),
                         other => return Err(A::Error::unknown_field(other, FIELDS)),
                     };
                     if let Some(n) = next {
@@ -153,7 +157,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                     }
                     (None, None) => {
                         return Err(A::Error::custom(
-                            "no model: expected `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle",
+                            "no model: expected `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle",
                         ))
                     }
                 };

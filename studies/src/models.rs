@@ -15,6 +15,13 @@
 //! base = "bonded"             # bonded | sliding
 //! tool = "needle"             # needle | sphere:R | punch:R | platen
 //!
+//! [models.needle3d.n3_needle] # N3 needle indentation, 3D quarter block (finite elements)
+//! law = "neo-hookean"
+//! friction = 0.8
+//! mesh = "coarse"             # coarse (default for N3) | medium | fine | N: 0.8/N mm hexahedra under the tool
+//! bulk = "exact"
+//! tool = "needle"
+//!
 //! [models.press.c1_fe]        # C1 compression (finite elements)
 //! law = "neo-hookean"
 //! platens = "frictionless"    # frictionless | bonded
@@ -49,7 +56,8 @@ use crate::calibration::TestKind;
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Effect, ForwardModel};
 use palpate_fe::{
-    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, Platens, Prony, Q1Punch, ToolShape,
+    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Needle, Platens, Prony, Q1Punch,
+    ToolShape,
 };
 use palpate_material::Law;
 use serde::Deserialize;
@@ -77,6 +85,8 @@ pub enum ModelSpec {
     N1Needle(N1NeedleSpec),
     /// Benchmark Q1, flat-punch ramp-and-hold by finite elements.
     Q1(Q1Spec),
+    /// Benchmark N3, needle indentation of a block in 3D by finite elements.
+    N3Needle(N3NeedleSpec),
 }
 
 /// `[... .homogeneous]`
@@ -160,6 +170,34 @@ pub struct Q1Spec {
     pub prony: Option<String>,
 }
 
+/// `[... .n3_needle]`
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct N3NeedleSpec {
+    pub law: String,
+    /// Coulomb friction coefficient (default 0.8).
+    #[serde(default)]
+    pub friction: Option<f64>,
+    /// `coarse` (default for N3), `medium`, `fine` or a level 1..N3_MAX_LEVEL:
+    /// hexahedra of 0.8/N mm under the tool.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub mesh: Option<String>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub bulk: Option<String>,
+    /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
+    #[serde(default)]
+    pub tool: Option<String>,
+}
+
+/// The default N3 mesh: level 1 (0.8 mm hexahedra, 10,125 unknowns, peak
+/// 0.4 GiB; level 2 (17,400 cells) has ~7x the unknowns and its sparse LU peaks above
+/// 10 GiB, docs/validation/fe.md "N3").
+pub const N3_DEFAULT_MESH: &str = "coarse";
+/// The finest N3 level accepted: level 3 (~40,000 hexahedra) would need
+/// more memory and time than a 2-core, few-GiB machine has.
+pub const N3_MAX_LEVEL: usize = 2;
+
 /// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
 pub fn text_or_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
     #[derive(Deserialize)]
@@ -221,6 +259,7 @@ pub enum Model {
     C1Fe(C1Fe),
     N1Needle(N1Needle),
     Q1(Q1Punch),
+    N3Needle(N3Needle),
 }
 
 impl Model {
@@ -232,6 +271,7 @@ impl Model {
             Model::C1Fe(m) => Box::new(m),
             Model::N1Needle(m) => Box::new(m),
             Model::Q1(m) => Box::new(m),
+            Model::N3Needle(m) => Box::new(m),
         }
     }
 }
@@ -243,7 +283,8 @@ pub fn build(spec: &ModelSpec) -> Result<Box<dyn ForwardModel>, ModelError> {
 
 impl ModelSpec {
     /// The kinds, as spelled in manifests.
-    pub const KINDS: [&'static str; 5] = ["homogeneous", "c1", "c1_fe", "n1_needle", "q1"];
+    pub const KINDS: [&'static str; 6] =
+        ["homogeneous", "c1", "c1_fe", "n1_needle", "n3_needle", "q1"];
 
     /// The kind, as spelled in manifests.
     pub fn kind(&self) -> &'static str {
@@ -253,6 +294,7 @@ impl ModelSpec {
             ModelSpec::C1Fe(_) => "c1_fe",
             ModelSpec::N1Needle(_) => "n1_needle",
             ModelSpec::Q1(_) => "q1",
+            ModelSpec::N3Needle(_) => "n3_needle",
         }
     }
 
@@ -264,6 +306,7 @@ impl ModelSpec {
             ModelSpec::C1Fe(s) => &s.law,
             ModelSpec::N1Needle(s) => &s.law,
             ModelSpec::Q1(s) => &s.law,
+            ModelSpec::N3Needle(s) => &s.law,
         }
     }
 
@@ -279,7 +322,8 @@ impl ModelSpec {
         Ok(match self {
             ModelSpec::Homogeneous(s) => TestKind::Homogeneous(parse_mode(&s.mode)?),
             ModelSpec::C1(_) | ModelSpec::C1Fe(_) => TestKind::C1,
-            ModelSpec::N1Needle(_) => TestKind::N1,
+            // needle force records, as N1's
+            ModelSpec::N1Needle(_) | ModelSpec::N3Needle(_) => TestKind::N1,
             ModelSpec::Q1(_) => {
                 return Err(ModelError::new(
                     "q1",
@@ -372,8 +416,47 @@ impl ModelSpec {
                 m.element = parse_element(K, s.element.as_deref())?;
                 Model::N1Needle(m)
             }
+            ModelSpec::N3Needle(s) => {
+                const K: &str = "n3_needle";
+                let mut m = N3Needle::new(law);
+                let friction = s.friction.unwrap_or(DEFAULT_FRICTION);
+                if !(friction >= 0.0 && friction.is_finite()) {
+                    return Err(ModelError::new(
+                        K,
+                        "friction",
+                        friction,
+                        "expected a coefficient >= 0",
+                    ));
+                }
+                m.friction = friction;
+                let text = s.mesh.as_deref().unwrap_or(N3_DEFAULT_MESH);
+                let level = parse_mesh(K, Some(text))?;
+                if level > N3_MAX_LEVEL {
+                    return Err(ModelError::new(
+                        K,
+                        "mesh",
+                        text,
+                        format!(
+                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} displacement unknowns, beyond this machine's memory and time (measured peaks: level 1 0.4 GiB, level 2 over 10 GiB)",
+                            n3_unknowns(level)
+                        ),
+                    ));
+                }
+                m.level = level;
+                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+                m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
+                Model::N3Needle(m)
+            }
         })
     }
+}
+
+/// The displacement unknowns of N3 mesh `level` (3 per node), counted from
+/// its grading without building the mesh.
+fn n3_unknowns(level: usize) -> usize {
+    let g = palpate_fe::n3_grading(level);
+    let n = |l: f64| g.positions(l).map_or(0, |p| p.len());
+    3 * n(35.0) * n(40.0) * n(80.0)
 }
 
 fn parse_mode(s: &str) -> Result<Mode, ModelError> {
@@ -569,6 +652,32 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("mesh"), "{e}");
+    }
+
+    /// `[n3_needle]`: coarse by default, friction and mesh checked by name.
+    #[test]
+    fn n3_needle_spec() {
+        let s: ModelSpec =
+            toml::from_str("[n3_needle]\nlaw = \"neo-hookean\"\nfriction = 0\n").unwrap();
+        assert_eq!(s.kind(), "n3_needle");
+        assert!(
+            matches!(s.validate(), Ok(Model::N3Needle(m)) if m.level == 1 && m.friction == 0.0)
+        );
+        let n3 = |f: fn(&mut N3NeedleSpec)| {
+            let mut s = N3NeedleSpec {
+                law: "neo-hookean".into(),
+                ..Default::default()
+            };
+            f(&mut s);
+            ModelSpec::N3Needle(s).validate().unwrap_err().to_string()
+        };
+        assert!(n3(|s| s.friction = Some(-0.1)).starts_with("n3_needle.friction"));
+        let e = n3(|s| s.mesh = Some("fine".into()));
+        assert!(
+            e.starts_with("n3_needle.mesh") && e.contains("190476"),
+            "{e}"
+        );
+        assert!(n3(|s| s.tool = Some("cone".into())).starts_with("n3_needle.tool"));
     }
 
     #[test]

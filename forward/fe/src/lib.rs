@@ -3,8 +3,8 @@
 //! Large-deformation finite elements with frictional rigid-tool contact, as
 //! one composable layer (docs/architecture.md has the map and how to add a
 //! model, kernel, surface or effect), and the forward models built on it:
-//! N1 needle indentation, C1 compression and Q1 flat-punch ramp-and-hold
-//! (`BENCHMARKS.md`).
+//! N1 and N3 needle indentation, C1 compression and Q1 flat-punch
+//! ramp-and-hold (`BENCHMARKS.md`).
 //!
 //! * [`mesh`] — meshes of any cell type with node sets, facet sets and
 //!   regions; generators, a Gmsh reader, VTU output.
@@ -21,7 +21,7 @@
 //! * [`system`], [`stepper`] — Newton (chord steps, line search) on a faer
 //!   sparse LU that keeps its symbolic factorisation, apart from the
 //!   stepper (channels along a path with time, cut-back, partial results).
-//! * [`n1`], [`c1`], [`q1`] — the forward models; [`discretisation`] — the
+//! * [`n1`], [`n3`], [`c1`], [`q1`] — the forward models; [`discretisation`] — the
 //!   Richardson estimate of their discretisation error from one coarser solve.
 
 // Index loops mirror the index notation of the equations; negated comparisons
@@ -47,6 +47,7 @@ pub mod mesh;
 pub mod model;
 pub mod motion;
 pub mod n1;
+pub mod n3;
 pub mod q1;
 pub mod quadrature;
 pub mod shape;
@@ -65,6 +66,7 @@ pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Element, N1Needle};
+pub use n3::{n3_grading, N3Needle};
 pub use q1::Q1Punch;
 pub use stepper::{LoadPath, Progress};
 pub use surface::{Cylinder3d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};

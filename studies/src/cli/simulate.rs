@@ -1,5 +1,6 @@
 //! `palpate simulate`: run a finite-element forward model (N1 needle
 //! indentation, C1 compression or Q1 flat-punch ramp-and-hold, BENCHMARKS.md) and write its force curve,
+//! indentation, N3 needle indentation in 3D, or C1 compression, BENCHMARKS.md) and write its force curve,
 //! with the volumetric treatment used and, unless `--error-estimate off`, an
 //! estimate of its discretisation error from one coarser solve (Richardson
 //! extrapolation with the model's documented order of convergence,
@@ -16,7 +17,7 @@ use palpate_fe::discretisation::{richardson, Coarser};
 use palpate_fe::{Bulk, Progress, Simulation};
 use palpate_material::Law;
 
-use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, Q1Spec};
+use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
 use crate::output::write_atomic;
 use crate::plot::{Plot, Series};
 
@@ -24,8 +25,8 @@ use crate::plot::{Plot, Series};
 #[derive(Debug, clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Args {
-    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), C1 (compression of a 38 x 9 mm cylinder) or Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm).
-    #[arg(long, value_parser = ["N1", "C1", "Q1", "n1", "c1", "q1"])]
+    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), N3 (the same needle into a 70 x 80 x 80 mm block, 3D quarter model), C1 (compression of a 38 x 9 mm cylinder) or Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm).
+    #[arg(long, value_parser = ["N1", "N3", "C1", "Q1", "n1", "n3", "c1", "q1"])]
     pub benchmark: String,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
     #[arg(long)]
@@ -33,7 +34,7 @@ pub struct Args {
     /// A law parameter in MPa (or 1), e.g. --param C10=0.001101295; repeat for each parameter of the law.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     pub params: Vec<String>,
-    /// N1: Coulomb friction coefficient between needle and material [default: 0.8].
+    /// N1, N3: Coulomb friction coefficient between needle and material [default: 0.8].
     #[arg(long)]
     pub friction: Option<f64>,
     /// C1: bonded (no-slip) platens instead of frictionless ones.
@@ -42,7 +43,7 @@ pub struct Args {
     /// N1: bottom face free to slide radially instead of fixed.
     #[arg(long)]
     pub sliding_base: bool,
-    /// N1 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
+    /// N1, N3 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
     /// N1 and Q1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4].
@@ -55,6 +56,7 @@ pub struct Args {
     #[arg(long)]
     pub step: Option<f64>,
     /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch) [default: medium].
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; N3: hexahedra of 0.8/N mm, levels 1..2, default coarse) [default: medium].
     #[arg(long)]
     pub mesh: Option<String>,
     /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
@@ -130,12 +132,14 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
     Ok(p)
 }
 
-/// The model the options describe: N1 -> `n1_needle`, C1 -> `c1_fe`,
-/// Q1 -> `q1`; an option of another benchmark is refused by name, since it
+/// The model the options describe: N1 -> `n1_needle`, N3 -> `n3_needle`,
+/// C1 -> `c1_fe`, Q1 -> `q1`; an option of another benchmark is refused by name, since it
 /// would be neither used nor visible in the result.
 pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
     let kind = if is_q1(args) {
         "Q1"
+    } else if args.benchmark.eq_ignore_ascii_case("n3") {
+        "N3"
     } else if args.benchmark.eq_ignore_ascii_case("n1") {
         "N1"
     } else {
@@ -166,14 +170,14 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
             args.friction.is_some(),
             "--friction",
             args.friction.map(|f| f.to_string()).unwrap_or_default(),
-            &["N1"],
+            &["N1", "N3"],
         ),
         (args.sliding_base, "--sliding-base", String::new(), &["N1"]),
         (
             args.tool.is_some(),
             "--tool",
             args.tool.clone().unwrap_or_default(),
-            &["N1"],
+            &["N1", "N3"],
         ),
         (
             args.element.is_some(),
@@ -199,6 +203,14 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
             bulk: args.bulk.clone(),
             element: args.element.clone(),
             prony: args.prony.clone(),
+        })
+    } else if kind == "N3" {
+        ModelSpec::N3Needle(N3NeedleSpec {
+            law: args.law.clone(),
+            friction: args.friction,
+            mesh: args.mesh.clone(),
+            bulk: args.bulk.clone(),
+            tool: args.tool.clone(),
         })
     } else if kind == "N1" {
         ModelSpec::N1Needle(N1NeedleSpec {
@@ -243,7 +255,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ("--plot", &args.plot),
         ]),
     )?;
-    let n1 = args.benchmark.eq_ignore_ascii_case("n1");
+    // needle benchmarks (N1, N3): 10 mm every 0.25 mm
+    let n1 = args.benchmark.eq_ignore_ascii_case("n1") || args.benchmark.eq_ignore_ascii_case("n3");
     let q1 = is_q1(&args);
     let depth = args.depth.unwrap_or(if n1 {
         10.0
@@ -293,6 +306,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             m.bulk,
             m.simulate(&theta, &loading, Some(&mut cb)),
         ),
+        Model::N3Needle(m) => (
+            m.name(),
+            m.bulk,
+            m.simulate(&theta, &loading, Some(&mut cb)),
+        ),
         Model::C1Fe(m) => (
             m.name(),
             m.bulk,
@@ -303,7 +321,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             m.bulk,
             m.simulate(&theta, &loading, Some(&mut cb)),
         ),
-        _ => bail!("--benchmark {}: expected N1, C1 or Q1", args.benchmark),
+        _ => bail!("--benchmark {}: expected N1, N3, C1 or Q1", args.benchmark),
     };
     drop(cb);
     bar.finish_and_clear();
@@ -469,6 +487,11 @@ fn estimate(
             let r = model.simulate(theta, loading, Some(&mut cb));
             (ratio, mesh, m.convergence_order(), r)
         }
+        Model::N3Needle(m) => {
+            let Coarser { model, ratio, mesh } = m.coarser();
+            let r = model.simulate(theta, loading, Some(&mut cb));
+            (ratio, mesh, m.convergence_order(), r)
+        }
         Model::C1Fe(m) => {
             let Coarser { model, ratio, mesh } = m
                 .coarser()
@@ -550,8 +573,8 @@ fn timed_history(
         }
         return Ok(None);
     }
-    if args.benchmark.eq_ignore_ascii_case("n1") {
-        bail!("--prony: only C1 has the viscoelastic material so far");
+    if !(args.benchmark.eq_ignore_ascii_case("c1") || q1) {
+        bail!("--prony: only C1 and Q1 have the viscoelastic material so far");
     }
     let ramp = args.ramp.unwrap_or(if q1 { 0.5 } else { 1.0 });
     let hold = args.hold.unwrap_or(if q1 { 60.0 } else { 0.0 });

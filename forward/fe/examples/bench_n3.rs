@@ -1,0 +1,137 @@
+//! Benchmark (issue 12): N3 (BENCHMARKS.md), the 3D quarter block with the
+//! N1 needle, to `--depth` (default 10 mm) with the force every 0.25 mm, on
+//! the given mesh levels (default 1), for neo-Hookean `ecoflex-nh` and
+//! reduced polynomial `ecoflex-rp2`, friction 0 and 0.8. Each row prints
+//! elements, unknowns, increments, Newton iterations, factorisations, wall
+//! and CPU seconds (`/proc/self/stat`), the peak resident memory of the
+//! process so far (`VmHWM`, `/proc/self/status`), the forces at 2, 5 and
+//! 10 mm (whole block) and how far the run got.
+//!
+//! `cargo run --release -p palpate-fe --example bench_n3 -- [level ...]
+//!  [--depth D] [--law nh|rp2|both] [--friction 0|0.8|both] [--grading h,zone,growth]`
+
+use std::time::Instant;
+
+use palpate_core::{Drive, ForwardError, Loading};
+use palpate_fe::mesh::Grading;
+use palpate_fe::N3Needle;
+
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
+
+/// Peak resident set size of this process (MiB), `VmHWM`.
+fn peak_rss_mib() -> f64 {
+    let s = std::fs::read_to_string("/proc/self/status").unwrap_or_default();
+    s.lines()
+        .find(|l| l.starts_with("VmHWM:"))
+        .and_then(|l| l.split_whitespace().nth(1))
+        .and_then(|k| k.parse::<f64>().ok())
+        .map_or(f64::NAN, |kib| kib / 1024.0)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut levels = Vec::new();
+    let mut depth = 10.0;
+    let mut laws = vec!["nh", "rp2"];
+    let mut frictions = vec![0.0, 0.8];
+    let mut grading: Option<Grading> = None;
+    let mut max_step: Option<f64> = None;
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = || it.next().expect("a value after the option").clone();
+        match a.as_str() {
+            "--depth" => depth = value().parse().expect("depth"),
+            "--max-step" => max_step = Some(value().parse().expect("max step")),
+            "--law" => {
+                laws = match value().as_str() {
+                    "nh" => vec!["nh"],
+                    "rp2" => vec!["rp2"],
+                    _ => vec!["nh", "rp2"],
+                }
+            }
+            "--friction" => {
+                frictions = match value().as_str() {
+                    "both" => vec![0.0, 0.8],
+                    v => vec![v.parse().expect("friction")],
+                }
+            }
+            "--grading" => {
+                let v: Vec<f64> = value()
+                    .split(',')
+                    .map(|x| x.parse().expect("h,zone,growth"))
+                    .collect();
+                grading = Some(Grading {
+                    h_fine: v[0],
+                    fine_length: v[1],
+                    growth: v[2],
+                });
+            }
+            l => levels.push(l.parse::<usize>().expect("a mesh level")),
+        }
+    }
+    if levels.is_empty() {
+        levels.push(1);
+    }
+    let n = (depth / 0.25f64).round() as usize;
+    let drive: Vec<f64> = (1..=n).map(|k| 0.25 * k as f64).collect();
+    let loading = Loading::quasi_static(Drive::DisplacementMm, drive.clone());
+    println!(
+        "{:<28} {:>5} {:>4} {:>7} {:>8} {:>5} {:>5} {:>5} {:>7} {:>7} {:>8} {:>10} {:>10} {:>10}  reached",
+        "mesh", "law", "mu", "cells", "unknowns", "incr", "iter", "fact", "wall s", "cpu s", "VmHWM MiB", "F(2) N", "F(5) N", "F(10) N"
+    );
+    for &level in &levels {
+        for law in &laws {
+            for &mu in &frictions {
+                let (l, theta) = match *law {
+                    "nh" => ("neo-hookean", vec![1101.295e-6]),
+                    _ => ("reduced-polynomial:2", vec![686.428e-6, 1929.606e-6]),
+                };
+                let mut m = N3Needle::new(l.parse().expect("law"));
+                m.level = level;
+                m.grading = grading;
+                m.friction = mu;
+                if let Some(s) = max_step {
+                    m.options.max_step = s;
+                }
+                let label = match grading {
+                    Some(g) => format!("grading {}/{}/{}", g.h_fine, g.fine_length, g.growth),
+                    None => format!("level {level}"),
+                };
+                let (t, c) = (Instant::now(), cpu_seconds(false));
+                let result = m.simulate(&theta, &loading, None);
+                let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(false) - c);
+                let (forces, stats, cells, unknowns, reached) = match result {
+                    Ok((sim, sys)) => (
+                        sim.forces,
+                        Some(sim.stats),
+                        sys.mesh.cell_count(),
+                        sys.equations(),
+                        depth,
+                    ),
+                    Err(ForwardError::NotConverged { completed, .. }) => {
+                        let r = 0.25 * completed.len() as f64;
+                        (completed, None, 0, 0, r)
+                    }
+                    Err(e) => panic!("{label}: {e}"),
+                };
+                let at = |d: f64| {
+                    forces
+                        .get(((d / 0.25).round() as usize).wrapping_sub(1))
+                        .map_or("-".to_string(), |f| format!("{f:.6}"))
+                };
+                let (inc, iters, fact) = stats.map_or((0, 0, 0), |s| {
+                    (s.increments, s.iterations, s.factorisations)
+                });
+                println!(
+                    "{label:<28} {law:>5} {mu:>4} {cells:>7} {unknowns:>8} {inc:>5} {iters:>5} {fact:>5} {wall:>7.1} {cpu:>7.1} {:>8.0} {:>10} {:>10} {:>10}  {reached} mm",
+                    peak_rss_mib(),
+                    at(2.0),
+                    at(5.0),
+                    at(10.0)
+                );
+            }
+        }
+    }
+}

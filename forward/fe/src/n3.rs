@@ -1,0 +1,374 @@
+//! `N3Needle`: needle indentation of a block in 3D (BENCHMARKS.md N3) —
+//! 70 x 80 x 80 mm (x, y, z up), bottom fixed, the N1 needle (hemispherical
+//! tip 2.5 mm tangent to a 15 degree cone, [`ToolShape::n1_needle`] revolved
+//! about z, [`Revolution3d`]) pressed into the centre of the top face with
+//! Coulomb friction 0.8. The quarter `[0, 35] x [0, 40] x [0, 80]` is
+//! modelled, with symmetry on x = 0 (`u_x = 0`) and y = 0 (`u_y = 0`) and the
+//! needle's axis on the line x = y = 0; the force is 4 x the quarter's
+//! needle reaction, positive in compression.
+//!
+//! It is N1's setup in 3D on the same layer: 8-node hexahedra with a
+//! constant pressure per element (Q1/P0, exact incompressibility by
+//! default), a graded box fine at the needle ([`Mesh::graded_box`]), the 3D
+//! Coulomb contact (two-component slip) at the Gauss points of the top
+//! facets. Effects: `friction` (a parameter, 0..2) and `zero_offset`.
+
+use palpate_core::{
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
+    ParamSpec,
+};
+use palpate_enrich::ZeroOffset;
+use palpate_material::Law;
+use std::sync::Arc;
+
+use crate::body::{RegionMaterial, SolidBody};
+use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::discretisation::{Coarser, ConvergenceOrder};
+use crate::dofs::Dirichlet;
+use crate::kernel::{kernel_for, PressureSpace};
+use crate::kinematics::Kinematics;
+use crate::mesh::{CellType, Grading, Mesh};
+use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
+use crate::motion::ToolMotion;
+use crate::stepper::Progress;
+use crate::surface::Revolution3d;
+use crate::system::{SolverOptions, System};
+use crate::tool::ToolShape;
+use crate::FeError;
+
+/// The N3 grading of mesh level `n` (the same in x, y and z from the
+/// needle): elements of `0.8 / n` mm over a 4 mm zone, growing by
+/// `1 + 0.4 / n` beyond it. Level 1 has 2,340 hexahedra (10,125 unknowns,
+/// 0.43 GiB peak, 25-41 s of CPU to 10 mm); level 2 has ~7x the unknowns
+/// (17,400 cells) and its LU does not fit in 10 GiB (docs/validation/fe.md, N3).
+pub fn n3_grading(level: usize) -> Grading {
+    let n = level.max(1) as f64;
+    Grading {
+        h_fine: 0.8 / n,
+        fine_length: 4.0,
+        growth: 1.0 + 0.4 / n,
+    }
+}
+
+/// The N3 model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct N3Needle {
+    pub law: Law,
+    pub bulk: Bulk,
+    pub friction: f64,
+    pub tool: ToolShape,
+    /// Mesh level ([`n3_grading`]); 1 coarse, 2 medium, 3 fine.
+    pub level: usize,
+    /// When set, this grading (x, y from the axis and z from the top)
+    /// replaces the one of `level`.
+    pub grading: Option<Grading>,
+    /// Quarter-block sizes (mm): x, y, height.
+    pub size: [f64; 3],
+    /// Height of the tool tip above the top face at the start (mm); a
+    /// negative value puts it inside the body, which is refused.
+    pub start_gap: f64,
+    /// Contact penalty factor: `eps = penalty * mu0 / h_fine` (augmented
+    /// once per increment, so the converged force does not depend on it).
+    pub penalty: f64,
+    pub penetration_tol: f64,
+    pub contact_points: ContactPoints,
+    pub options: SolverOptions,
+    friction_is_parameter: bool,
+    space: ParamSpace,
+}
+
+impl N3Needle {
+    /// BENCHMARKS.md N3 with the given law: friction 0.8, exact
+    /// incompressibility, mesh level 1, contact at the facet Gauss points,
+    /// multipliers updated once per increment (as N1).
+    pub fn new(law: Law) -> Self {
+        N3Needle {
+            space: law_space(&law),
+            law,
+            bulk: Bulk::Exact,
+            friction: 0.8,
+            tool: ToolShape::n1_needle(),
+            level: 1,
+            grading: None,
+            size: [35.0, 40.0, 80.0],
+            start_gap: 0.0,
+            penalty: 100.0,
+            penetration_tol: 2e-3,
+            contact_points: ContactPoints::EdgeGauss,
+            options: SolverOptions {
+                max_step: 0.25,
+                first_step: 0.05,
+                max_augmentations: 0,
+                ..SolverOptions::default()
+            },
+            friction_is_parameter: false,
+        }
+    }
+
+    fn effective_grading(&self) -> Grading {
+        self.grading.unwrap_or_else(|| n3_grading(self.level))
+    }
+
+    /// The estimated peak memory of a run (bytes) from the number of
+    /// equations, counted from the grading without building anything:
+    /// `1.6 GiB x (equations / 24,500)^1.8`, through the measured peak of
+    /// the 0.6 mm mesh (24,500 equations, 1.6 GiB) with the exponent that
+    /// level 2's lower bound needs (> 10.5 GiB at ~70,000; level 1 at 10,125
+    /// equations measured 0.43 GiB, estimated 0.33). docs/validation/fe.md, N3.
+    pub fn memory_estimate(&self) -> Result<f64, FeError> {
+        let g = self.effective_grading();
+        let [lx, ly, lz] = self.size;
+        let (nx, ny, nz) = (
+            g.positions(lx)?.len(),
+            g.positions(ly)?.len(),
+            g.positions(lz)?.len(),
+        );
+        let cells = (nx - 1) * (ny - 1) * (nz - 1);
+        // displacements less the fixed ones (bottom, two symmetry planes),
+        // plus one pressure per cell
+        let equations = (3 * nx * ny * nz).saturating_sub(3 * nx * ny + ny * nz + nx * nz) + cells;
+        Ok(1.6 * GIB * (equations as f64 / 24_500.0).powf(1.8))
+    }
+
+    /// The mesh this model uses.
+    pub fn build_mesh(&self) -> Result<Mesh, FeError> {
+        let g = self.effective_grading();
+        let [lx, ly, lz] = self.size;
+        Mesh::graded_box(lx, ly, lz, g, g, g)
+    }
+
+    /// The coarser companion of the error estimate: elements twice as large
+    /// (fine size and `growth - 1` doubled, fine zone kept), so level 2 gives
+    /// level 1.
+    pub fn coarser(&self) -> Coarser<N3Needle> {
+        let g = self.effective_grading();
+        let coarse = Grading {
+            h_fine: 2.0 * g.h_fine,
+            fine_length: g.fine_length,
+            growth: 1.0 + 2.0 * (g.growth - 1.0),
+        };
+        let mut model = self.clone();
+        model.grading = Some(coarse);
+        Coarser {
+            model,
+            ratio: 2.0,
+            mesh: format!(
+                "{} mm elements under the tool, growth {}",
+                (coarse.h_fine * 1e6).round() / 1e6,
+                (coarse.growth * 1e6).round() / 1e6
+            ),
+        }
+    }
+
+    /// The order of convergence of the force with the element size, taken
+    /// as N1's Q1/P0 order (1.22 at 10 mm): the same element family and
+    /// contact in 3D. On N3 itself (h = 1.2, 0.8, 0.6 mm, NH, friction 0.8)
+    /// the observed order is 3.9 at 2 mm and 1.7 at 5 mm, and at 10 mm the
+    /// differences do not yet shrink (no order; docs/validation/fe.md, N3),
+    /// so the estimate is indicative at large depth.
+    pub fn convergence_order(&self) -> ConvergenceOrder {
+        ConvergenceOrder {
+            order: 1.22,
+            source: "N1 Q1/P0 order (docs/validation/fe.md N1 speed); N3 at 10 mm is not in the asymptotic range (fe.md N3)"
+                .to_string(),
+        }
+    }
+
+    /// Runs one history with a progress observer; returns the system too.
+    /// A depth of half the block height or more is refused.
+    pub fn simulate(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+        progress: Option<&mut dyn FnMut(&Progress)>,
+    ) -> Result<(Simulation, System), ForwardError> {
+        let max = loading.drive.iter().cloned().fold(0.0, f64::max);
+        if max >= 0.5 * self.size[2] {
+            return Err(ForwardError::InvalidLoading(format!(
+                "a depth of {max} mm is beyond what the {} mm block allows (at most half its height)",
+                self.size[2]
+            )));
+        }
+        let mut sys = self.build().map_err(to_forward)?;
+        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
+        Ok((sim, sys))
+    }
+}
+
+const GIB: f64 = 1024.0 * 1024.0 * 1024.0;
+
+/// `MemAvailable` of `/proc/meminfo` (bytes); `None` off Linux.
+fn available_memory() -> Option<f64> {
+    let s = std::fs::read_to_string("/proc/meminfo").ok()?;
+    let kib: f64 = s
+        .lines()
+        .find(|l| l.starts_with("MemAvailable:"))?
+        .split_whitespace()
+        .nth(1)?
+        .parse()
+        .ok()?;
+    Some(kib * 1024.0)
+}
+
+impl Setup for N3Needle {
+    fn law(&self) -> &Law {
+        &self.law
+    }
+    fn bulk(&self) -> Bulk {
+        self.bulk
+    }
+    fn options(&self) -> SolverOptions {
+        self.options
+    }
+    fn build(&self) -> Result<System, FeError> {
+        if !(self.friction >= 0.0 && self.friction.is_finite()) {
+            return Err(FeError::InvalidConfig {
+                field: "friction".into(),
+                reason: format!("{} must be >= 0", self.friction),
+            });
+        }
+        if !self.start_gap.is_finite() {
+            return Err(FeError::InvalidConfig {
+                field: "start_gap".into(),
+                reason: format!("{} is not a height", self.start_gap),
+            });
+        }
+        let need = self.memory_estimate()?;
+        if let Some(available) = available_memory() {
+            if need > available {
+                return Err(FeError::InvalidConfig {
+                    field: "mesh".into(),
+                    reason: format!(
+                        "this N3 mesh would need about {:.1} GiB, more than the {:.1} GiB available; use a coarser mesh",
+                        need / GIB,
+                        available / GIB
+                    ),
+                });
+            }
+        }
+        let mesh = self.build_mesh()?;
+        let kin = Kinematics::ThreeD;
+        let body = SolidBody::new(
+            "body",
+            &mesh,
+            &["body"],
+            kernel_for(CellType::Hex8, kin, PressureSpace::P0)?,
+            self.bulk.exact(),
+        )?;
+        let mut bcs: Vec<Dirichlet> = (0..3).map(|k| Dirichlet::fixed("bottom", k)).collect();
+        bcs.push(Dirichlet::fixed("x0", 0));
+        bcs.push(Dirichlet::fixed("y0", 1));
+        let options = ContactOptions {
+            friction: self.friction,
+            penalty_normal: 0.0,
+            penalty_tangent: 0.0,
+            penetration_tol: self.penetration_tol,
+            points: self.contact_points,
+        };
+        let motion = ToolMotion::translating(
+            [0.0, 0.0, self.size[2] + self.start_gap],
+            vec![(0, [0.0, 0.0, -1.0])],
+        );
+        let contact = RigidContact::new(
+            &self.tool.name(),
+            Box::new(Revolution3d(self.tool)),
+            motion,
+            &mesh,
+            "top",
+            kin,
+            options,
+            1,
+        )?;
+        System::new(mesh, 3, vec![Box::new(body), Box::new(contact)], &bcs, 1)
+    }
+    fn prepare(
+        &self,
+        sys: &mut System,
+        material: RegionMaterial,
+        extra: &[f64],
+    ) -> Result<(), FeError> {
+        let mu = material.material.shear_modulus();
+        let h = self.effective_grading().h_fine;
+        sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
+        sys.part_mut::<SolidBody>(0)?
+            .set_material("body", material)?;
+        let cs = sys.part_mut::<RigidContact>(1)?;
+        cs.options.penalty_normal = self.penalty * mu / h;
+        cs.options.penalty_tangent = self.penalty * mu / h;
+        cs.options.friction = if self.friction_is_parameter {
+            extra.first().copied().unwrap_or(self.friction)
+        } else {
+            self.friction
+        };
+        Ok(())
+    }
+    fn observe(&self, sys: &System) -> Vec<f64> {
+        vec![
+            4.0 * sys.contributions[1]
+                .tool_force([0.0, 0.0, -1.0])
+                .unwrap_or(0.0),
+        ]
+    }
+}
+
+impl ForwardModel for N3Needle {
+    fn name(&self) -> String {
+        format!(
+            "N3 FE needle indentation (3D quarter block), {}, friction {}",
+            self.law, self.friction
+        )
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.space
+    }
+    fn observable(&self) -> Observable {
+        Observable::ForceN
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(FeEvaluator {
+            setup: self,
+            space: &self.space,
+            outputs: self.outputs().len(),
+            system: None,
+        })
+    }
+    /// A nonlinear 3D FE solve per prediction (tens of seconds or more).
+    fn expensive(&self) -> bool {
+        true
+    }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for N3Needle {
+    fn effects(&self) -> Vec<Effect> {
+        let mut v = Vec::new();
+        if !self.friction_is_parameter {
+            v.push(Effect::Friction);
+        }
+        v.push(Effect::ZeroOffset);
+        v
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        match effect {
+            Effect::Friction if !self.friction_is_parameter => {
+                let mut m = self.clone();
+                m.friction_is_parameter = true;
+                m.space = self.space.extended(&[ParamSpec::new(
+                    "friction",
+                    "1",
+                    0.0,
+                    2.0,
+                    self.friction,
+                )]);
+                Ok(Box::new(m))
+            }
+            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(self.clone())))),
+            _ => Err(ForwardError::InvalidConfig {
+                field: "effect".into(),
+                reason: format!("`{effect}` does not apply to {}", self.name()),
+            }),
+        }
+    }
+}
