@@ -48,9 +48,10 @@ pub struct Args {
 
 /// Runs `palpate anova`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    crate::output::check_outputs(
+    crate::output::check_outputs_and_dirs(
         &[&args.data],
-        &crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]),
+        &crate::output::given(&[("--json", &args.json)]),
+        &crate::output::given(&[("--plot", &args.plot)]),
     )?;
     check_alpha("--alpha", args.alpha)?;
     if let Some(f) = args.factors.iter().find(|f| f.trim() == args.response) {

@@ -214,6 +214,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(seed) = manifest.design.seed {
         design = design.randomised(seed);
     }
+    if let Some(out) = &args.out {
+        check_out(out, &args.manifest, &manifest, &base_dir)?;
+    }
     println!("{}", describe(&design));
     if let Some(out) = &args.out {
         // The design alone first, so it is there even if a run fails.
@@ -222,11 +225,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             design_csv(&design, "", None).as_bytes(),
         )?;
     }
+    // Errors of the response (its fields, its data, a run) name the manifest.
     let response = match &manifest.response {
-        Some(ResponseSpec::Calibration(c)) => Some(run_calibrations(&design, c, &base_dir)?),
-        Some(ResponseSpec::Simulation(s)) => Some(run_simulations(&design, s, &base_dir)?),
+        Some(ResponseSpec::Calibration(c)) => Some(run_calibrations(&design, c, &base_dir)),
+        Some(ResponseSpec::Simulation(s)) => Some(run_simulations(&design, s, &base_dir)),
         None => None,
-    };
+    }
+    .transpose()
+    .map_err(|e| anyhow::anyhow!("{m}: {e:#}"))?;
     let metric = match &manifest.response {
         Some(ResponseSpec::Calibration(c)) => c.metric.clone(),
         Some(ResponseSpec::Simulation(s)) => s.metric.clone(),
@@ -264,6 +270,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
     }
     Ok(())
+}
+
+/// Checks `--out` and the files written into it before any run: none is
+/// the manifest or a data file it names, and the folder can be written.
+fn check_out(out: &Path, path: &Path, manifest: &Manifest, base: &Path) -> anyhow::Result<()> {
+    let mut inputs: Vec<PathBuf> = vec![path.to_path_buf()];
+    match &manifest.response {
+        Some(ResponseSpec::Calibration(c)) => {
+            inputs.extend(c.data.values().map(|f| base.join(f)));
+        }
+        Some(ResponseSpec::Simulation(s)) => inputs.push(base.join(&s.reference)),
+        None => {}
+    }
+    let inputs: Vec<&Path> = inputs.iter().map(PathBuf::as_path).collect();
+    let files: Vec<(String, PathBuf)> = ["design.csv", "design.json", "anova.json"]
+        .iter()
+        .map(|f| (format!("--out (its {f})"), out.join(f)))
+        .collect();
+    let plots = out.join("plots");
+    crate::output::check_outputs_and_dirs(
+        &inputs,
+        &files
+            .iter()
+            .map(|(o, p)| (o.as_str(), p.as_path()))
+            .collect::<Vec<_>>(),
+        &[("--out", out), ("--out (its plots/)", &plots)],
+    )
 }
 
 fn describe(d: &Design) -> String {

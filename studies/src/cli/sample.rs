@@ -167,13 +167,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     check_sizes(&args, &sampler, law.params().len() + 2 * args.data.len())?;
     let data = read_data(&args.data, args.benchmark.as_deref())?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
-    crate::output::check_outputs(
+    crate::output::check_outputs_and_dirs(
         &inputs,
-        &crate::output::given(&[
-            ("--json", &args.json),
-            ("--chains", &args.chains_out),
-            ("--plot", &args.plot),
-        ]),
+        &crate::output::given(&[("--json", &args.json), ("--chains", &args.chains_out)]),
+        &crate::output::given(&[("--plot", &args.plot)]),
     )?;
     if let Some(s) = args.sigma {
         anyhow::ensure!(
