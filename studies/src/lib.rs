@@ -13,4 +13,5 @@ pub mod output;
 pub mod plot;
 pub mod provenance;
 pub mod report;
+pub mod run_folder;
 pub mod runner;

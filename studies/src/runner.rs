@@ -5,6 +5,11 @@
 //! * `report.md` — a readable report with comparison tables;
 //! * `plots/*.svg`;
 //! * `provenance.json` — hashes, git commit, crate versions, seed, threads, timings.
+//!
+//! The folder is staged, locked, marked while incomplete and resumable
+//! ([`crate::run_folder`]): each fit and each diagnosed record is a unit
+//! cached under the hash of its inputs, so a rerun (after a kill, or after
+//! an edit of another step) computes only the units whose inputs changed.
 
 use crate::calibration::{calibrate, parse_method, Calibration, Request, TestData, TestKind};
 use crate::manifest::{CalibrateStep, DiagnoseStep, Manifest, ModelForm, Step};
@@ -12,10 +17,11 @@ use crate::models::{build, default_effects, gap_base, parse_effects};
 use crate::output::{write_atomic, write_json};
 use crate::provenance::{crate_versions, git_state, hash_file, Provenance};
 use crate::report::{fit_plot, gap_svg};
+use crate::run_folder::RunFolder;
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -29,18 +35,48 @@ pub struct StudyResults {
     pub steps: Vec<StepResult>,
 }
 
-/// The results of one step.
+/// The results of one step. Each fit is a [`FitEntry`] and each case a
+/// [`DiagnoseEntry`], held as JSON so that a unit read from the cache and
+/// one computed now give the same bytes.
 #[derive(Debug, Clone, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum StepResult {
     Calibrate {
         name: String,
-        fits: Vec<FitEntry>,
+        fits: Vec<serde_json::Value>,
     },
     Diagnose {
         name: String,
-        cases: Vec<DiagnoseEntry>,
+        cases: Vec<serde_json::Value>,
     },
+}
+
+/// A finished fit as cached: its results entry, its report rows and its plot.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct FitUnit {
+    entry: serde_json::Value,
+    /// The row of the fit table.
+    row: String,
+    /// (data set, R^2 cell) of the prediction table.
+    r2: Vec<(String, String)>,
+    plot: String,
+}
+
+/// A diagnosed record as cached.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct DiagnoseUnit {
+    entry: serde_json::Value,
+    row: String,
+    plot: String,
+}
+
+/// How to run a study.
+#[derive(Debug, Clone, Default)]
+pub struct RunOptions {
+    /// Run folder (default `runs/<study name>`).
+    pub out: Option<PathBuf>,
+    /// Compute every unit again (the cache of finished units is emptied).
+    pub fresh: bool,
 }
 
 /// One fit of a calibrate step.
@@ -70,10 +106,24 @@ impl<F: Fn(&str)> RunObserver for F {
     }
 }
 
-/// Runs the manifest at `path` into `out_dir` (default `runs/<study name>`).
+/// Runs the manifest at `path` into `out_dir` (default `runs/<study name>`),
+/// reusing the finished units of an earlier run into the same folder.
 pub fn run_study(
     path: &Path,
     out_dir: Option<&Path>,
+    observer: &dyn RunObserver,
+) -> anyhow::Result<PathBuf> {
+    let options = RunOptions {
+        out: out_dir.map(Path::to_path_buf),
+        fresh: false,
+    };
+    run_study_with(path, &options, observer)
+}
+
+/// Runs the manifest at `path` as `options` say (see [`run_study`]).
+pub fn run_study_with(
+    path: &Path,
+    options: &RunOptions,
     observer: &dyn RunObserver,
 ) -> anyhow::Result<PathBuf> {
     let started = std::time::Instant::now();
@@ -84,11 +134,10 @@ pub fn run_study(
     let manifest = Manifest::read(path)?;
     manifest.validate(path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
-    let out = out_dir
-        .map(Path::to_path_buf)
+    let out = options
+        .out
+        .clone()
         .unwrap_or_else(|| PathBuf::from("runs").join(&manifest.study.name));
-    std::fs::create_dir_all(out.join("plots"))
-        .with_context(|| format!("cannot create run folder {}", out.display()))?;
 
     let mut data = BTreeMap::new();
     for (name, spec) in &manifest.data {
@@ -98,6 +147,12 @@ pub fn run_study(
             TestData::read(name, kind, &dir.join(&spec.file))?,
         );
     }
+    let inputs: Vec<PathBuf> = std::iter::once(path.to_path_buf())
+        .chain(manifest.data.values().map(|d| dir.join(&d.file)))
+        .collect();
+    check_not_inside(&out, &inputs)?;
+    let folder = RunFolder::open(&out, options.fresh)?;
+    let stage = folder.staging().to_path_buf();
     let mut results = StudyResults {
         study: manifest.study.name.clone(),
         description: manifest.study.description.clone(),
@@ -109,20 +164,27 @@ pub fn run_study(
     if !manifest.study.description.is_empty() {
         let _ = writeln!(report, "{}\n", manifest.study.description.trim());
     }
+    let run = Run {
+        manifest: &manifest,
+        data: &data,
+        out: &stage,
+        folder: &folder,
+        observer,
+    };
     for step in &manifest.steps {
         match step {
             Step::Calibrate(c) => {
-                let r = run_calibrate(&manifest, c, &data, &out, observer, &mut report)?;
+                let r = run.calibrate(c, &mut report)?;
                 results.steps.push(r);
             }
             Step::Diagnose(d) => {
-                let r = run_diagnose(&manifest, d, &data, &out, observer, &mut report)?;
+                let r = run.diagnose(d, &mut report)?;
                 results.steps.push(r);
             }
         }
     }
-    write_json(&out.join("results.json"), &results)?;
-    write_atomic(&out.join("report.md"), report.as_bytes())?;
+    write_json(&stage.join("results.json"), &results)?;
+    write_atomic(&stage.join("report.md"), report.as_bytes())?;
     let (git_commit, git_dirty) = git_state();
     let provenance = Provenance {
         palpate_version: env!("CARGO_PKG_VERSION").to_string(),
@@ -141,21 +203,82 @@ pub fn run_study(
         wall_time_s: started.elapsed().as_secs_f64(),
         command_line: std::env::args().collect(),
     };
-    write_json(&out.join("provenance.json"), &provenance)?;
-    Ok(out)
+    write_json(&stage.join("provenance.json"), &provenance)?;
+    folder.commit()
+}
+
+/// Refuses a run folder that is an input file or holds one (the swap of a
+/// rerun would remove it): the manifest and its data stay outside.
+fn check_not_inside(out: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
+    let Ok(out_c) = out.canonicalize() else {
+        return Ok(()); // a new folder holds nothing yet
+    };
+    for i in inputs {
+        if let Ok(c) = i.canonicalize() {
+            if c.starts_with(&out_c) {
+                anyhow::bail!(
+                    "run folder {}: holds the input {}; keep the manifest and its data outside the run folder (give another --out)",
+                    out.display(),
+                    i.display()
+                );
+            }
+        }
+    }
+    Ok(())
+}
+
+/// One study run: what every step needs.
+struct Run<'a> {
+    manifest: &'a Manifest,
+    data: &'a BTreeMap<String, TestData>,
+    /// The staging folder the files are written into.
+    out: &'a Path,
+    folder: &'a RunFolder,
+    observer: &'a dyn RunObserver,
+}
+
+impl Run<'_> {
+    /// A unit's record: from the cache when its inputs are unchanged, else
+    /// computed and cached at once (so a kill after it keeps it).
+    fn unit<T, K>(
+        &self,
+        label: &str,
+        inputs: &K,
+        compute: impl FnOnce() -> anyhow::Result<T>,
+    ) -> anyhow::Result<T>
+    where
+        T: Serialize + serde::de::DeserializeOwned,
+        K: std::fmt::Debug,
+    {
+        let key = RunFolder::key(inputs);
+        if let Some(record) = self.folder.cached(&key) {
+            self.observer.message(&format!("{label} (cached)"));
+            return Ok(record);
+        }
+        self.observer.message(label);
+        let record = compute()?;
+        self.folder.store(&key, &record)?;
+        Ok(record)
+    }
+
+    fn calibrate(&self, step: &CalibrateStep, report: &mut String) -> anyhow::Result<StepResult> {
+        run_calibrate(self, step, report)
+    }
+
+    fn diagnose(&self, step: &DiagnoseStep, report: &mut String) -> anyhow::Result<StepResult> {
+        run_diagnose(self, step, report)
+    }
 }
 
 fn run_calibrate(
-    manifest: &Manifest,
+    run: &Run,
     step: &CalibrateStep,
-    data: &BTreeMap<String, TestData>,
-    out: &Path,
-    observer: &dyn RunObserver,
     report: &mut String,
 ) -> anyhow::Result<StepResult> {
+    let (manifest, data) = (run.manifest, run.data);
     let method = parse_method(&step.estimator)?;
     let predict: Vec<TestData> = step.predict.iter().map(|n| data[n].clone()).collect();
-    let mut fits = Vec::new();
+    let mut units = Vec::new();
     for model_name in &step.models {
         let entry = &manifest.models[model_name];
         let law: Law = entry
@@ -170,121 +293,145 @@ fn run_calibrate(
             let fitted: Vec<TestData> = sets.iter().map(|n| data[n].clone()).collect();
             for residual in &step.residuals {
                 let kind: ResidualKind = residual.parse().map_err(|e| anyhow::anyhow!("{e}"))?;
-                observer.message(&format!(
-                    "{}: {model_name} on {group} ({residual})",
-                    step.name
-                ));
-                let calibration = calibrate(Request {
-                    law,
-                    model: spec,
-                    fitted: &fitted,
-                    predict: &predict,
-                    residual: kind,
-                    method,
-                    fixed: entry.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
-                    observer: None,
-                })
-                .with_context(|| {
-                    format!(
-                        "step `{}`: model `{model_name}` on `{group}` ({residual})",
-                        step.name
-                    )
+                let label = format!("{}: {model_name} on {group} ({residual})", step.name);
+                let inputs = (
+                    "calibrate",
+                    &step.name,
+                    model_name,
+                    entry,
+                    group,
+                    &fitted,
+                    &predict,
+                    residual,
+                    &step.estimator,
+                );
+                let unit: FitUnit = run.unit(&label, &inputs, || {
+                    let calibration = calibrate(Request {
+                        law,
+                        model: spec,
+                        fitted: &fitted,
+                        predict: &predict,
+                        residual: kind,
+                        method,
+                        fixed: entry.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
+                        observer: None,
+                    })
+                    .with_context(|| {
+                        format!(
+                            "step `{}`: model `{model_name}` on `{group}` ({residual})",
+                            step.name
+                        )
+                    })?;
+                    let fit = FitEntry {
+                        model: model_name.clone(),
+                        group: group.clone(),
+                        residual: residual.clone(),
+                        calibration,
+                    };
+                    Ok(FitUnit {
+                        row: fit_row(&fit),
+                        r2: fit
+                            .calibration
+                            .predictions
+                            .iter()
+                            .map(|p| {
+                                let cell = if p.fitted {
+                                    format!("{:.4}", p.r2)
+                                } else {
+                                    format!("*{:.4}*", p.r2)
+                                };
+                                (p.data.clone(), cell)
+                            })
+                            .collect(),
+                        plot: fit_plot(&fit.calibration).to_svg(),
+                        entry: serde_json::to_value(&fit)?,
+                    })
                 })?;
-                let plot = fit_plot(&calibration);
                 let file = format!("{}-{model_name}-{group}-{residual}.svg", step.name);
-                write_atomic(&out.join("plots").join(&file), plot.to_svg().as_bytes())?;
-                fits.push(FitEntry {
-                    model: model_name.clone(),
-                    group: group.clone(),
-                    residual: residual.clone(),
-                    calibration,
-                });
+                write_atomic(&run.out.join("plots").join(&file), unit.plot.as_bytes())?;
+                units.push(((model_name, group, residual), unit));
             }
         }
     }
-    write_calibrate_report(step, &fits, report);
+    write_calibrate_report(step, &units, report);
     Ok(StepResult::Calibrate {
         name: step.name.clone(),
-        fits,
+        fits: units.into_iter().map(|(_, u)| u.entry).collect(),
     })
 }
 
-fn write_calibrate_report(step: &CalibrateStep, fits: &[FitEntry], r: &mut String) {
+/// The row of one fit in the report's fit table.
+fn fit_row(f: &FitEntry) -> String {
+    let c = &f.calibration;
+    let params: Vec<String> = c
+        .params
+        .iter()
+        .map(|(n, p)| match p.standard_error {
+            Some(se) if c.identifiable => format!("{n} = {:.5e} ± {:.2e}", p.value, se),
+            _ => format!("{n} = {:.5e}", p.value),
+        })
+        .collect();
+    let d = &c.drucker;
+    format!(
+        "| {} (`{}`) | {} | {} | {:.6e} | {:.5} | {} | {} | [{:.2}, {:.2}] / [{:.2}, {:.2}] / [{:.2}, {:.2}] |",
+        f.model,
+        c.law,
+        f.group,
+        f.residual,
+        c.sse,
+        c.r2,
+        if c.identifiable { "yes".to_string() } else { format!("**no** ({})", c.fit.identifiability.involved.join(", ")) },
+        params.join("<br>"),
+        d.uniaxial.lower,
+        d.uniaxial.upper,
+        d.biaxial.lower,
+        d.biaxial.upper,
+        d.planar.lower,
+        d.planar.upper
+    )
+}
+
+type FitName<'a> = (&'a String, &'a String, &'a String);
+
+fn write_calibrate_report(step: &CalibrateStep, fits: &[(FitName, FitUnit)], r: &mut String) {
     let _ = writeln!(r, "## Calibration `{}`\n", step.name);
     let _ = writeln!(r, "Estimator `{}`. R^2 = 1 - SS_res/SS_tot on the fitted data; predictions of the other tests use the fitted parameters.\n", step.estimator);
     let _ = writeln!(r, "| model | fitted to | residual | SSE | R^2 (fit) | identifiable | parameters | Drucker stable (uniaxial / biaxial / planar) |");
     let _ = writeln!(r, "|---|---|---|---|---|---|---|---|");
-    for f in fits {
-        let c = &f.calibration;
-        let params: Vec<String> = c
-            .params
-            .iter()
-            .map(|(n, p)| match p.standard_error {
-                Some(se) if c.identifiable => format!("{n} = {:.5e} ± {:.2e}", p.value, se),
-                _ => format!("{n} = {:.5e}", p.value),
-            })
-            .collect();
-        let d = &c.drucker;
-        let _ = writeln!(
-            r,
-            "| {} (`{}`) | {} | {} | {:.6e} | {:.5} | {} | {} | [{:.2}, {:.2}] / [{:.2}, {:.2}] / [{:.2}, {:.2}] |",
-            f.model,
-            c.law,
-            f.group,
-            f.residual,
-            c.sse,
-            c.r2,
-            if c.identifiable { "yes".to_string() } else { format!("**no** ({})", c.fit.identifiability.involved.join(", ")) },
-            params.join("<br>"),
-            d.uniaxial.lower,
-            d.uniaxial.upper,
-            d.biaxial.lower,
-            d.biaxial.upper,
-            d.planar.lower,
-            d.planar.upper
-        );
+    for (_, f) in fits {
+        let _ = writeln!(r, "{}", f.row);
     }
-    let names: Vec<String> = {
-        let mut v: Vec<String> = fits
-            .iter()
-            .flat_map(|f| f.calibration.predictions.iter().map(|p| p.data.clone()))
-            .collect();
-        v.dedup();
-        let mut seen = Vec::new();
-        v.retain(|x| {
-            let new = !seen.contains(x);
-            seen.push(x.clone());
-            new
-        });
-        v
-    };
+    // The data sets in order of first appearance.
+    let mut names: Vec<&String> = Vec::new();
+    for (d, _) in fits.iter().flat_map(|(_, f)| &f.r2) {
+        if !names.contains(&d) {
+            names.push(d);
+        }
+    }
     let _ = writeln!(
         r,
         "\nR^2 on each data set (*italic*: predicted, not fitted):\n"
     );
+    let header: Vec<&str> = names.iter().map(|n| n.as_str()).collect();
     let _ = writeln!(
         r,
         "| model | fitted to | residual | {} |",
-        names.join(" | ")
+        header.join(" | ")
     );
     let _ = writeln!(r, "|---|---|---|{}", "---|".repeat(names.len()));
-    for f in fits {
-        let cells: Vec<String> = names
+    for ((model, group, residual), f) in fits {
+        let cells: Vec<&str> = names
             .iter()
-            .map(
-                |n| match f.calibration.predictions.iter().find(|p| &p.data == n) {
-                    Some(p) if p.fitted => format!("{:.4}", p.r2),
-                    Some(p) => format!("*{:.4}*", p.r2),
-                    None => "".into(),
-                },
-            )
+            .map(|n| {
+                f.r2.iter()
+                    .find(|(d, _)| d == *n)
+                    .map(|(_, c)| c.as_str())
+                    .unwrap_or("")
+            })
             .collect();
         let _ = writeln!(
             r,
-            "| {} | {} | {} | {} |",
-            f.model,
-            f.group,
-            f.residual,
+            "| {model} | {group} | {residual} | {} |",
             cells.join(" | ")
         );
     }
@@ -295,14 +442,8 @@ fn write_calibrate_report(step: &CalibrateStep, fits: &[FitEntry], r: &mut Strin
     );
 }
 
-fn run_diagnose(
-    manifest: &Manifest,
-    step: &DiagnoseStep,
-    data: &BTreeMap<String, TestData>,
-    out: &Path,
-    observer: &dyn RunObserver,
-    report: &mut String,
-) -> anyhow::Result<StepResult> {
+fn run_diagnose(run: &Run, step: &DiagnoseStep, report: &mut String) -> anyhow::Result<StepResult> {
+    let (manifest, data) = (run.manifest, run.data);
     // The base model: a named model spec, or the base law in the gap base
     // model of each record's test (models::gap_base).
     let (base_name, named) = match (&step.base, &step.model) {
@@ -322,7 +463,6 @@ fn run_diagnose(
     let _ = writeln!(report, "| data | verdict | noise SD (N) | base misfit (N) | best effect | misfit after (N) | held-out before / after (N) |");
     let _ = writeln!(report, "|---|---|---|---|---|---|---|");
     for name in &step.data {
-        observer.message(&format!("{}: diagnosing {name}", step.name));
         let d = &data[name];
         let spec = match named {
             Some(s) => s.clone(),
@@ -333,46 +473,64 @@ fn run_diagnose(
                 gap_base(d.test, law).with_context(|| format!("step `{}`: `{name}`", step.name))?
             }
         };
-        let model = build(&spec).map_err(|e| anyhow::anyhow!("step `{}`: {e}", step.name))?;
-        let options = palpate_uq::gap::GapOptions {
-            effects: match &step.effects {
-                Some(list) => Some(
-                    parse_effects(list)
-                        .with_context(|| format!("step `{}`: effects", step.name))?,
-                ),
-                None => default_effects(&spec),
-            },
-            ..Default::default()
-        };
-        let gap = palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &options)
-            .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
-        let best = gap.ranking.first();
-        let _ = writeln!(
-            report,
-            "| {name} | **{}**{} | {:.4} | {:.4} | {} | {} | {} |",
-            gap.verdict,
-            if gap.confounded.is_empty() {
-                String::new()
-            } else {
-                format!(" (confounded with {})", gap.confounded.join(", "))
-            },
-            gap.noise_sd,
-            gap.base.misfit,
-            best.map(|b| b.effect.clone()).unwrap_or_default(),
-            best.map(|b| format!("{:.4}", b.misfit_after))
-                .unwrap_or_default(),
-            best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))
-                .unwrap_or_default(),
+        let label = format!("{}: diagnosing {name}", step.name);
+        let inputs = (
+            "diagnose",
+            &step.name,
+            &base_name,
+            &spec,
+            &step.effects,
+            name,
+            d,
         );
-        let svg = gap_svg(&gap, name);
+        let unit: DiagnoseUnit = run.unit(&label, &inputs, || {
+            let model = build(&spec).map_err(|e| anyhow::anyhow!("step `{}`: {e}", step.name))?;
+            let options = palpate_uq::gap::GapOptions {
+                effects: match &step.effects {
+                    Some(list) => Some(
+                        parse_effects(list)
+                            .with_context(|| format!("step `{}`: effects", step.name))?,
+                    ),
+                    None => default_effects(&spec),
+                },
+                ..Default::default()
+            };
+            let gap = palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &options)
+                .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
+            let best = gap.ranking.first();
+            let row = format!(
+                "| {name} | **{}**{} | {:.4} | {:.4} | {} | {} | {} |",
+                gap.verdict,
+                if gap.confounded.is_empty() {
+                    String::new()
+                } else {
+                    format!(" (confounded with {})", gap.confounded.join(", "))
+                },
+                gap.noise_sd,
+                gap.base.misfit,
+                best.map(|b| b.effect.clone()).unwrap_or_default(),
+                best.map(|b| format!("{:.4}", b.misfit_after))
+                    .unwrap_or_default(),
+                best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))
+                    .unwrap_or_default(),
+            );
+            Ok(DiagnoseUnit {
+                row,
+                plot: gap_svg(&gap, name),
+                entry: serde_json::to_value(DiagnoseEntry {
+                    data: name.clone(),
+                    report: serde_json::to_value(&gap)?,
+                })?,
+            })
+        })?;
+        let _ = writeln!(report, "{}", unit.row);
         write_atomic(
-            &out.join("plots").join(format!("{}-{name}.svg", step.name)),
-            svg.as_bytes(),
+            &run.out
+                .join("plots")
+                .join(format!("{}-{name}.svg", step.name)),
+            unit.plot.as_bytes(),
         )?;
-        cases.push(DiagnoseEntry {
-            data: name.clone(),
-            report: serde_json::to_value(&gap)?,
-        });
+        cases.push(unit.entry);
     }
     let _ = writeln!(report, "\nPlots: `plots/{}-<data>.svg` (data, base and enriched fits, residuals with the flagged windows).\n", step.name);
     Ok(StepResult::Diagnose {

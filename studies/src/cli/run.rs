@@ -1,6 +1,7 @@
 //! `palpate run STUDY.toml`: run a whole study from one manifest.
 
-use std::path::PathBuf;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
 
 /// Run a study described by one TOML manifest.
 ///
@@ -8,6 +9,20 @@ use std::path::PathBuf;
 /// (byte-identical when the same manifest is run again), report.md, plots/*.svg
 /// and provenance.json (manifest and data hashes, git commit, crate versions,
 /// seed, thread count). Data file paths in the manifest are relative to it.
+///
+/// The run folder is safe to rerun into and to interrupt:
+///   * the run is written into DIR/.palpate/staging and swapped in at the end,
+///     so the folder holds either the previous complete run or the new one,
+///     never a mix of both; files of a previous run that this one does not
+///     write (plots of a larger study) are removed;
+///   * DIR/INCOMPLETE is present while the folder holds no complete run;
+///   * each fit and each diagnosed record is cached in DIR/.palpate/cache
+///     under the hash of its inputs: a rerun after a kill (Ctrl-C, SIGKILL)
+///     or after editing another step computes only what changed (--fresh
+///     computes everything again);
+///   * one run at a time: a second run into the same folder is refused with
+///     the pid of the one writing it.
+///
 /// See studies/*.toml for examples and docs/guide.md for every field.
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
@@ -15,11 +30,17 @@ pub struct Args {
     /// The study manifest (TOML).
     pub manifest: PathBuf,
     /// Run folder (default: runs/<study name> under the current directory).
+    /// It must be new, empty or a run folder of palpate.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
-    /// Only check the manifest (fields, references, files) and exit.
+    /// Only check the manifest (fields, references) and read every data
+    /// file it names, then exit without running.
     #[arg(long)]
     pub check: bool,
+    /// Compute every fit and diagnosis again instead of reusing the ones
+    /// cached in the run folder.
+    #[arg(long)]
+    pub fresh: bool,
 }
 
 /// Runs `palpate run`.
@@ -27,8 +48,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if args.check {
         let m = crate::manifest::Manifest::read(&args.manifest)?;
         m.validate(&args.manifest)?;
+        let rows = check_data(&args.manifest, &m)?;
         println!(
-            "{}: ok ({} data sets, {} models, {} steps)",
+            "{}: ok ({} data sets with {rows} rows, {} models, {} steps)",
             args.manifest.display(),
             m.data.len(),
             m.models.len(),
@@ -36,12 +58,42 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    let bar = indicatif::ProgressBar::new_spinner();
-    bar.enable_steady_tick(std::time::Duration::from_millis(120));
-    let observer = |msg: &str| bar.set_message(msg.to_string());
-    let out = crate::runner::run_study(&args.manifest, args.out.as_deref(), &observer)?;
-    bar.finish_and_clear();
+    // A spinner on a terminal; plain lines when stderr is a log file.
+    let bar = std::io::stderr().is_terminal().then(|| {
+        let bar = indicatif::ProgressBar::new_spinner();
+        bar.enable_steady_tick(std::time::Duration::from_millis(120));
+        bar
+    });
+    let observer = |msg: &str| match &bar {
+        Some(b) => b.set_message(msg.to_string()),
+        None => eprintln!("{msg}"),
+    };
+    let options = crate::runner::RunOptions {
+        out: args.out.clone(),
+        fresh: args.fresh,
+    };
+    let out = crate::runner::run_study_with(&args.manifest, &options, &observer);
+    if let Some(b) = &bar {
+        b.finish_and_clear();
+    }
+    let out = out?;
     println!("study written to {}", out.display());
     println!("  {}", out.join("report.md").display());
     Ok(())
+}
+
+/// Reads every data file of a manifest as its test (the errors name the
+/// file, line and column, and the data set); returns the number of rows.
+fn check_data(path: &Path, m: &crate::manifest::Manifest) -> anyhow::Result<usize> {
+    use crate::calibration::{TestData, TestKind};
+    let dir = path.parent().unwrap_or(Path::new("."));
+    let mut rows = 0;
+    for (name, spec) in &m.data {
+        let kind = TestKind::parse(&spec.test)
+            .map_err(|e| anyhow::anyhow!("{}: data.{name}.test: {e}", path.display()))?;
+        let d = TestData::read(name, kind, &dir.join(&spec.file))
+            .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
+        rows += d.observed.len();
+    }
+    Ok(rows)
 }
