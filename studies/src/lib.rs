@@ -5,6 +5,7 @@
 //! module per subcommand under [`cli`]).
 
 pub mod calibration;
+pub mod checks;
 pub mod cli;
 pub mod limits;
 pub mod manifest;

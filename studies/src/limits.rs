@@ -176,11 +176,102 @@ pub fn check_runs(
     let max = palpate_uq::doe::MAX_RUNS;
     anyhow::ensure!(
         runs <= max as f64,
-        "{what} gives {} runs ({} x {replicates} replicates); at most {max} (2^20) runs are supported",
-        fmt_count(runs),
-        levels.iter().map(|l| format!("{l} levels")).collect::<Vec<_>>().join(" x "),
+        "{what} gives {} runs ({}); at most {max} (2^20) runs are supported",
+        runs_formula(levels, generators, replicates, runs),
+        design_size(levels, replicates),
     );
     check_count(what, runs, "runs", 64.0 + 8.0 * levels.len() as f64)
+}
+
+/// The run count as a product of powers, e.g. `2^40 = 1.100e12`,
+/// `2^3 x 3 x 5 replicates / 2^1 = 60`.
+fn runs_formula(levels: &[usize], generators: usize, replicates: usize, runs: f64) -> String {
+    let mut terms: Vec<String> = grouped(levels)
+        .into_iter()
+        .map(|(l, n)| {
+            if n == 1 {
+                format!("{l}")
+            } else {
+                format!("{l}^{n}")
+            }
+        })
+        .collect();
+    if replicates != 1 {
+        terms.push(format!("{replicates} replicates"));
+    }
+    let mut f = terms.join(" x ");
+    if f.is_empty() {
+        f = "1".into();
+    }
+    if generators > 0 {
+        f = format!("{f} / 2^{generators}");
+    }
+    if f == fmt_count(runs) {
+        f
+    } else {
+        format!("{f} = {}", fmt_count(runs))
+    }
+}
+
+/// The factors grouped by level count, e.g. `40 factors of 2 levels, 1 replicate`.
+fn design_size(levels: &[usize], replicates: usize) -> String {
+    let mut parts: Vec<String> = grouped(levels)
+        .into_iter()
+        .map(|(l, n)| format!("{n} factor{} of {l} levels", if n == 1 { "" } else { "s" }))
+        .collect();
+    parts.push(format!(
+        "{replicates} replicate{}",
+        if replicates == 1 { "" } else { "s" }
+    ));
+    parts.join(", ")
+}
+
+/// (level count, number of factors with it), in order of first appearance.
+fn grouped(levels: &[usize]) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for &l in levels {
+        match out.iter_mut().find(|(m, _)| *m == l) {
+            Some((_, n)) => *n += 1,
+            None => out.push((l, 1)),
+        }
+    }
+    out
+}
+
+/// Parses a count typed on the command line (clap `value_parser`): a whole
+/// number, 0 or more, also as `1e3` or `10_000`; the message says what is
+/// valid instead of clap's "invalid digit found in string".
+pub fn parse_count<T: TryFrom<u64>>(text: &str) -> Result<T, String> {
+    let t = text.trim().replace('_', "");
+    let value: u64 = match t.parse::<u64>() {
+        Ok(v) => v,
+        Err(_) => match t.parse::<f64>() {
+            Ok(x) if x.is_finite() && x >= 0.0 && x.fract() == 0.0 && x <= 2f64.powi(53) => {
+                x as u64
+            }
+            Ok(x) if x < 0.0 => {
+                return Err(
+                    "a count cannot be negative; expected a whole number 0 or more, e.g. 1000"
+                        .into(),
+                )
+            }
+            Ok(x) if x.is_finite() && x.fract() != 0.0 => {
+                return Err("expected a whole number, e.g. 1000".into())
+            }
+            Ok(_) => {
+                return Err(format!(
+                    "too large; expected a whole number up to {}",
+                    u64::MAX
+                ))
+            }
+            Err(_) => {
+                return Err(
+                    "not a number; expected a whole number 0 or more, e.g. 1000 or 1e3".into(),
+                )
+            }
+        },
+    };
+    T::try_from(value).map_err(|_| format!("{value} is too large for this option"))
 }
 
 /// A number as a user would type it: `1e-300`, `0.1`, `2`.
@@ -195,6 +286,43 @@ pub fn fmt_value(x: f64) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn counts_parse_as_a_user_types_them() {
+        assert_eq!(parse_count::<usize>("1000"), Ok(1000));
+        assert_eq!(parse_count::<usize>("1e3"), Ok(1000));
+        assert_eq!(parse_count::<usize>("10_000"), Ok(10_000));
+        assert_eq!(parse_count::<u64>("18446744073709551615"), Ok(u64::MAX));
+        for (bad, says) in [
+            ("-3", "negative"),
+            ("2.5", "whole number"),
+            ("ten", "not a number"),
+            ("1e30", "too large"),
+        ] {
+            let e = parse_count::<usize>(bad).unwrap_err();
+            assert!(e.contains(says), "{bad}: {e}");
+        }
+    }
+
+    #[test]
+    fn a_run_count_is_stated_as_the_product_it_is() {
+        let e = check_runs("d.toml: [[factors]]", &[2; 40], 0, 1)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("2^40 = 1.100e12 runs (40 factors of 2 levels, 1 replicate)"),
+            "{e}"
+        );
+        let e = check_runs("d.toml", &[2, 2, 3], 0, usize::MAX)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("2^2 x 3 x 18446744073709551615 replicates = 2.214e20 runs")
+                && e.contains("2 factors of 2 levels, 1 factor of 3 levels"),
+            "{e}"
+        );
+        assert!(!e.contains("18446744073709551615 runs"), "{e}");
+    }
 
     #[test]
     fn every_absurd_count_is_refused_with_its_estimate() {

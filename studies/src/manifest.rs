@@ -303,6 +303,15 @@ impl Manifest {
                     }
                 }
             }
+            if let Ok(law) = m.law_text().parse::<palpate_material::Law>() {
+                let fixed: Vec<(String, f64)> =
+                    m.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect();
+                crate::checks::check_fixed(
+                    &law,
+                    &fixed,
+                    &format!("{where_}: models.{name}.fixed:"),
+                )?;
+            }
         }
         for (i, step) in self.steps.iter().enumerate() {
             match step {

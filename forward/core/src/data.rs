@@ -29,11 +29,12 @@ impl Column {
 #[derive(Debug, Error)]
 #[non_exhaustive]
 pub enum DataError {
-    #[error("{file}: cannot read: {source}")]
+    // The I/O error is in the message, not a `source`: a report that prints
+    // the chain of causes would otherwise say it twice.
+    #[error("{file}: cannot read: {error}")]
     Io {
         file: PathBuf,
-        #[source]
-        source: std::io::Error,
+        error: std::io::Error,
     },
     #[error(
         "{file}: no header line (expected column names such as `time_s,displacement_mm,force_N`)"
@@ -114,9 +115,9 @@ impl TextTable {
     /// Reads a file.
     pub fn read(path: impl AsRef<Path>) -> Result<TextTable, DataError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| DataError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         })?;
         TextTable::parse(path, &text)
     }
@@ -202,9 +203,9 @@ impl Table {
     /// Reads and checks a file.
     pub fn read(path: impl AsRef<Path>) -> Result<Table, DataError> {
         let path = path.as_ref();
-        let text = std::fs::read_to_string(path).map_err(|source| DataError::Io {
+        let text = std::fs::read_to_string(path).map_err(|error| DataError::Io {
             file: path.to_path_buf(),
-            source,
+            error,
         })?;
         Table::parse(path, &text)
     }

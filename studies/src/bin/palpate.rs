@@ -2,10 +2,10 @@
 //! readable messages with their causes (never a panic on user input).
 
 use clap::Parser;
-use palpate_studies::cli::{dispatch, Cli};
+use palpate_studies::cli::{dispatch, join_negative_values, Cli};
 
 fn main() -> std::process::ExitCode {
-    let cli = Cli::parse();
+    let cli = Cli::parse_from(join_negative_values(std::env::args_os()));
     match dispatch(cli) {
         Ok(()) => std::process::ExitCode::SUCCESS,
         Err(e) => {

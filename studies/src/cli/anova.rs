@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', required = true)]
     pub factors: Vec<String>,
     /// Highest interaction order in the model (default: all).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
     pub max_order: Option<usize>,
     /// Significance level of the Pareto reference line and Lenth's margins.
     #[arg(long, default_value_t = 0.05)]

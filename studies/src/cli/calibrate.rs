@@ -94,7 +94,8 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
                 let (test, path) = split_pair(
                     d,
                     "TEST=FILE, e.g. uniaxial=data.csv (or use --benchmark C1 --data FILE)",
-                )?;
+                )
+                .map_err(|e| anyhow::anyhow!("--data {e}"))?;
                 let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
                 out.push(TestData::read(test, kind, std::path::Path::new(path))?);
             }
@@ -116,7 +117,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let method = parse_method(&args.estimator).context("--estimator")?;
     let mut fixed = Vec::new();
     for f in &args.fix {
-        let (name, value) = split_pair(f, "NAME=VALUE, e.g. C01=0")?;
+        let (name, value) =
+            split_pair(f, "NAME=VALUE, e.g. C01=0").map_err(|e| anyhow::anyhow!("--fix {e}"))?;
         let v: f64 = value
             .parse()
             .ok()
@@ -127,6 +129,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         fixed.push((name.to_string(), v));
     }
+    crate::checks::check_fixed(&law, &fixed, "--fix")?;
     let data = read_data(&args.data, args.benchmark.as_deref())?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);

@@ -50,7 +50,7 @@ pub struct Args {
     #[arg(long, default_value_t = GapOptions::default().alpha)]
     pub alpha: f64,
     /// Contiguous blocks for the blocked cross-validation.
-    #[arg(long, default_value_t = GapOptions::default().folds)]
+    #[arg(long, default_value_t = GapOptions::default().folds, value_parser = crate::limits::parse_count::<usize>)]
     pub folds: usize,
     /// Write the diagnosis as JSON (GAP.md contract).
     #[arg(long, value_name = "OUT.json")]
@@ -72,10 +72,14 @@ pub fn diagnose_file(
 ) -> anyhow::Result<GapReport> {
     let law: Law = base
         .parse()
-        .map_err(|e| anyhow::anyhow!("base law `{base}`: {e}"))?;
-    let spec = TestKind::parse(benchmark)
-        .and_then(|test| gap_base(test, law))
-        .with_context(|| format!("--benchmark {benchmark}"))?;
+        .map_err(|e| anyhow::anyhow!("--base {base}: {e}"))?;
+    let test = match TestKind::parse(benchmark) {
+        Ok(t @ (TestKind::C1 | TestKind::N1)) => t,
+        _ => anyhow::bail!(
+            "--benchmark {benchmark}: the gap diagnosis takes a C1 or N1 record; expected C1 or N1"
+        ),
+    };
+    let spec = gap_base(test, law).with_context(|| format!("--benchmark {benchmark}"))?;
     let model = build(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
     // C1 and N1 records share the columns displacement_mm, force_N[, time_s].
     let record = TestData::read("record", TestKind::C1, data)?;
@@ -101,6 +105,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if !args.effects.is_empty() {
         options.effects = Some(parse_effects(&args.effects).context("--effects")?);
     }
+    // The options are checked before the record is read, by their names.
+    options.validate().map_err(|e| match e {
+        palpate_uq::gap::GapError::InvalidOption { option, reason } => {
+            anyhow::anyhow!("--{option} {reason}")
+        }
+        e => anyhow::anyhow!("{e}"),
+    })?;
     crate::output::check_outputs(
         &[&args.data],
         &crate::output::given(&[

@@ -217,6 +217,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(out) = &args.out {
         check_out(out, &args.manifest, &manifest, &base_dir)?;
     }
+    // Every input of the response (its fields, its data, each run's model)
+    // is checked before anything is written or run; errors name the manifest.
+    let plan = match &manifest.response {
+        Some(ResponseSpec::Calibration(c)) => {
+            Some(prepare_calibrations(&design, c, &base_dir).map(Plan::Calibration))
+        }
+        Some(ResponseSpec::Simulation(s)) => {
+            Some(prepare_simulations(&design, s, &base_dir).map(Plan::Simulation))
+        }
+        None => None,
+    }
+    .transpose()
+    .map_err(|e| anyhow::anyhow!("{m}: {e:#}"))?;
     println!("{}", describe(&design));
     if let Some(out) = &args.out {
         // The design alone first, so it is there even if a run fails.
@@ -225,11 +238,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             design_csv(&design, "", None).as_bytes(),
         )?;
     }
-    // Errors of the response (its fields, its data, a run) name the manifest.
-    let response = match &manifest.response {
-        Some(ResponseSpec::Calibration(c)) => Some(run_calibrations(&design, c, &base_dir)),
-        Some(ResponseSpec::Simulation(s)) => Some(run_simulations(&design, s, &base_dir)),
-        None => None,
+    let response = match (&manifest.response, plan) {
+        (Some(ResponseSpec::Calibration(c)), Some(Plan::Calibration(sets))) => {
+            Some(run_calibrations(&design, c, &sets))
+        }
+        (Some(ResponseSpec::Simulation(s)), Some(Plan::Simulation(plan))) => {
+            Some(run_simulations(&design, s, plan))
+        }
+        _ => None,
     }
     .transpose()
     .map_err(|e| anyhow::anyhow!("{m}: {e:#}"))?;
@@ -375,13 +391,18 @@ fn design_csv(d: &Design, metric: &str, y: Option<&[f64]>) -> String {
     s
 }
 
-/// One calibration per run, in parallel (each run is independent; results
-/// do not depend on the thread count). Returns the metric per run.
-fn run_calibrations(
+/// What a response needs, checked and read before any run.
+enum Plan {
+    Calibration(BTreeMap<String, TestData>),
+    Simulation(SimulationPlan),
+}
+
+/// Checks a calibration response (factors, metric) and reads its data sets.
+fn prepare_calibrations(
     d: &Design,
     spec: &CalibrationResponse,
     base: &Path,
-) -> anyhow::Result<Vec<f64>> {
+) -> anyhow::Result<BTreeMap<String, TestData>> {
     for f in &d.factors {
         if FE_FACTORS.contains(&f.name.as_str()) {
             anyhow::bail!("factor `{}` needs a finite-element response: use [response.simulation] (benchmark N1)", f.name);
@@ -406,6 +427,16 @@ fn run_calibrations(
             TestData::read(set, test, &base.join(file))?,
         );
     }
+    Ok(sets)
+}
+
+/// One calibration per run, in parallel (each run is independent; results
+/// do not depend on the thread count). Returns the metric per run.
+fn run_calibrations(
+    d: &Design,
+    spec: &CalibrationResponse,
+    sets: &BTreeMap<String, TestData>,
+) -> anyhow::Result<Vec<f64>> {
     let setting = |run: &palpate_uq::doe::Run, factor: &str| -> Option<String> {
         d.factors
             .iter()
@@ -464,9 +495,21 @@ fn run_calibrations(
         .collect()
 }
 
-/// One N1 simulation per run (in parallel over runs; each run's numbers do
-/// not depend on the thread count), scored against the reference curve.
-fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow::Result<Vec<f64>> {
+/// Every run's N1 model with its parameters, the reference loading and the
+/// reference forces it is scored against.
+struct SimulationPlan {
+    models: Vec<(Box<dyn palpate_core::ForwardModel>, Vec<f64>)>,
+    loading: palpate_core::Loading,
+    y: Vec<f64>,
+}
+
+/// Checks an N1 simulation response, reads its reference and builds (and
+/// checks) every run's model.
+fn prepare_simulations(
+    d: &Design,
+    spec: &SimulationResponse,
+    base: &Path,
+) -> anyhow::Result<SimulationPlan> {
     use crate::models::{ModelSpec, N1NeedleSpec};
     use palpate_core::{data::Table, Drive, ForwardModel, Loading};
     if !spec.benchmark.eq_ignore_ascii_case("n1") {
@@ -575,6 +618,17 @@ fn run_simulations(d: &Design, spec: &SimulationResponse, base: &Path) -> anyhow
             Ok((model, theta))
         })
         .collect::<anyhow::Result<_>>()?;
+    Ok(SimulationPlan { models, loading, y })
+}
+
+/// One N1 simulation per run (in parallel over runs; each run's numbers do
+/// not depend on the thread count), scored against the reference curve.
+fn run_simulations(
+    d: &Design,
+    spec: &SimulationResponse,
+    plan: SimulationPlan,
+) -> anyhow::Result<Vec<f64>> {
+    let SimulationPlan { models, loading, y } = plan;
     let bar = crate::limits::Progress::new(
         d.runs.len() as u64,
         "N1 runs",

@@ -43,6 +43,36 @@ pub enum Command {
     Run(run::Args),
 }
 
+/// The command line with a negative number after an option joined to it
+/// (`--depth -1e-3` -> `--depth=-1e-3`), so that clap reads it as the
+/// option's value: clap's own test for a negative number takes `-1e-3`,
+/// `-.5` and `-inf` for flags ("unexpected argument '-1'"), and the value's
+/// check then names the option instead.
+pub fn join_negative_values<I: IntoIterator<Item = std::ffi::OsString>>(
+    args: I,
+) -> Vec<std::ffi::OsString> {
+    let mut out: Vec<std::ffi::OsString> = Vec::new();
+    for a in args {
+        let joined = match (out.last().and_then(|p| p.to_str()), a.to_str()) {
+            (Some(opt), Some(value))
+                if opt.starts_with("--")
+                    && opt.len() > 2
+                    && !opt.contains('=')
+                    && value.starts_with('-')
+                    && value.parse::<f64>().is_ok() =>
+            {
+                Some(format!("{opt}={value}"))
+            }
+            _ => None,
+        };
+        match joined {
+            Some(j) => *out.last_mut().expect("an option before") = j.into(),
+            None => out.push(a),
+        }
+    }
+    out
+}
+
 /// Runs the parsed command line.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {

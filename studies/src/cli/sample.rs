@@ -47,16 +47,16 @@ pub struct Args {
     #[arg(long, default_value = "nuts")]
     pub sampler: String,
     /// Stored draws per chain (default: ensemble 2000 per walker, demc 5000, nuts 1000).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
     pub draws: Option<usize>,
     /// Warm-up iterations (default: ensemble 1000, demc 2000, nuts 1000).
-    #[arg(long)]
+    #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
     pub tune: Option<usize>,
     /// Parallel units: NUTS chains (4), ensembles (2) or DE-MCz populations (2).
-    #[arg(long = "parallel")]
+    #[arg(long = "parallel", value_parser = crate::limits::parse_count::<usize>)]
     pub chains: Option<usize>,
     /// Seed of the random streams (results are identical for a seed whatever the thread count).
-    #[arg(long, default_value_t = 0)]
+    #[arg(long, default_value_t = 0, value_parser = crate::limits::parse_count::<u64>)]
     pub seed: u64,
     /// Known noise SD of every data set (observable unit: N or MPa); inferred when absent.
     #[arg(long)]

@@ -127,8 +127,10 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
         bail!("missing --param for {}", missing.join(", "));
     }
     let p: Vec<f64> = values.into_iter().flatten().collect();
+    let shown: Vec<String> = given.iter().map(|g| format!("--param {g}")).collect();
     law.check(&p)
-        .map_err(|e| anyhow!("parameters of {law}: {e}"))?;
+        .map_err(|e| anyhow!("{} ({law}): {e}", shown.join(" ")))?;
+    crate::checks::check_law_values(law, &p, |n, v| format!("--param {n}={v}"))?;
     Ok(p)
 }
 
@@ -292,6 +294,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         "samples",
         256.0,
     )? - 1;
+    crate::checks::check_travel("--depth", depth, &model)?;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
     let time = timed_history(&args, depth, &mut drive)?;
     let loading = match &time {

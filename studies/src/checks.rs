@@ -1,0 +1,236 @@
+//! Physical plausibility of values a user types, checked before any work so
+//! that an absurd value is refused by its option and value, with the valid
+//! range, instead of failing deep in a solver ("element 18446744073709551615:
+//! non-finite stress", "element 646 inverted").
+//!
+//! * A law parameter in MPa lies within `±MAX_MODULUS_MPA` (1 TPa: stiffer
+//!   than diamond, whose Young's modulus is about 1.05 TPa), and the law's
+//!   moduli are not all below `MIN_MODULUS_MPA` (1 Pa; the softest tissues,
+//!   brain and fat, are near 1 kPa = 1e-3 MPa).
+//! * A tool displacement stays inside the body: below the height of the C1
+//!   specimen (the platens would meet), of the N1 and Q1 cylinders and of the
+//!   N3 block (the tool would reach the fixed base).
+
+use crate::limits::fmt_value;
+use crate::models::Model;
+use palpate_material::Law;
+
+/// Largest magnitude of a law parameter in MPa (1 TPa).
+pub const MAX_MODULUS_MPA: f64 = 1e6;
+/// Smallest largest modulus of a law in MPa (1 Pa).
+pub const MIN_MODULUS_MPA: f64 = 1e-6;
+
+/// Checks a law's parameter values (in the law's order). `option` names
+/// where a parameter was given from its name and value as typed, e.g.
+/// `|n, v| format!("--param {n}={v}")`.
+pub fn check_law_values(
+    law: &Law,
+    values: &[f64],
+    option: impl Fn(&str, &str) -> String,
+) -> anyhow::Result<()> {
+    let specs = law.params();
+    let mut largest: f64 = 0.0;
+    for (spec, &v) in specs.iter().zip(values) {
+        if !v.is_finite() {
+            anyhow::bail!(
+                "{}: not a finite number; give a value in {}",
+                option(&spec.name, &fmt_value(v)),
+                spec.unit
+            );
+        }
+        if spec.unit == "MPa" {
+            if v.abs() > MAX_MODULUS_MPA {
+                anyhow::bail!(
+                    "{}: {v:e} MPa is beyond any solid (diamond: about 1e6 MPa; soft tissue: 1e-4 to 1 MPa); \
+                     a parameter in MPa must lie within ±{MAX_MODULUS_MPA:e} (is the unit Pa instead of MPa?)",
+                    option(&spec.name, &fmt_value(v))
+                );
+            }
+            largest = largest.max(v.abs());
+        }
+    }
+    let moduli: Vec<(&str, f64)> = specs
+        .iter()
+        .zip(values)
+        .filter(|(s, _)| s.unit == "MPa")
+        .map(|(s, v)| (s.name.as_str(), *v))
+        .collect();
+    if !moduli.is_empty() && largest < MIN_MODULUS_MPA {
+        let given: Vec<String> = moduli
+            .iter()
+            .map(|(n, v)| option(n, &fmt_value(*v)))
+            .collect();
+        anyhow::bail!(
+            "{}: every modulus of {law} is below {MIN_MODULUS_MPA:e} MPa (1 Pa); nothing solid is that soft \
+             (soft tissue: 1e-4 to 1 MPa; is the unit GPa instead of MPa?)",
+            given.join(" ")
+        );
+    }
+    Ok(())
+}
+
+/// Checks parameters held fixed in a fit (`(name, value)`, as given by
+/// `option`, e.g. `--fix`): each is a parameter of the law, strictly inside
+/// its bounds (the fit starts there), of a plausible size, and at least one
+/// parameter is left to fit.
+pub fn check_fixed(law: &Law, fixed: &[(String, f64)], option: &str) -> anyhow::Result<()> {
+    let specs = law.params();
+    for (name, v) in fixed {
+        let shown = format!("{option} {name}={}", fmt_value(*v));
+        let Some(spec) = specs.iter().find(|s| &s.name == name) else {
+            let names: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();
+            anyhow::bail!(
+                "{shown}: {law} has no parameter `{name}` (its parameters: {})",
+                names.join(", ")
+            );
+        };
+        if !(v.is_finite() && *v > spec.lower && *v < spec.upper) {
+            anyhow::bail!(
+                "{shown}: {name} must lie strictly inside ({}, {}) {}",
+                fmt_value(spec.lower),
+                fmt_value(spec.upper),
+                spec.unit
+            );
+        }
+        if spec.unit == "MPa" && v.abs() > MAX_MODULUS_MPA {
+            anyhow::bail!(
+                "{shown}: {} MPa is beyond any solid (diamond: about 1e6 MPa); a parameter in MPa must lie within ±{MAX_MODULUS_MPA:e} (is the unit Pa instead of MPa?)",
+                fmt_value(*v)
+            );
+        }
+    }
+    if !specs.is_empty()
+        && specs
+            .iter()
+            .all(|s| fixed.iter().any(|(n, _)| n == &s.name))
+    {
+        let all: Vec<String> = fixed
+            .iter()
+            .map(|(n, v)| format!("{option} {n}={}", fmt_value(*v)))
+            .collect();
+        anyhow::bail!(
+            "{}: every parameter of {law} is fixed; nothing is left to fit (leave at least one free)",
+            all.join(" ")
+        );
+    }
+    Ok(())
+}
+
+/// A body dimension along the tool's travel: (height in mm, what it is).
+pub fn travel_limit(model: &Model) -> Option<(f64, &'static str)> {
+    match model {
+        Model::Homogeneous(_) => None,
+        Model::C1(m) => Some((
+            m.geometry.height_mm,
+            "the C1 specimen is that high: the platens would meet",
+        )),
+        Model::C1Fe(m) => Some((
+            m.height,
+            "the C1 specimen is that high: the platens would meet",
+        )),
+        Model::N1Needle(m) => Some((
+            m.height,
+            "the N1 cylinder is that high: the tool would reach its base",
+        )),
+        Model::Q1(m) => Some((
+            m.height,
+            "the Q1 cylinder is that high: the punch would reach its base",
+        )),
+        Model::N3Needle(m) => Some((
+            m.size[2],
+            "the N3 block is that high: the needle would reach its base",
+        )),
+    }
+}
+
+/// Checks a tool displacement (mm) against the body: `option` names it.
+pub fn check_travel(option: &str, depth: f64, model: &Model) -> anyhow::Result<()> {
+    if let Some((h, what)) = travel_limit(model) {
+        if depth >= h {
+            anyhow::bail!(
+                "{option} {}: the tool cannot travel that far into a body {h} mm high ({what}); \
+                 give a displacement below {h} mm",
+                fmt_value(depth)
+            );
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn opt(n: &str, v: &str) -> String {
+        format!("--param {n}={v}")
+    }
+
+    #[test]
+    fn absurd_moduli_are_named_with_the_valid_range() {
+        let nh: Law = "neo-hookean".parse().unwrap();
+        check_law_values(&nh, &[1.1e-3], opt).unwrap();
+        let e = check_law_values(&nh, &[1e300], opt)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("--param C10=1e300") && e.contains("1e6"),
+            "{e}"
+        );
+        let e = check_law_values(&nh, &[1e-300], opt)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("--param C10=1e-300") && e.contains("1e-6"),
+            "{e}"
+        );
+        let e = check_law_values(&nh, &[f64::NAN], opt)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("finite"), "{e}");
+        // Mooney-Rivlin with C01 = 0 is fine: the largest modulus counts.
+        let mr: Law = "mooney-rivlin".parse().unwrap();
+        check_law_values(&mr, &[1e-3, 0.0], opt).unwrap();
+    }
+
+    #[test]
+    fn fixed_parameters_are_checked_by_name_bounds_and_size() {
+        let mr: Law = "mooney-rivlin".parse().unwrap();
+        check_fixed(&mr, &[("C01".into(), 0.0)], "--fix").unwrap();
+        for (fixed, needle) in [
+            (vec![("C11".to_string(), 0.0)], "no parameter `C11`"),
+            (vec![("C01".to_string(), 1e300)], "--fix C01=1e300"),
+            (
+                vec![("C10".to_string(), 1e-3), ("C01".to_string(), 0.0)],
+                "nothing is left to fit",
+            ),
+        ] {
+            let e = check_fixed(&mr, &fixed, "--fix").unwrap_err().to_string();
+            assert!(e.starts_with("--fix ") && e.contains(needle), "{e}");
+        }
+        let nh: Law = "neo-hookean".parse().unwrap();
+        let e = check_fixed(&nh, &[("C10".into(), -1.0)], "--fix")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("--fix C10=-1") && e.contains("strictly inside (0, inf)"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn a_displacement_through_the_body_is_refused() {
+        let spec = crate::models::ModelSpec::C1Fe(crate::models::C1FeSpec {
+            law: "neo-hookean".into(),
+            ..Default::default()
+        });
+        let model = spec.validate().unwrap();
+        check_travel("--depth", 8.0, &model).unwrap();
+        let e = check_travel("--depth", 20.0, &model)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("--depth 20") && e.contains("below 9 mm"),
+            "{e}"
+        );
+    }
+}
