@@ -205,7 +205,12 @@ pub fn check_writable(option: &str, path: &Path, dir: bool) -> anyhow::Result<()
                 "{option} {shown}: {} is a file, not a directory, so nothing can be written under it",
                 at.display()
             ),
-            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::NotFound | std::io::ErrorKind::NotADirectory
+                ) =>
+            {
                 at = parent_of(at);
                 if at == Path::new(".") && !at.exists() {
                     break;

@@ -141,11 +141,11 @@ pub fn run_study_with(
 
     let mut data = BTreeMap::new();
     for (name, spec) in &manifest.data {
-        let kind = TestKind::parse(&spec.test).with_context(|| format!("data.{name}.test"))?;
-        data.insert(
-            name.clone(),
-            TestData::read(name, kind, &dir.join(&spec.file))?,
-        );
+        let kind = TestKind::parse(&spec.test)
+            .map_err(|e| anyhow::anyhow!("{}: data.{name}.test: {e}", path.display()))?;
+        let d = TestData::read(name, kind, &dir.join(&spec.file))
+            .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
+        data.insert(name.clone(), d);
     }
     let inputs: Vec<PathBuf> = std::iter::once(path.to_path_buf())
         .chain(manifest.data.values().map(|d| dir.join(&d.file)))

@@ -1,0 +1,510 @@
+//! Bad input, continued (issue 16, items 5 and 6): every refusal names the
+//! input (the option and its value, the manifest and its field, or
+//! file:line) and says what would be valid; values that would fail deep in a
+//! solver are refused before any work; an unwritable output is refused
+//! before anything is computed or written. Each case asserts a non-zero
+//! exit, no panic and the locator.
+
+mod common;
+use common::*;
+use std::process::Output;
+
+const UNI: &str = "stretch,stress_MPa\n1.0,0\n1.5,0.2\n2.0,0.35\n3.0,0.6\n";
+
+fn simulate(s: &Scratch, benchmark: &str, extra: &[&str]) -> Output {
+    let mut a = vec![
+        "simulate",
+        "--benchmark",
+        benchmark,
+        "--law",
+        "neo-hookean",
+        "--error-estimate",
+        "off",
+    ];
+    a.extend_from_slice(extra);
+    s.run(&a)
+}
+
+// ---------- values a solver cannot take ----------
+
+#[test]
+fn absurd_or_vanishing_moduli_are_refused_by_the_option() {
+    let s = Scratch::new();
+    for (value, needle) in [
+        ("1e300", "within ±1e6"),
+        ("1e7", "within ±1e6"),
+        ("1e-300", "below 1e-6 MPa"),
+        ("1e-12", "below 1e-6 MPa"),
+        ("inf", "not finite"),
+        ("NaN", "not finite"),
+        ("-1", "must be > 0"),
+        ("0", "must be > 0"),
+    ] {
+        let p = format!("C10={value}");
+        let o = simulate(&s, "C1", &["--param", &p]);
+        refused(&o, &["--param C10=", needle]);
+        assert!(
+            !String::from_utf8_lossy(&o.stderr).contains("18446744073709551615"),
+            "the sentinel element index leaked"
+        );
+    }
+    // A fixed parameter in a fit: by name, bounds and size.
+    let u = format!("uniaxial={}", treloar("uniaxial.csv"));
+    for (law, fix, needle) in [
+        ("neo-hookean", "C10=1e300", "within ±1e6"),
+        ("mooney-rivlin", "C01=1e300", "within ±1e6"),
+        ("neo-hookean", "C10=-1", "strictly inside (0, inf)"),
+        ("neo-hookean", "C11=0", "no parameter `C11`"),
+        ("neo-hookean", "C10=0.001", "nothing is left to fit"),
+        ("neo-hookean", "C10", "expected NAME=VALUE"),
+        ("neo-hookean", "C10=abc", "not a finite number"),
+    ] {
+        let o = s.run(&["calibrate", "--law", law, "--data", &u, "--fix", fix]);
+        refused(&o, &["--fix ", needle]);
+    }
+}
+
+#[test]
+fn a_tool_travelling_through_the_body_is_refused_before_solving() {
+    let s = Scratch::new();
+    for (benchmark, depth, height) in [
+        ("C1", "9", "9 mm"),
+        ("C1", "20", "9 mm"),
+        ("C1", "1000", "9 mm"),
+        ("N1", "80", "80 mm"),
+        ("N1", "85", "80 mm"),
+        ("Q1", "60", "60 mm"),
+        ("Q1", "100", "60 mm"),
+        ("N3", "80", "80 mm"),
+    ] {
+        let o = simulate(
+            &s,
+            benchmark,
+            &["--param", "C10=0.0011", "--depth", depth, "--step", "1"],
+        );
+        refused(&o, &[&format!("--depth {depth}"), height, "below"]);
+        assert!(
+            !String::from_utf8_lossy(&o.stderr).contains("inverted"),
+            "blamed on an element"
+        );
+    }
+}
+
+// ---------- how the command line is read ----------
+
+#[test]
+fn negative_numbers_of_every_spelling_are_values_of_their_option() {
+    let s = Scratch::new();
+    for depth in ["-1", "-1e-3", "-.5", "-inf", "-1E2"] {
+        let o = simulate(&s, "C1", &["--param", "C10=0.0011", "--depth", depth]);
+        refused(&o, &["--depth", "must be positive"]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !e.contains("unexpected argument"),
+            "{depth} read as a flag: {e}"
+        );
+    }
+    let u = format!("uniaxial={}", treloar("uniaxial.csv"));
+    for sigma in ["-1e-3", "-0.5", "-inf"] {
+        let o = s.run(&[
+            "sample",
+            "--law",
+            "neo-hookean",
+            "--data",
+            &u,
+            "--sigma",
+            sigma,
+        ]);
+        refused(&o, &["--sigma", "positive"]);
+    }
+    let o = simulate(&s, "N1", &["--param", "C10=0.0011", "--friction", "-1e-2"]);
+    refused(&o, &["--friction", "-0.01", ">= 0"]);
+    // A missing value is still a missing value, not the next option.
+    let o = simulate(
+        &s,
+        "C1",
+        &["--param", "C10=0.0011", "--depth", "--csv", "x.csv"],
+    );
+    refused(&o, &["--depth", "value is required"]);
+}
+
+#[test]
+fn counts_say_what_a_valid_count_is() {
+    let s = Scratch::new();
+    let u = format!("uniaxial={}", treloar("uniaxial.csv"));
+    for (flag, value, needle) in [
+        ("--seed", "-1", "cannot be negative"),
+        ("--draws", "-5", "cannot be negative"),
+        ("--draws", "2.5", "whole number"),
+        ("--draws", "ten", "not a number"),
+        ("--tune", "1e30", "too large"),
+        ("--parallel", "-2", "cannot be negative"),
+    ] {
+        let o = s.run(&["sample", "--law", "neo-hookean", "--data", &u, flag, value]);
+        refused(&o, &[flag, value, needle]);
+    }
+    let t = s.file("runs.csv", "a,b,y\nx,p,1\nz,p,2\nx,q,3\nz,q,5\n");
+    let o = s.run(&[
+        "anova",
+        "--data",
+        &t,
+        "--response",
+        "y",
+        "--factors",
+        "a,b",
+        "--max-order",
+        "-1",
+    ]);
+    refused(&o, &["--max-order", "-1", "cannot be negative"]);
+}
+
+#[test]
+fn diagnose_options_are_checked_by_name_before_the_record_is_read() {
+    let s = Scratch::new();
+    // A record that is not even a force record: the options are refused first.
+    let u = treloar("uniaxial.csv");
+    for (args, needle) in [
+        (vec!["--alpha", "-0.1"], "--alpha -0.1 must lie in (0, 0.5)"),
+        (vec!["--alpha", "2"], "--alpha 2 must lie in (0, 0.5)"),
+        (vec!["--folds", "0"], "--folds 0 must lie in [2, 20]"),
+        (
+            vec!["--folds", "1e6"],
+            "--folds 1000000 must lie in [2, 20]",
+        ),
+        (vec!["--folds", "-3"], "cannot be negative"),
+    ] {
+        let mut a = vec!["diagnose", "--data", &u];
+        a.extend(args);
+        refused(&s.run(&a), &[needle]);
+    }
+    let c1 = s.file(
+        "c1.csv",
+        "displacement_mm,force_N\n0,0\n0.5,1\n1,2.1\n1.5,3.3\n2,4.6\n",
+    );
+    for (args, needle) in [
+        (vec!["--benchmark", "Q1"], "--benchmark Q1"),
+        (vec!["--benchmark", "uniaxial"], "expected C1 or N1"),
+        (vec!["--base", "ogden:100"], "--base ogden:100"),
+        (vec!["--base", "hooke"], "--base hooke"),
+    ] {
+        let mut a = vec!["diagnose", "--data", &c1];
+        a.extend(args);
+        refused(&s.run(&a), &[needle]);
+    }
+}
+
+#[test]
+fn a_data_option_without_its_test_names_the_option() {
+    let s = Scratch::new();
+    let f = s.file("d.csv", UNI);
+    let o = s.run(&["calibrate", "--law", "neo-hookean", "--data", &f]);
+    refused(&o, &["--data ", "expected TEST=FILE"]);
+    let o = s.run(&["calibrate", "--law", "neo-hookean", "--data", "uniaxial="]);
+    refused(&o, &["--data ", "expected TEST=FILE"]);
+    // A missing file: its path, and the reason once.
+    let o = s.run(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        "uniaxial=nope.csv",
+    ]);
+    refused(&o, &["nope.csv", "cannot read"]);
+    let e = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(e.matches("No such file").count(), 1, "{e}");
+}
+
+// ---------- designs ----------
+
+#[test]
+fn design_sizes_are_stated_as_the_product_they_are() {
+    let s = Scratch::new();
+    let factors = |n: usize| {
+        (0..n)
+            .map(|k| format!("[[factors]]\nname = \"f{k}\"\nlevels = [\"a\", \"b\"]\n"))
+            .collect::<String>()
+    };
+    let m = s.file("forty.toml", &factors(40));
+    let o = s.run(&["doe", "--manifest", &m]);
+    refused(
+        &o,
+        &[
+            "forty.toml",
+            "2^40 = 1.100e12 runs",
+            "40 factors of 2 levels",
+        ],
+    );
+    let m = s.file("seventy.toml", &factors(70));
+    let o = s.run(&["doe", "--manifest", &m]);
+    refused(&o, &["seventy.toml", "2^70", "70 factors of 2 levels"]);
+    assert!(
+        String::from_utf8_lossy(&o.stderr).len() < 400,
+        "a list of 70 factors"
+    );
+    let m = s.file(
+        "reps.toml",
+        &format!(
+            "[design]\nreplicates = 18446744073709551615\n{}",
+            factors(3)
+        ),
+    );
+    let o = s.run(&["doe", "--manifest", &m]);
+    refused(
+        &o,
+        &["reps.toml", "2^3 x 18446744073709551615 replicates = "],
+    );
+    assert!(!String::from_utf8_lossy(&o.stderr).contains("18446744073709551615 runs"));
+}
+
+#[test]
+fn doe_response_errors_name_the_manifest_and_write_nothing() {
+    let s = Scratch::new();
+    s.file("u.csv", UNI);
+    let two = "[[factors]]\nname = \"law\"\nlevels = [\"neo-hookean\", \"yeoh\"]\n";
+    for (name, response, needle) in [
+        (
+            "metric.toml",
+            "[response.calibration]\nmetric = \"r3\"\ndata = { uniaxial = \"u.csv\" }\n",
+            "response.calibration.metric",
+        ),
+        (
+            "missing.toml",
+            "[response.calibration]\nmetric = \"r2\"\ndata = { uniaxial = \"nope.csv\" }\n",
+            "nope.csv",
+        ),
+        (
+            "mode.toml",
+            "[response.calibration]\nmetric = \"r2\"\ndata = { \"u:sideways\" = \"u.csv\" }\n",
+            "sideways",
+        ),
+        (
+            "bench.toml",
+            "[response.simulation]\nbenchmark = \"N9\"\nmetric = \"r2\"\nreference = \"u.csv\"\n",
+            "benchmark",
+        ),
+        (
+            "depth.toml",
+            "[response.simulation]\nbenchmark = \"N1\"\nmetric = \"r2\"\nreference = \"u.csv\"\nmax_depth_mm = -1\n",
+            "max_depth_mm = -1",
+        ),
+    ] {
+        let m = s.file(name, &format!("{two}{response}"));
+        let out = s.path(&format!("out-{name}"));
+        let o = s.run(&["doe", "--manifest", &m, "--out", out.to_str().unwrap()]);
+        refused(&o, &[name, needle]);
+        assert!(!out.exists(), "{name}: wrote {out:?} before refusing");
+    }
+}
+
+#[test]
+fn doe_out_is_checked_before_the_design_is_run() {
+    let s = Scratch::new();
+    let two = "[[factors]]\nname = \"a\"\nlevels = [\"x\", \"y\"]\n";
+    let m = s.file("d.toml", two);
+    let blocker = s.file("plain-file", "x");
+    let under = format!("{blocker}/out");
+    let o = s.run(&["doe", "--manifest", &m, "--out", &under]);
+    refused(&o, &["--out", "plain-file", "is a file"]);
+    let o = s.run(&["doe", "--manifest", &m, "--out", &blocker]);
+    refused(&o, &["--out", "is a file"]);
+    assert_eq!(std::fs::read_to_string(&blocker).unwrap(), "x");
+}
+
+// ---------- outputs checked before the work ----------
+
+#[test]
+fn an_unwritable_output_is_refused_before_anything_is_computed_or_written() {
+    let s = Scratch::new();
+    let blocker = s.file("blocker", "keep");
+    let bad_file = format!("{blocker}/x.svg");
+    let json = s.path("first.json");
+    let json = json.to_str().unwrap();
+    let u = format!("uniaxial={}", treloar("uniaxial.csv"));
+
+    let o = s.run(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &u,
+        "--json",
+        json,
+        "--plot",
+        &bad_file,
+    ]);
+    refused(&o, &["--plot", "blocker", "is a file"]);
+    let o = simulate(
+        &s,
+        "C1",
+        &["--param", "C10=0.0011", "--csv", json, "--plot", &bad_file],
+    );
+    refused(&o, &["--plot", "is a file"]);
+    let o = simulate(
+        &s,
+        "C1",
+        &[
+            "--param",
+            "C10=0.0011",
+            "--csv",
+            s.0.path().to_str().unwrap(),
+        ],
+    );
+    refused(&o, &["--csv", "is a directory"]);
+    let o = s.run(&[
+        "sample",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &u,
+        "--json",
+        json,
+        "--plot",
+        &blocker,
+    ]);
+    refused(&o, &["--plot", "is a file", "give a directory"]);
+    let t = s.file("runs.csv", "a,b,y\nx,p,1\nz,p,2\nx,q,3\nz,q,5\n");
+    let o = s.run(&[
+        "anova",
+        "--data",
+        &t,
+        "--response",
+        "y",
+        "--factors",
+        "a,b",
+        "--json",
+        json,
+        "--plot",
+        &blocker,
+    ]);
+    refused(&o, &["--plot", "is a file"]);
+    let c1 = s.file(
+        "c1.csv",
+        "displacement_mm,force_N\n0,0\n0.5,1\n1,2.1\n1.5,3.3\n2,4.6\n",
+    );
+    let o = s.run(&[
+        "diagnose", "--data", &c1, "--json", json, "--report", &bad_file,
+    ]);
+    refused(&o, &["--report", "is a file"]);
+    let o = s.run(&[
+        "diagnose",
+        "--data",
+        &c1,
+        "--json",
+        json,
+        "--plot",
+        s.0.path().to_str().unwrap(),
+    ]);
+    refused(&o, &["--plot", "is a directory"]);
+    assert!(
+        !s.path("first.json").exists(),
+        "an earlier output was written"
+    );
+    assert_eq!(std::fs::read_to_string(&blocker).unwrap(), "keep");
+}
+
+// ---------- study manifests and run folders ----------
+
+fn study(s: &Scratch, name: &str, data_file: &str, model: &str) -> String {
+    s.file(
+        name,
+        &format!(
+            "[study]\nname = \"s\"\n\n[data.u]\nfile = \"{data_file}\"\ntest = \"uniaxial\"\n\n\
+             [models.nh]\n{model}\n\n[[steps]]\n[steps.calibrate]\nname = \"fit\"\n\
+             models = [\"nh\"]\nfits = {{ a = [\"u\"] }}\n"
+        ),
+    )
+}
+
+#[test]
+fn run_check_reads_the_data_files_it_checks() {
+    let s = Scratch::new();
+    for (csv, text, needle) in [
+        ("bad.csv", "stretch,stress_MPa\n1,0\n1.1,abc\n", "bad.csv:3"),
+        ("one.csv", "stretch,stress_MPa\n1,0.1\n", "one.csv:2"),
+        (
+            "zero.csv",
+            "stretch,stress_MPa\n1,0\n2,0\n",
+            "zero on every row",
+        ),
+        ("cols.csv", "displacement_mm,force_N\n0,0\n1,1\n", "stretch"),
+        ("neg.csv", "stretch,stress_MPa\n1,0\n-1,0.1\n", "neg.csv:3"),
+    ] {
+        s.file(csv, text);
+        let m = study(&s, &format!("{csv}.toml"), csv, "law = \"neo-hookean\"");
+        for cmd in [vec!["run", &m, "--check"], vec!["run", &m]] {
+            let o = s.run(&cmd);
+            refused(&o, &[&format!("{csv}.toml"), "data.u", needle]);
+        }
+    }
+    s.file("good.csv", UNI);
+    let m = study(&s, "good.toml", "good.csv", "law = \"neo-hookean\"");
+    let o = s.run(&["run", &m, "--check"]);
+    accepted(&o);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("4 rows"));
+}
+
+#[test]
+fn fixed_values_in_a_manifest_are_checked_by_field() {
+    let s = Scratch::new();
+    s.file("good.csv", UNI);
+    for (model, needle) in [
+        (
+            "law = \"neo-hookean\"\nfixed = { C10 = 1e300 }",
+            "models.nh.fixed: C10=1e300",
+        ),
+        (
+            "law = \"neo-hookean\"\nfixed = { C11 = 1 }",
+            "no parameter `C11`",
+        ),
+        (
+            "law = \"neo-hookean\"\nfixed = { C10 = -1 }",
+            "strictly inside",
+        ),
+        (
+            "law = \"neo-hookean\"\nfixed = { C10 = 0.001 }",
+            "nothing is left to fit",
+        ),
+        (
+            "law = \"mooney-rivlin\"\nfixed = { C01 = -1e9 }",
+            "models.nh.fixed: C01=",
+        ),
+    ] {
+        let m = study(&s, "m.toml", "good.csv", model);
+        refused(&s.run(&["run", &m, "--check"]), &["m.toml", needle]);
+    }
+}
+
+#[test]
+fn a_run_folder_that_is_not_one_is_refused() {
+    let s = Scratch::new();
+    s.file("good.csv", UNI);
+    let m = study(&s, "m.toml", "good.csv", "law = \"neo-hookean\"");
+    // The manifest's own folder (it holds the manifest and the data).
+    refused(
+        &s.run(&["run", &m, "--out", "."]),
+        &["run folder .", "--out"],
+    );
+    // A data file as the folder.
+    refused(
+        &s.run(&["run", &m, "--out", "good.csv"]),
+        &["run folder good.csv"],
+    );
+    // A folder of someone's files.
+    let mine = s.path("mine");
+    std::fs::create_dir(&mine).unwrap();
+    std::fs::write(mine.join("thesis.tex"), "keep").unwrap();
+    refused(
+        &s.run(&["run", &m, "--out", "mine"]),
+        &["run folder mine", "not a palpate run folder"],
+    );
+    assert_eq!(
+        std::fs::read_to_string(mine.join("thesis.tex")).unwrap(),
+        "keep"
+    );
+    // Under a file.
+    refused(
+        &s.run(&["run", &m, "--out", "good.csv/run"]),
+        &["good.csv", "is a file"],
+    );
+    assert_eq!(std::fs::read_to_string(s.path("good.csv")).unwrap(), UNI);
+}
