@@ -61,9 +61,10 @@ pub struct Args {
     pub out: Option<PathBuf>,
 }
 
+/// A design manifest.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct Manifest {
+pub struct Manifest {
     #[serde(default)]
     design: DesignSpec,
     factors: Vec<Factor>,
@@ -168,17 +169,13 @@ fn default_params(law: &Law) -> Option<Vec<(String, f64)>> {
     }
 }
 
-/// Runs `palpate doe`.
-pub fn run(args: Args) -> anyhow::Result<()> {
-    let text = std::fs::read_to_string(&args.manifest)
-        .with_context(|| format!("cannot read {}", args.manifest.display()))?;
-    let manifest: Manifest =
-        toml::from_str(&text).map_err(|e| anyhow::anyhow!("{}: {e}", args.manifest.display()))?;
-    let base_dir = args
-        .manifest
-        .parent()
-        .unwrap_or(Path::new("."))
-        .to_path_buf();
+/// Reads a design manifest's text (named `path` in errors) and builds its
+/// design, checking its size, analysis options and generators before any
+/// allocation; the response is checked later, against its files. The
+/// design-manifest reader of `palpate doe`, also fuzzed (fuzz/).
+pub fn read_design(path: &Path, text: &str) -> anyhow::Result<(Manifest, Design)> {
+    let m = path.display();
+    let manifest: Manifest = toml::from_str(text).map_err(|e| anyhow::anyhow!("{m}: {e}"))?;
     let gens: Vec<&str> = manifest
         .design
         .generators
@@ -186,7 +183,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(String::as_str)
         .collect();
     let levels: Vec<usize> = manifest.factors.iter().map(|f| f.levels.len()).collect();
-    let m = args.manifest.display();
     crate::limits::check_runs(
         &format!(
             "{m}: [[factors]] and design.replicates = {}",
@@ -214,6 +210,20 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Some(seed) = manifest.design.seed {
         design = design.randomised(seed);
     }
+    Ok((manifest, design))
+}
+
+/// Runs `palpate doe`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    let text = std::fs::read_to_string(&args.manifest)
+        .with_context(|| format!("cannot read {}", args.manifest.display()))?;
+    let (manifest, design) = read_design(&args.manifest, &text)?;
+    let base_dir = args
+        .manifest
+        .parent()
+        .unwrap_or(Path::new("."))
+        .to_path_buf();
+    let m = args.manifest.display();
     if let Some(out) = &args.out {
         check_out(out, &args.manifest, &manifest, &base_dir)?;
     }
