@@ -10,6 +10,10 @@
 //! * A tool displacement stays inside the body: below the height of the C1
 //!   specimen (the platens would meet), of the N1 and Q1 cylinders and of the
 //!   N3 block (the tool would reach the fixed base).
+//! * A sphere or punch is not wider than the body under it.
+//! * A viscoelastic history takes at most `MAX_INCREMENTS` time increments.
+//! * Parameters held fixed in a fit are parameters of the law, inside their
+//!   bounds and of a plausible size, and leave something to fit.
 
 use crate::limits::fmt_value;
 use crate::models::Model;
@@ -35,6 +39,16 @@ pub fn check_law_values(
             anyhow::bail!(
                 "{}: not a finite number; give a value in {}",
                 option(&spec.name, &fmt_value(v)),
+                spec.unit
+            );
+        }
+        if v < spec.lower || v > spec.upper {
+            anyhow::bail!(
+                "{}: outside the range of {} in {law}, [{}, {}] {}",
+                option(&spec.name, &fmt_value(v)),
+                spec.name,
+                fmt_value(spec.lower),
+                fmt_value(spec.upper),
                 spec.unit
             );
         }
@@ -111,6 +125,62 @@ pub fn check_fixed(law: &Law, fixed: &[(String, f64)], option: &str) -> anyhow::
         anyhow::bail!(
             "{}: every parameter of {law} is fixed; nothing is left to fit (leave at least one free)",
             all.join(" ")
+        );
+    }
+    Ok(())
+}
+
+/// Most time increments a viscoelastic run may take (each is a Newton solve).
+pub const MAX_INCREMENTS: f64 = 1e5;
+
+/// Checks a viscoelastic history before it is stepped: increments of at
+/// most a tenth of the shortest relaxation time over `duration` seconds
+/// (the ramp and the hold) must stay within [`MAX_INCREMENTS`].
+pub fn check_increments(model: &Model, duration: f64) -> anyhow::Result<()> {
+    let prony = match model {
+        Model::C1Fe(m) => m.prony.as_ref(),
+        Model::Q1(m) => m.prony.as_ref(),
+        _ => None,
+    };
+    let Some(prony) = prony else {
+        return Ok(());
+    };
+    let tau = prony.shortest_time();
+    let steps = duration / (0.1 * tau);
+    if steps.is_nan() || steps > MAX_INCREMENTS {
+        anyhow::bail!(
+            "--prony with --ramp/--hold: the shortest relaxation time {} s is stepped at most {} s at a time, so {} s of history take {:.3e} increments; at most {MAX_INCREMENTS:e} (give a longer relaxation time or a shorter --ramp/--hold)",
+            fmt_value(tau),
+            fmt_value(0.1 * tau),
+            fmt_value(duration),
+            steps.ceil()
+        );
+    }
+    Ok(())
+}
+
+/// Checks the size of a rigid tool against the body under it: a sphere or
+/// punch wider than the body (whose radius, or half-width for N3, it would
+/// overhang) is refused; `option` names where the tool was given.
+pub fn check_tool(option: &str, model: &Model) -> anyhow::Result<()> {
+    use palpate_fe::tool::ToolShape;
+    let (tool, body, what) = match model {
+        Model::N1Needle(m) => (m.tool, m.radius, "the N1 cylinder's radius"),
+        Model::N3Needle(m) => (
+            m.tool,
+            m.size[0].min(m.size[1]),
+            "the N3 block's half-width",
+        ),
+        _ => return Ok(()),
+    };
+    let radius = match tool {
+        ToolShape::Sphere { radius } | ToolShape::FlatPunch { radius, .. } => radius,
+        _ => return Ok(()),
+    };
+    if radius > body {
+        anyhow::bail!(
+            "{option}: a tool of radius {} mm overhangs the body ({what} is {body} mm); give a radius up to {body} mm, or `platen` for a plate wider than the body",
+            fmt_value(radius)
         );
     }
     Ok(())

@@ -509,12 +509,14 @@ fn parse_bulk(kind: &'static str, s: Option<&str>) -> Result<Bulk, ModelError> {
         return Ok(Bulk::Exact);
     }
     match s.parse::<f64>() {
-        Ok(r) if r > 0.0 && r.is_finite() => Ok(Bulk::Ratio(r)),
+        // Above 1e9 (Poisson's ratio 0.4999999995) the penalty swamps the
+        // shear stiffness and the stresses overflow: use `exact`.
+        Ok(r) if r > 0.0 && r <= 1e9 => Ok(Bulk::Ratio(r)),
         _ => Err(ModelError::new(
             kind,
             "bulk",
             s,
-            "expected `exact` or a positive ratio K/mu such as 1000",
+            "expected `exact` or a ratio K/mu in (0, 1e9] such as 1000",
         )),
     }
 }

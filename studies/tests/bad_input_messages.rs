@@ -90,6 +90,72 @@ fn a_tool_travelling_through_the_body_is_refused_before_solving() {
     }
 }
 
+#[test]
+fn settings_that_would_hang_or_overflow_a_solver_are_refused() {
+    let s = Scratch::new();
+    let c10 = ["--param", "C10=0.0011"];
+    for (bench, extra, needles) in [
+        (
+            "N1",
+            vec!["--tool", "sphere:1e9"],
+            vec!["--tool sphere:1e9", "up to 35 mm"],
+        ),
+        (
+            "N1",
+            vec!["--tool", "punch:40"],
+            vec!["--tool punch:40", "overhangs"],
+        ),
+        (
+            "N3",
+            vec!["--tool", "sphere:100"],
+            vec!["--tool sphere:100", "half-width"],
+        ),
+        (
+            "C1",
+            vec!["--prony", "g1=0.5,tau1=1e-300"],
+            vec!["--prony", "increments", "at most 1e5"],
+        ),
+        (
+            "C1",
+            vec!["--prony", "g1=0.5,tau1=1", "--hold", "1e300"],
+            vec!["--hold", "1e300 s of history"],
+        ),
+        (
+            "Q1",
+            vec!["--prony", "g1=0.5,tau1=1e-6", "--depth", "0.1"],
+            vec!["--prony", "60.5 s of history take 6.050e8 increments"],
+        ),
+        (
+            "C1",
+            vec!["--bulk", "1e300"],
+            vec!["--bulk `1e300`", "(0, 1e9]"],
+        ),
+        (
+            "C1",
+            vec!["--bulk", "1e10"],
+            vec!["--bulk `1e10`", "(0, 1e9]"],
+        ),
+    ] {
+        let mut a: Vec<&str> = c10.to_vec();
+        a.extend(extra);
+        refused(&simulate(&s, bench, &a), &needles);
+    }
+    let o = s.run(&[
+        "simulate",
+        "--benchmark",
+        "C1",
+        "--law",
+        "ogden:1",
+        "--param",
+        "mu1=0.001",
+        "--param",
+        "alpha1=1e300",
+        "--error-estimate",
+        "off",
+    ]);
+    refused(&o, &["--param alpha1=1e300", "[-20, 20]"]);
+}
+
 // ---------- how the command line is read ----------
 
 #[test]

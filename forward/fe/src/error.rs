@@ -29,8 +29,10 @@ pub enum FeError {
     /// An element turned inside out (det F <= 0 at a quadrature point).
     #[error("element {element} inverted (det F = {det_f:.3e})")]
     InvertedElement { element: usize, det_f: f64 },
-    /// The material law returned a non-finite stress.
-    #[error("element {element}: non-finite stress")]
+    /// The material law returned a non-finite stress (`element` is
+    /// `usize::MAX` when the residual as a whole overflowed and no single
+    /// element is to blame).
+    #[error("{}", non_finite_message(*element))]
     NonFiniteStress { element: usize },
     /// The sparse factorisation failed (singular tangent).
     #[error("sparse LU failed: {reason}")]
@@ -57,5 +59,34 @@ impl FeError {
                 | FeError::Factorisation { .. }
                 | FeError::NewtonFailed { .. }
         )
+    }
+}
+
+/// The message of [`FeError::NonFiniteStress`]: the element, or the whole
+/// residual when no element is known (never the `usize::MAX` sentinel).
+fn non_finite_message(element: usize) -> String {
+    if element == usize::MAX {
+        "non-finite residual: the stresses or contact forces overflowed (are the material parameters or the tool displacement far outside their usual range?)".into()
+    } else {
+        format!("element {element}: non-finite stress")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn an_overflow_without_an_element_does_not_name_the_sentinel() {
+        let e = FeError::NonFiniteStress {
+            element: usize::MAX,
+        }
+        .to_string();
+        assert!(
+            !e.contains(&usize::MAX.to_string()) && e.contains("non-finite"),
+            "{e}"
+        );
+        let e = FeError::NonFiniteStress { element: 7 }.to_string();
+        assert_eq!(e, "element 7: non-finite stress");
     }
 }

@@ -55,8 +55,7 @@ pub struct Args {
     /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1, depth/100 for Q1).
     #[arg(long)]
     pub step: Option<f64>,
-    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch) [default: medium].
-    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; N3: hexahedra of 0.8/N mm, levels 1..2, default coarse) [default: medium].
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch; N3: hexahedra of 0.8/N mm, levels 1..2) [default: medium; N3: coarse].
     #[arg(long)]
     pub mesh: Option<String>,
     /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
@@ -295,8 +294,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         256.0,
     )? - 1;
     crate::checks::check_travel("--depth", depth, &model)?;
+    crate::checks::check_tool(
+        &format!("--tool {}", args.tool.as_deref().unwrap_or("needle")),
+        &model,
+    )?;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
     let time = timed_history(&args, depth, &mut drive)?;
+    if let Some(end) = time.as_ref().and_then(|t| t.last()) {
+        crate::checks::check_increments(&model, *end)?;
+    }
     let loading = match &time {
         Some(t) => Loading::timed(Drive::DisplacementMm, t.clone(), drive.clone()),
         None => Loading::quasi_static(Drive::DisplacementMm, drive.clone()),
