@@ -4,6 +4,7 @@
 //! SVG plots, VTK output wiring, and the `palpate` command-line tool (one
 //! module per subcommand under [`cli`]).
 
+pub mod anova_step;
 pub mod calibration;
 pub mod checks;
 pub mod cli;
@@ -12,6 +13,7 @@ pub mod manifest;
 pub mod models;
 pub mod output;
 pub mod plot;
+pub mod predict_step;
 pub mod provenance;
 pub mod report;
 pub mod run_folder;

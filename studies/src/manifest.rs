@@ -4,7 +4,9 @@
 //! error with its line, reported by the TOML parser), then [`Manifest::validate`]
 //! checks every cross-reference and file and names the offending field.
 //! Steps are an externally tagged enum, so each `[[steps]]` table holds exactly
-//! one of `calibrate`, `diagnose`, `sample`, `anova` or `simulate`.
+//! one of `calibrate`, `diagnose`, `predict` ([`PredictStep`]: models run with
+//! a calibrate step's parameters against records) or `anova` ([`AnovaStep`]:
+//! a factorial analysis of a predict step's comparisons).
 //!
 //! ```toml
 //! [study]
@@ -184,7 +186,12 @@ impl ModelEntry {
 pub enum Step {
     Calibrate(CalibrateStep),
     Diagnose(DiagnoseStep),
+    Predict(PredictStep),
+    Anova(AnovaStep),
 }
+
+pub use crate::anova_step::AnovaStep;
+pub use crate::predict_step::PredictStep;
 
 /// Fit every model to every group of data sets, with every residual kind.
 #[derive(Debug, Clone, Deserialize)]
@@ -265,10 +272,7 @@ impl Manifest {
             "{where_}: steps: no steps; give at least one [[steps]] table"
         );
         for (i, step) in self.steps.iter().enumerate() {
-            let (kind, name) = match step {
-                Step::Calibrate(c) => ("calibrate", &c.name),
-                Step::Diagnose(d) => ("diagnose", &d.name),
-            };
+            let (kind, name) = (step.kind(), step.name());
             check_file_name(name)
                 .map_err(|e| anyhow::anyhow!("{where_}: steps[{i}].{kind}.name = {name:?}: {e}"))?;
             if let Some(j) = self.steps[..i].iter().position(|s| s.name() == name) {
@@ -315,6 +319,8 @@ impl Manifest {
         }
         for (i, step) in self.steps.iter().enumerate() {
             match step {
+                Step::Predict(p) => p.validate(self, i, &where_.to_string())?,
+                Step::Anova(a) => a.validate(self, i, &where_.to_string(), dir)?,
                 Step::Calibrate(c) => {
                     let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
                     for (field, list) in [
@@ -460,6 +466,18 @@ impl Step {
         match self {
             Step::Calibrate(c) => &c.name,
             Step::Diagnose(d) => &d.name,
+            Step::Predict(p) => &p.name,
+            Step::Anova(a) => &a.name,
+        }
+    }
+
+    /// The step's kind, as spelled in manifests.
+    pub fn kind(&self) -> &'static str {
+        match self {
+            Step::Calibrate(_) => "calibrate",
+            Step::Diagnose(_) => "diagnose",
+            Step::Predict(_) => "predict",
+            Step::Anova(_) => "anova",
         }
     }
 }
@@ -512,7 +530,7 @@ impl Manifest {
     }
 
     /// Checks that a model spec predicts the records of data set `data`.
-    fn check_predicts(
+    pub(crate) fn check_predicts(
         &self,
         where_: String,
         at: &str,
@@ -535,7 +553,7 @@ impl Manifest {
     }
 }
 
-fn keys<V>(m: &BTreeMap<String, V>) -> String {
+pub(crate) fn keys<V>(m: &BTreeMap<String, V>) -> String {
     if m.is_empty() {
         "none".into()
     } else {

@@ -49,6 +49,19 @@ pub enum StepResult {
         name: String,
         cases: Vec<serde_json::Value>,
     },
+    /// [`crate::predict_step`]: each model's run and each (model, record) comparison.
+    Predict {
+        name: String,
+        runs: Vec<serde_json::Value>,
+        comparisons: Vec<serde_json::Value>,
+    },
+    /// [`crate::anova_step`]: the runs, our analysis and the published one.
+    Anova {
+        name: String,
+        runs: serde_json::Value,
+        analysis: serde_json::Value,
+        published: Option<serde_json::Value>,
+    },
 }
 
 /// A finished fit as cached: its results entry, its report rows and its plot.
@@ -98,6 +111,9 @@ pub struct DiagnoseEntry {
 /// Progress messages of a run (the CLI shows them; tests ignore them).
 pub trait RunObserver {
     fn message(&self, text: &str);
+    /// `done` of `total` load steps of the FE runs of a step (`label`);
+    /// called on the runner's thread.
+    fn progress(&self, _label: &str, _done: u64, _total: u64) {}
 }
 
 impl<F: Fn(&str)> RunObserver for F {
@@ -147,8 +163,18 @@ pub fn run_study_with(
             .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
         data.insert(name.clone(), d);
     }
+    // Data files, then the published tables of anova steps.
+    let data_files: Vec<PathBuf> = manifest
+        .data
+        .values()
+        .map(|d| dir.join(&d.file))
+        .chain(manifest.steps.iter().filter_map(|s| match s {
+            Step::Anova(a) => a.published.as_ref().map(|p| dir.join(p)),
+            _ => None,
+        }))
+        .collect();
     let inputs: Vec<PathBuf> = std::iter::once(path.to_path_buf())
-        .chain(manifest.data.values().map(|d| dir.join(&d.file)))
+        .chain(data_files.iter().cloned())
         .collect();
     check_not_inside(&out, &inputs)?;
     let folder = RunFolder::open(&out, options.fresh)?;
@@ -166,6 +192,7 @@ pub fn run_study_with(
     }
     let run = Run {
         manifest: &manifest,
+        manifest_dir: dir,
         data: &data,
         out: &stage,
         folder: &folder,
@@ -181,6 +208,14 @@ pub fn run_study_with(
                 let r = run.diagnose(d, &mut report)?;
                 results.steps.push(r);
             }
+            Step::Predict(p) => {
+                let r = crate::predict_step::run_predict(&run, p, &results.steps, &mut report)?;
+                results.steps.push(r);
+            }
+            Step::Anova(a) => {
+                let r = crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?;
+                results.steps.push(r);
+            }
         }
     }
     write_json(&stage.join("results.json"), &results)?;
@@ -189,10 +224,9 @@ pub fn run_study_with(
     let provenance = Provenance {
         palpate_version: env!("CARGO_PKG_VERSION").to_string(),
         manifest: hash_file(path)?,
-        data: manifest
-            .data
-            .values()
-            .map(|d| hash_file(&dir.join(&d.file)))
+        data: data_files
+            .iter()
+            .map(|f| hash_file(f))
             .collect::<anyhow::Result<_>>()?,
         git_commit,
         git_dirty,
@@ -228,13 +262,15 @@ fn check_not_inside(out: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
 }
 
 /// One study run: what every step needs.
-struct Run<'a> {
-    manifest: &'a Manifest,
-    data: &'a BTreeMap<String, TestData>,
+pub(crate) struct Run<'a> {
+    pub(crate) manifest: &'a Manifest,
+    /// The manifest's folder (its relative paths start there).
+    pub(crate) manifest_dir: &'a Path,
+    pub(crate) data: &'a BTreeMap<String, TestData>,
     /// The staging folder the files are written into.
-    out: &'a Path,
-    folder: &'a RunFolder,
-    observer: &'a dyn RunObserver,
+    pub(crate) out: &'a Path,
+    pub(crate) folder: &'a RunFolder,
+    pub(crate) observer: &'a dyn RunObserver,
 }
 
 impl Run<'_> {

@@ -16,8 +16,8 @@ use std::path::{Path, PathBuf};
 ///     never a mix of both; files of a previous run that this one does not
 ///     write (plots of a larger study) are removed;
 ///   * DIR/INCOMPLETE is present while the folder holds no complete run;
-///   * each fit and each diagnosed record is cached in DIR/.palpate/cache
-///     under the hash of its inputs: a rerun after a kill (Ctrl-C, SIGKILL)
+///   * each fit, each diagnosed record and each model run of a predict step
+///     is cached in DIR/.palpate/cache under the hash of its inputs: a rerun after a kill (Ctrl-C, SIGKILL)
 ///     or after editing another step computes only what changed (--fresh
 ///     computes everything again);
 ///   * one run at a time: a second run into the same folder is refused with
@@ -58,15 +58,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    // A spinner on a terminal; plain lines when stderr is a log file.
+    // A spinner on a terminal (a bar over the FE runs of a predict step);
+    // plain lines when stderr is a log file.
     let bar = std::io::stderr().is_terminal().then(|| {
         let bar = indicatif::ProgressBar::new_spinner();
         bar.enable_steady_tick(std::time::Duration::from_millis(120));
         bar
     });
-    let observer = |msg: &str| match &bar {
-        Some(b) => b.set_message(msg.to_string()),
-        None => eprintln!("{msg}"),
+    let observer = CliObserver {
+        bar: bar.clone(),
+        shown: std::sync::Mutex::new((String::new(), 0)),
     };
     let options = crate::runner::RunOptions {
         out: args.out.clone(),
@@ -80,6 +81,55 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     println!("study written to {}", out.display());
     println!("  {}", out.join("report.md").display());
     Ok(())
+}
+
+/// What `palpate run` shows: messages on a spinner, FE load steps on a bar
+/// (a terminal), or plain lines, progress every 10 % (a log file).
+struct CliObserver {
+    bar: Option<indicatif::ProgressBar>,
+    /// The label and the tenth last printed (plain lines).
+    shown: std::sync::Mutex<(String, u64)>,
+}
+
+const SPINNER: &str = "{spinner} {msg}";
+const BAR: &str = "{msg} [{bar:30}] {pos}/{len} load steps ({elapsed}, eta {eta})";
+
+impl crate::runner::RunObserver for CliObserver {
+    fn message(&self, text: &str) {
+        match &self.bar {
+            Some(b) => {
+                if let Ok(style) = indicatif::ProgressStyle::with_template(SPINNER) {
+                    b.set_style(style);
+                }
+                b.set_message(text.to_string());
+            }
+            None => eprintln!("{text}"),
+        }
+    }
+
+    fn progress(&self, label: &str, done: u64, total: u64) {
+        match &self.bar {
+            Some(b) => {
+                if b.length() != Some(total) {
+                    if let Ok(style) = indicatif::ProgressStyle::with_template(BAR) {
+                        b.set_style(style.progress_chars("=> "));
+                    }
+                    b.set_length(total);
+                    b.set_message(label.to_string());
+                }
+                b.set_position(done);
+            }
+            None => {
+                let tenth = done * 10 / total.max(1);
+                if let Ok(mut shown) = self.shown.lock() {
+                    if shown.0 != label || tenth > shown.1 {
+                        eprintln!("{label}: {done}/{total} load steps ({} %)", 10 * tenth);
+                        *shown = (label.to_string(), tenth);
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// Reads every data file of a manifest as its test (the errors name the
