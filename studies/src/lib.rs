@@ -6,6 +6,7 @@
 
 pub mod calibration;
 pub mod cli;
+pub mod columns;
 pub mod limits;
 pub mod manifest;
 pub mod models;

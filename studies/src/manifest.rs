@@ -61,8 +61,37 @@ pub struct StudyMeta {
 pub struct DataSpec {
     /// CSV file, relative to the manifest's directory.
     pub file: PathBuf,
-    /// `uniaxial`, `biaxial`, `planar` (stretch, stress_MPa), `C1` or `N1` (displacement_mm, force_N[, time_s]).
+    /// `uniaxial`, `biaxial` (equibiaxial, or general with `lambda1,lambda2`),
+    /// `planar`, `simple_shear` (stretch or strain and stress_MPa, see the
+    /// guide), `C1` or `N1` (displacement_mm, force_N[, time_s]).
     pub test: String,
+    /// Weight of the record's residuals in joint fits (default 1).
+    #[serde(default)]
+    pub weight: Option<f64>,
+    /// Simple shear superposed on this axial stretch (default 1).
+    #[serde(default)]
+    pub axial_stretch: Option<f64>,
+    /// `MPa`, `kPa` or `Pa`: the unit the stress columns are really in, for a
+    /// file whose header names the wrong unit (default: the header's).
+    #[serde(default)]
+    pub stress_unit: Option<String>,
+}
+
+impl DataSpec {
+    /// The reading options this data set states.
+    pub fn read_options(&self) -> anyhow::Result<crate::calibration::ReadOptions> {
+        let mut o = crate::calibration::ReadOptions::default();
+        if let Some(w) = self.weight {
+            o.set("weight", &w.to_string())?;
+        }
+        if let Some(a) = self.axial_stretch {
+            o.set("axial_stretch", &a.to_string())?;
+        }
+        if let Some(u) = &self.stress_unit {
+            o.set("stress_unit", u)?;
+        }
+        Ok(o)
+    }
 }
 
 /// A named model: a law applied to each data set's own test (`law = "..."`,
@@ -73,6 +102,9 @@ pub struct ModelEntry {
     pub model: ModelForm,
     /// Parameters held at a value during fits, by name (MPa or dimensionless).
     pub fixed: BTreeMap<String, f64>,
+    /// With `law = "..."`: a viscoelastic form of the homogeneous tests,
+    /// `qlv:N` or `finite:N` ([`crate::models::Viscous`]).
+    pub viscoelastic: Option<String>,
 }
 
 /// The two forms of a named model.
@@ -95,6 +127,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
         const FIELDS: &[&str] = &[
             "law",
             "fixed",
+            "viscoelastic",
             "homogeneous",
             "c1",
             "c1_fe",
@@ -114,6 +147,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                 let mut law: Option<String> = None;
                 let mut spec: Option<ModelSpec> = None;
                 let mut fixed = BTreeMap::new();
+                let mut viscoelastic: Option<String> = None;
                 while let Some(key) = map.next_key::<String>()? {
                     let next = match key.as_str() {
                         "law" => {
@@ -122,6 +156,10 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         }
                         "fixed" => {
                             fixed = map.next_value()?;
+                            None
+                        }
+                        "viscoelastic" => {
+                            viscoelastic = Some(map.next_value()?);
                             None
                         }
                         "homogeneous" => {
@@ -161,7 +199,21 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         ))
                     }
                 };
-                Ok(ModelEntry { model, fixed })
+                if let (Some(v), ModelForm::Spec(s)) = (&viscoelastic, &model) {
+                    return Err(A::Error::custom(format!(
+                        "`viscoelastic = \"{v}\"` goes with `law = ...`; inside the `{}` table give it there",
+                        s.kind()
+                    )));
+                }
+                if let Some(v) = &viscoelastic {
+                    crate::models::Viscous::parse(v)
+                        .map_err(|e| A::Error::custom(format!("viscoelastic: {e}")))?;
+                }
+                Ok(ModelEntry {
+                    model,
+                    fixed,
+                    viscoelastic,
+                })
             }
         }
         d.deserialize_map(V)

@@ -93,9 +93,12 @@ pub fn run_study(
     let mut data = BTreeMap::new();
     for (name, spec) in &manifest.data {
         let kind = TestKind::parse(&spec.test).with_context(|| format!("data.{name}.test"))?;
+        let options = spec
+            .read_options()
+            .with_context(|| format!("data.{name}"))?;
         data.insert(
             name.clone(),
-            TestData::read(name, kind, &dir.join(&spec.file))?,
+            TestData::read_with(name, kind, &dir.join(&spec.file), options)?,
         );
     }
     let mut results = StudyResults {
@@ -183,6 +186,12 @@ fn run_calibrate(
                     method,
                     fixed: entry.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
                     observer: None,
+                    viscous: entry
+                        .viscoelastic
+                        .as_deref()
+                        .map(crate::models::Viscous::parse)
+                        .transpose()
+                        .map_err(|e| anyhow::anyhow!("models.{model_name}.viscoelastic: {e}"))?,
                 })
                 .with_context(|| {
                     format!(

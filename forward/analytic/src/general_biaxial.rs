@@ -67,14 +67,14 @@ impl Evaluator for GeneralBiaxialEvaluator<'_> {
         let m = self.model;
         check_law_params(&m.law, &m.space, theta)?;
         check_loading(loading, Drive::Stretch, out.len())?;
-        if loading.len() % 2 != 0 {
+        if !loading.len().is_multiple_of(2) {
             return Err(ForwardError::InvalidLoading(format!(
                 "a general biaxial record has pairs (lambda1, lambda2); got {} stretches",
                 loading.len()
             )));
         }
         for (o, l) in out.chunks_exact_mut(2).zip(loading.drive.chunks_exact(2)) {
-            if let Some(&bad) = l.iter().find(|&&s| !(s > 0.0)) {
+            if let Some(&bad) = l.iter().find(|&&s| s.is_nan() || s <= 0.0) {
                 return Err(ForwardError::Unphysical {
                     drive: bad,
                     reason: "stretch must be positive".into(),

@@ -107,7 +107,7 @@ impl Evaluator for ViscousUniaxialEvaluator<'_> {
         for i in 0..m.terms {
             sum += prony[2 * i];
             let tau = prony[2 * i + 1];
-            if !(tau > 0.0) {
+            if tau.is_nan() || tau <= 0.0 {
                 return Err(ForwardError::InvalidParameter {
                     name: format!("tau{}_s", i + 1),
                     value: tau,
@@ -115,7 +115,7 @@ impl Evaluator for ViscousUniaxialEvaluator<'_> {
                 });
             }
         }
-        if !(sum <= 1.0) {
+        if sum.is_nan() || sum > 1.0 {
             return Err(ForwardError::InvalidParameter {
                 name: format!("g{}", m.terms),
                 value: prony[2 * (m.terms - 1)],
@@ -133,7 +133,7 @@ impl Evaluator for ViscousUniaxialEvaluator<'_> {
             v.resize(n, 0.0);
         }
         for (k, &s) in loading.drive.iter().enumerate() {
-            if !(s > 0.0) {
+            if s.is_nan() || s <= 0.0 {
                 return Err(ForwardError::Unphysical {
                     drive: s,
                     reason: "stretch must be positive".into(),
