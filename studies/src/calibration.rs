@@ -303,10 +303,15 @@ impl Serialize for NamedParams {
 #[derive(Debug, Clone, Serialize)]
 pub struct Prediction {
     pub data: String,
+    /// The record's test.
+    pub test: TestKind,
     pub fitted: bool,
     pub r2: f64,
     pub rms: f64,
     pub stretch_or_displacement: Vec<f64>,
+    /// Time of each sample (s), for timed records.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub time: Option<Vec<f64>>,
     pub observed: Vec<f64>,
     pub predicted: Vec<f64>,
 }
@@ -452,6 +457,8 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
         let (r2, rms) = r2_rms(&d.observed, &predicted);
         predictions.push(Prediction {
             data: d.name.clone(),
+            test: d.test,
+            time: d.loading.time.clone(),
             fitted: fitted || req.fitted.iter().any(|f| f.name == d.name),
             r2,
             rms,

@@ -286,7 +286,15 @@ fn default_estimator() -> String {
 }
 
 /// The kinds of test a data set can record.
-pub const TESTS: [&str; 5] = ["uniaxial", "biaxial", "planar", "C1", "N1"];
+pub const TESTS: [&str; 7] = [
+    "uniaxial",
+    "biaxial",
+    "general_biaxial",
+    "planar",
+    "simple_shear",
+    "C1",
+    "N1",
+];
 
 impl Manifest {
     /// Reads and parses a manifest; TOML and unknown-field errors carry the
@@ -337,6 +345,8 @@ impl Manifest {
                     TESTS.join(", ")
                 );
             }
+            d.read_options()
+                .map_err(|e| anyhow::anyhow!("{where_}: data.{name}: {e}"))?;
             let f = dir.join(&d.file);
             if !f.is_file() {
                 anyhow::bail!("{where_}: data.{name}.file: no such file {}", f.display());
