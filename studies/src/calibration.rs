@@ -496,7 +496,8 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
         evaluations: report.evaluations,
         converged: report.converged,
         identifiable: report.identifiability.identifiable,
-        drucker: drucker(&req.law, &theta),
+        // A viscoelastic fit appends Prony terms: the law is the leading part.
+        drucker: drucker(&req.law, &theta[..req.law.param_count().min(theta.len())]),
         predictions,
         fit: report,
     })
