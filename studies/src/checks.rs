@@ -189,7 +189,11 @@ pub fn check_tool(option: &str, model: &Model) -> anyhow::Result<()> {
 /// A body dimension along the tool's travel: (height in mm, what it is).
 pub fn travel_limit(model: &Model) -> Option<(f64, &'static str)> {
     match model {
-        Model::Homogeneous(_) => None,
+        Model::Homogeneous(_)
+        | Model::GeneralBiaxial(_)
+        | Model::SimpleShear(_)
+        | Model::ViscousUniaxial(_) => None,
+        Model::Qlv(inner, _) => travel_limit(inner),
         Model::C1(m) => Some((
             m.geometry.height_mm,
             "the C1 specimen is that high: the platens would meet",

@@ -8,6 +8,7 @@ pub mod anova_step;
 pub mod calibration;
 pub mod checks;
 pub mod cli;
+pub mod columns;
 pub mod limits;
 pub mod manifest;
 pub mod models;

@@ -63,8 +63,37 @@ pub struct StudyMeta {
 pub struct DataSpec {
     /// CSV file, relative to the manifest's directory.
     pub file: PathBuf,
-    /// `uniaxial`, `biaxial`, `planar` (stretch, stress_MPa), `C1` or `N1` (displacement_mm, force_N[, time_s]).
+    /// `uniaxial`, `biaxial` (equibiaxial, or general with `lambda1,lambda2`),
+    /// `planar`, `simple_shear` (stretch or strain and stress_MPa, see the
+    /// guide), `C1` or `N1` (displacement_mm, force_N[, time_s]).
     pub test: String,
+    /// Weight of the record's residuals in joint fits (default 1).
+    #[serde(default)]
+    pub weight: Option<f64>,
+    /// Simple shear superposed on this axial stretch (default 1).
+    #[serde(default)]
+    pub axial_stretch: Option<f64>,
+    /// `MPa`, `kPa` or `Pa`: the unit the stress columns are really in, for a
+    /// file whose header names the wrong unit (default: the header's).
+    #[serde(default)]
+    pub stress_unit: Option<String>,
+}
+
+impl DataSpec {
+    /// The reading options this data set states.
+    pub fn read_options(&self) -> anyhow::Result<crate::calibration::ReadOptions> {
+        let mut o = crate::calibration::ReadOptions::default();
+        if let Some(w) = self.weight {
+            o.set("weight", &w.to_string())?;
+        }
+        if let Some(a) = self.axial_stretch {
+            o.set("axial_stretch", &a.to_string())?;
+        }
+        if let Some(u) = &self.stress_unit {
+            o.set("stress_unit", u)?;
+        }
+        Ok(o)
+    }
 }
 
 /// A named model: a law applied to each data set's own test (`law = "..."`,
@@ -75,6 +104,9 @@ pub struct ModelEntry {
     pub model: ModelForm,
     /// Parameters held at a value during fits, by name (MPa or dimensionless).
     pub fixed: BTreeMap<String, f64>,
+    /// With `law = "..."`: a viscoelastic form of the homogeneous tests,
+    /// `qlv:N` or `finite:N` ([`crate::models::Viscous`]).
+    pub viscoelastic: Option<String>,
 }
 
 /// The two forms of a named model.
@@ -97,6 +129,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
         const FIELDS: &[&str] = &[
             "law",
             "fixed",
+            "viscoelastic",
             "homogeneous",
             "c1",
             "c1_fe",
@@ -116,6 +149,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                 let mut law: Option<String> = None;
                 let mut spec: Option<ModelSpec> = None;
                 let mut fixed = BTreeMap::new();
+                let mut viscoelastic: Option<String> = None;
                 while let Some(key) = map.next_key::<String>()? {
                     let next = match key.as_str() {
                         "law" => {
@@ -124,6 +158,10 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         }
                         "fixed" => {
                             fixed = map.next_value()?;
+                            None
+                        }
+                        "viscoelastic" => {
+                            viscoelastic = Some(map.next_value()?);
                             None
                         }
                         "homogeneous" => {
@@ -163,7 +201,21 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         ))
                     }
                 };
-                Ok(ModelEntry { model, fixed })
+                if let (Some(v), ModelForm::Spec(s)) = (&viscoelastic, &model) {
+                    return Err(A::Error::custom(format!(
+                        "`viscoelastic = \"{v}\"` goes with `law = ...`; inside the `{}` table give it there",
+                        s.kind()
+                    )));
+                }
+                if let Some(v) = &viscoelastic {
+                    crate::models::Viscous::parse(v)
+                        .map_err(|e| A::Error::custom(format!("viscoelastic: {e}")))?;
+                }
+                Ok(ModelEntry {
+                    model,
+                    fixed,
+                    viscoelastic,
+                })
             }
         }
         d.deserialize_map(V)
@@ -241,7 +293,15 @@ fn default_estimator() -> String {
 }
 
 /// The kinds of test a data set can record.
-pub const TESTS: [&str; 5] = ["uniaxial", "biaxial", "planar", "C1", "N1"];
+pub const TESTS: [&str; 7] = [
+    "uniaxial",
+    "biaxial",
+    "general_biaxial",
+    "planar",
+    "simple_shear",
+    "C1",
+    "N1",
+];
 
 impl Manifest {
     /// Reads and parses a manifest; TOML and unknown-field errors carry the
@@ -289,6 +349,8 @@ impl Manifest {
                     TESTS.join(", ")
                 );
             }
+            d.read_options()
+                .map_err(|e| anyhow::anyhow!("{where_}: data.{name}: {e}"))?;
             let f = dir.join(&d.file);
             if !f.is_file() {
                 anyhow::bail!("{where_}: data.{name}.file: no such file {}", f.display());

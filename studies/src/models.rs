@@ -39,7 +39,9 @@
 //!
 //! [models.tension.homogeneous] # homogeneous test (analytic)
 //! law = "mooney-rivlin"
-//! mode = "uniaxial"           # uniaxial | biaxial | planar
+//! mode = "uniaxial"           # uniaxial | biaxial | planar | general_biaxial | simple_shear
+//! axial_stretch = 0.8         # simple_shear only: shear superposed on this axial stretch (default 1)
+//! viscoelastic = "qlv:2"      # qlv:N (Prony on the nominal stress) | finite:N (on the isochoric 2nd Piola stress, uniaxial)
 //! ```
 //!
 //! Every optional setting has one default, the same from a manifest and from
@@ -53,7 +55,9 @@
 //! `base = "..."` means the base model of [`gap_base`].
 
 use crate::calibration::TestKind;
-use palpate_analytic::{C1Compression, Homogeneous, Mode};
+use palpate_analytic::{
+    C1Compression, GeneralBiaxial, Homogeneous, Mode, SimpleShear, ViscousUniaxial,
+};
 use palpate_core::{Effect, ForwardModel};
 use palpate_fe::{
     Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Needle, Platens, Prony, Q1Punch,
@@ -94,8 +98,57 @@ pub enum ModelSpec {
 #[serde(deny_unknown_fields)]
 pub struct HomogeneousSpec {
     pub law: String,
-    /// `uniaxial`, `biaxial` or `planar`.
+    /// `uniaxial`, `biaxial` (equibiaxial), `planar`, `general_biaxial` or `simple_shear`.
     pub mode: String,
+    /// Simple shear only: the axial stretch of the plate gap the shear is
+    /// superposed on (default 1, plain simple shear).
+    #[serde(default)]
+    pub axial_stretch: Option<f64>,
+    /// A viscoelastic form ([`Viscous`]): `qlv:N` or `finite:N`; none: elastic.
+    #[serde(default)]
+    pub viscoelastic: Option<String>,
+}
+
+/// A viscoelastic form of a homogeneous test, with its number of Prony terms.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Viscous {
+    /// Quasi-linear viscoelasticity (Fung): the Prony series acts on the
+    /// elastic nominal stress (`palpate_enrich::Viscoelastic`). Any homogeneous test.
+    Qlv(usize),
+    /// The Prony series acts on the isochoric second Piola stress, the
+    /// pressure at the current stretch (`palpate_analytic::ViscousUniaxial`).
+    /// Uniaxial records only.
+    Finite(usize),
+}
+
+impl Viscous {
+    /// Parses `qlv:N` or `finite:N` (N = 1..=6 Prony terms; `qlv` alone is `qlv:2`).
+    pub fn parse(s: &str) -> Result<Viscous, String> {
+        let (kind, n) = s.split_once(':').unwrap_or((s, "2"));
+        let n: usize = n
+            .trim()
+            .parse()
+            .ok()
+            .filter(|n| (1..=6).contains(n))
+            .ok_or_else(|| format!("`{s}`: the number of Prony terms must be 1 to 6"))?;
+        match kind.trim().to_ascii_lowercase().as_str() {
+            "qlv" => Ok(Viscous::Qlv(n)),
+            "finite" | "finite-strain" | "finite_strain" => Ok(Viscous::Finite(n)),
+            _ => Err(format!(
+                "`{s}`: expected qlv:N (Prony series on the nominal stress) or finite:N (on the isochoric second Piola stress)"
+            )),
+        }
+    }
+}
+
+impl fmt::Display for Viscous {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Viscous::Qlv(n) => write!(f, "qlv:{n}"),
+            Viscous::Finite(n) => write!(f, "finite:{n}"),
+        }
+    }
 }
 
 /// `[... .c1]`
@@ -255,6 +308,11 @@ impl ModelError {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Model {
     Homogeneous(Homogeneous),
+    GeneralBiaxial(GeneralBiaxial),
+    SimpleShear(SimpleShear),
+    /// A homogeneous test in quasi-linear viscoelasticity with N Prony terms.
+    Qlv(Box<Model>, usize),
+    ViscousUniaxial(ViscousUniaxial),
     C1(C1Compression),
     C1Fe(C1Fe),
     N1Needle(N1Needle),
@@ -267,6 +325,12 @@ impl Model {
     pub fn into_forward(self) -> Box<dyn ForwardModel> {
         match self {
             Model::Homogeneous(m) => Box::new(m),
+            Model::GeneralBiaxial(m) => Box::new(m),
+            Model::SimpleShear(m) => Box::new(m),
+            Model::Qlv(m, terms) => {
+                Box::new(palpate_enrich::Viscoelastic::new(m.into_forward(), terms))
+            }
+            Model::ViscousUniaxial(m) => Box::new(m),
             Model::C1(m) => Box::new(m),
             Model::C1Fe(m) => Box::new(m),
             Model::N1Needle(m) => Box::new(m),
@@ -320,7 +384,11 @@ impl ModelSpec {
     /// The test whose records this model predicts.
     pub fn test(&self) -> Result<TestKind, ModelError> {
         Ok(match self {
-            ModelSpec::Homogeneous(s) => TestKind::Homogeneous(parse_mode(&s.mode)?),
+            ModelSpec::Homogeneous(s) => match homogeneous_kind(&s.mode)? {
+                HomogeneousKind::Mode(m) => TestKind::Homogeneous(m),
+                HomogeneousKind::GeneralBiaxial => TestKind::GeneralBiaxial,
+                HomogeneousKind::SimpleShear => TestKind::SimpleShear,
+            },
             ModelSpec::C1(_) | ModelSpec::C1Fe(_) => TestKind::C1,
             // needle force records, as N1's
             ModelSpec::N1Needle(_) | ModelSpec::N3Needle(_) => TestKind::N1,
@@ -339,9 +407,7 @@ impl ModelSpec {
     pub fn validate(&self) -> Result<Model, ModelError> {
         let law = self.law()?;
         Ok(match self {
-            ModelSpec::Homogeneous(s) => {
-                Model::Homogeneous(Homogeneous::new(law, parse_mode(&s.mode)?))
-            }
+            ModelSpec::Homogeneous(s) => homogeneous_model(law, s)?,
             ModelSpec::C1(_) => Model::C1(C1Compression::new(law)),
             ModelSpec::C1Fe(s) => {
                 const K: &str = "c1_fe";
@@ -459,13 +525,84 @@ fn n3_unknowns(level: usize) -> usize {
     3 * n(35.0) * n(40.0) * n(80.0)
 }
 
+/// What a `homogeneous` spec's `mode` names.
+enum HomogeneousKind {
+    Mode(Mode),
+    GeneralBiaxial,
+    SimpleShear,
+}
+
+fn homogeneous_kind(s: &str) -> Result<HomogeneousKind, ModelError> {
+    match s.trim().to_ascii_lowercase().replace('-', "_").as_str() {
+        "general_biaxial" => Ok(HomogeneousKind::GeneralBiaxial),
+        "simple_shear" => Ok(HomogeneousKind::SimpleShear),
+        _ => parse_mode(s).map(HomogeneousKind::Mode),
+    }
+}
+
+/// The model of a `homogeneous` spec: the test, its axial stretch, its viscoelastic form.
+fn homogeneous_model(law: Law, s: &HomogeneousSpec) -> Result<Model, ModelError> {
+    const K: &str = "homogeneous";
+    let kind = homogeneous_kind(&s.mode)?;
+    if let Some(a) = s.axial_stretch {
+        if !matches!(kind, HomogeneousKind::SimpleShear) {
+            return Err(ModelError::new(
+                K,
+                "axial_stretch",
+                a,
+                "only a simple_shear test has an axial stretch",
+            ));
+        }
+    }
+    let elastic = match kind {
+        HomogeneousKind::Mode(m) => Model::Homogeneous(Homogeneous::new(law, m)),
+        HomogeneousKind::GeneralBiaxial => Model::GeneralBiaxial(GeneralBiaxial::new(law)),
+        HomogeneousKind::SimpleShear => {
+            let a = s.axial_stretch.unwrap_or(1.0);
+            Model::SimpleShear(
+                SimpleShear::new(law, a)
+                    .map_err(|e| ModelError::new(K, "axial_stretch", a, e.to_string()))?,
+            )
+        }
+    };
+    let Some(v) = &s.viscoelastic else {
+        return Ok(elastic);
+    };
+    let viscous = Viscous::parse(v).map_err(|e| ModelError::new(K, "viscoelastic", v, e))?;
+    Ok(match (viscous, &elastic) {
+        (_, Model::GeneralBiaxial(_)) => {
+            return Err(ModelError::new(
+                K,
+                "viscoelastic",
+                v,
+                "a general biaxial record pairs two stretches per row, not a time history",
+            ))
+        }
+        (Viscous::Qlv(n), _) => Model::Qlv(Box::new(elastic), n),
+        (Viscous::Finite(n), Model::Homogeneous(h)) if h.mode == Mode::Uniaxial => {
+            Model::ViscousUniaxial(
+                ViscousUniaxial::new(law, n)
+                    .map_err(|e| ModelError::new(K, "viscoelastic", v, e.to_string()))?,
+            )
+        }
+        (Viscous::Finite(_), _) => {
+            return Err(ModelError::new(
+                K,
+                "viscoelastic",
+                v,
+                "finite:N is written for uniaxial records; use qlv:N for other tests",
+            ))
+        }
+    })
+}
+
 fn parse_mode(s: &str) -> Result<Mode, ModelError> {
     s.parse::<Mode>().map_err(|_| {
         ModelError::new(
             "homogeneous",
             "mode",
             s,
-            "expected uniaxial, biaxial or planar",
+            "expected uniaxial, biaxial (equibiaxial), planar (pure_shear), general_biaxial or simple_shear",
         )
     })
 }
@@ -565,7 +702,22 @@ pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
         TestKind::Homogeneous(mode) => ModelSpec::Homogeneous(HomogeneousSpec {
             law,
             mode: mode.name().to_string(),
+            axial_stretch: None,
+            viscoelastic: None,
         }),
+        TestKind::GeneralBiaxial | TestKind::SimpleShear => {
+            ModelSpec::Homogeneous(HomogeneousSpec {
+                law,
+                mode: if test == TestKind::SimpleShear {
+                    "simple_shear"
+                } else {
+                    "general_biaxial"
+                }
+                .to_string(),
+                axial_stretch: None,
+                viscoelastic: None,
+            })
+        }
         TestKind::C1 => ModelSpec::C1(C1Spec { law }),
         TestKind::N1 => ModelSpec::N1Needle(N1NeedleSpec {
             law,
@@ -589,9 +741,11 @@ pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
             mesh: Some("coarse".into()),
             ..Default::default()
         })),
-        TestKind::Homogeneous(_) => anyhow::bail!(
-            "the gap diagnosis supports C1 (analytic) and N1 (finite elements) force records"
-        ),
+        TestKind::Homogeneous(_) | TestKind::GeneralBiaxial | TestKind::SimpleShear => {
+            anyhow::bail!(
+                "the gap diagnosis supports C1 (analytic) and N1 (finite elements) force records"
+            )
+        }
     }
 }
 

@@ -2,20 +2,29 @@
 //! calibration's table and its data against the fit; the gap diagnosis's
 //! terminal summary and two panels.
 
-use crate::calibration::Calibration;
+use crate::calibration::{Calibration, TestKind};
 use crate::plot::{grid_svg, Band, Plot, Series};
 use palpate_uq::gap::GapReport;
 
 /// Data (markers) against the fitted law (lines), one colour per data set.
 pub fn fit_plot(c: &Calibration) -> Plot {
-    let homogeneous = c
+    let homogeneous = c.predictions.iter().all(|p| p.test.is_homogeneous());
+    let timed = c.predictions.iter().all(|p| p.time.is_some());
+    let shear = c
         .predictions
         .iter()
-        .all(|p| p.data != "C1" && p.data != "N1");
-    let (xl, yl) = if homogeneous {
-        ("stretch", "nominal stress (MPa)")
-    } else {
+        .filter(|p| p.test == TestKind::SimpleShear)
+        .count();
+    let (xl, yl) = if !homogeneous {
         ("displacement (mm)", "force (N)")
+    } else if timed {
+        ("time (s)", "nominal stress (MPa)")
+    } else if shear == c.predictions.len() {
+        ("amount of shear", "nominal shear stress (MPa)")
+    } else if shear > 0 {
+        ("stretch, or amount of shear", "nominal stress (MPa)")
+    } else {
+        ("stretch", "nominal stress (MPa)")
     };
     let mut plot = Plot::new(
         format!(
@@ -32,29 +41,27 @@ pub fn fit_plot(c: &Calibration) -> Plot {
     ];
     for (k, p) in c.predictions.iter().enumerate() {
         let col = COLOURS[k % COLOURS.len()];
-        plot.push(
-            Series::markers(
-                format!("{} data", p.data),
-                &p.stretch_or_displacement,
-                &p.observed,
-            )
-            .color(col),
-        );
-        let (x, y) = (&p.stretch_or_displacement, &p.predicted);
+        let x = match (&p.time, timed) {
+            (Some(t), true) => t,
+            _ => &p.stretch_or_displacement,
+        };
+        plot.push(Series::markers(format!("{} data", p.data), x, &p.observed).color(col));
+        let y = &p.predicted;
         let label = format!(
             "{} {} (R^2 {:.4})",
             p.data,
             if p.fitted { "fit" } else { "prediction" },
             p.r2
         );
-        plot.push(
-            if p.fitted {
-                Series::line(label, x, y)
-            } else {
-                Series::dashed(label, x, y)
-            }
-            .color(col),
-        );
+        // General biaxial: (lambda_a, P_a) pairs are not a curve; each predicted
+        // point is drawn as a marker in the fit's colour, darker.
+        plot.push(if p.test == TestKind::GeneralBiaxial {
+            Series::markers(label, x, y).color("#000000")
+        } else if p.fitted {
+            Series::line(label, x, y).color(col)
+        } else {
+            Series::dashed(label, x, y).color(col)
+        });
     }
     plot
 }

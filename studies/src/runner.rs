@@ -159,7 +159,10 @@ pub fn run_study_with(
     for (name, spec) in &manifest.data {
         let kind = TestKind::parse(&spec.test)
             .map_err(|e| anyhow::anyhow!("{}: data.{name}.test: {e}", path.display()))?;
-        let d = TestData::read(name, kind, &dir.join(&spec.file))
+        let options = spec
+            .read_options()
+            .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
+        let d = TestData::read_with(name, kind, &dir.join(&spec.file), options)
             .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
         data.insert(name.clone(), d);
     }
@@ -351,6 +354,14 @@ fn run_calibrate(
                         method,
                         fixed: entry.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
                         observer: None,
+                        viscous: entry
+                            .viscoelastic
+                            .as_deref()
+                            .map(crate::models::Viscous::parse)
+                            .transpose()
+                            .map_err(|e| {
+                                anyhow::anyhow!("models.{model_name}.viscoelastic: {e}")
+                            })?,
                     })
                     .with_context(|| {
                         format!(

@@ -174,6 +174,9 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                             DataSpec {
                                 file: format!("data/{n}.csv").into(),
                                 test: t.to_string(),
+                                weight: None,
+                                axial_stretch: None,
+                                stress_unit: None,
                             },
                         )
                     })
@@ -187,6 +190,7 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                             ModelEntry {
                                 model: ModelForm::Law(law.to_string()),
                                 fixed,
+                                viscoelastic: None,
                             },
                         )
                     })

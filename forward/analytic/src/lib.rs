@@ -5,6 +5,12 @@
 //!
 //! * [`Homogeneous`] — uniaxial, equibiaxial and planar (pure-shear) nominal
 //!   stress of any incompressible law, driven by the principal stretch.
+//! * [`GeneralBiaxial`] — both in-plane stretches and both nominal stresses
+//!   of a sheet (Kawabata's general biaxial tests).
+//! * [`SimpleShear`] — nominal shear stress against the amount of shear,
+//!   optionally superposed on an axial stretch (Budday's brain tests).
+//! * [`ViscousUniaxial`] — finite-strain viscoelastic uniaxial tension and
+//!   compression (Prony series on the isochoric second Piola stress).
 //! * [`C1Compression`] — benchmark C1 (38 x 9 mm cylinder between lubricated
 //!   platens): homogeneous uniaxial compression, force against platen travel.
 //! * [`Compressible`] — C1 with a finite bulk modulus (`compressibility`),
@@ -36,10 +42,16 @@
 mod c1;
 mod compressible;
 mod convert;
+mod general_biaxial;
 mod homogeneous;
 mod mode;
+mod simple_shear;
+mod viscous_uniaxial;
 
 pub use c1::{c1_area_mm2, C1Compression, C1Geometry};
 pub use compressible::{lateral_stress_free, Compressible};
+pub use general_biaxial::GeneralBiaxial;
 pub use homogeneous::Homogeneous;
 pub use mode::Mode;
+pub use simple_shear::SimpleShear;
+pub use viscous_uniaxial::ViscousUniaxial;

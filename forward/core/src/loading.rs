@@ -12,6 +12,9 @@ pub enum Drive {
     Stretch,
     /// Tool position along a path in mm (rolling), at a fixed depth.
     PositionMm,
+    /// Amount of shear `gamma` of a homogeneous simple-shear test
+    /// (dimensionless: plate travel over the specimen height).
+    AmountOfShear,
 }
 
 /// What a model predicts at each sample.
@@ -86,6 +89,7 @@ impl Drive {
             Drive::DisplacementMm => "displacement_mm",
             Drive::Stretch => "stretch",
             Drive::PositionMm => "position_mm",
+            Drive::AmountOfShear => "amount_of_shear",
         }
     }
 }

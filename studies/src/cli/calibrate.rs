@@ -1,7 +1,8 @@
 //! `palpate calibrate`: fit a hyperelastic law to homogeneous-test data or a
 //! C1 force record, print a table, optionally write JSON and an SVG plot.
 
-use crate::calibration::{calibrate, parse_method, Request, TestData, TestKind};
+use crate::calibration::{calibrate, parse_method, ReadOptions, Request, TestData, TestKind};
+use crate::models::Viscous;
 use crate::output::{write_atomic, write_json};
 use crate::report::{calibration_table, fit_plot};
 use anyhow::Context;
@@ -12,9 +13,21 @@ use std::path::PathBuf;
 
 /// Fit a hyperelastic law to measured data.
 ///
-/// Homogeneous tests: `--data TEST=FILE` with TEST one of uniaxial, biaxial,
-/// planar and FILE a CSV with columns `stretch,stress_MPa` (nominal stress).
-/// Several --data options are fitted jointly with one parameter set.
+/// Homogeneous tests: `--data TEST=FILE` with TEST one of
+///   uniaxial       stretch (or strain, true_strain), stress_MPa; tension and compression
+///   biaxial        equibiaxial: stretch, stress_MPa; general (Kawabata): lambda1,
+///                  lambda2, stress1_MPa, stress2_MPa
+///   planar         pure shear: stretch, stress_MPa
+///   simple_shear   amount_of_shear, shear_stress_MPa
+/// Stresses are nominal (force / undeformed area) unless the column says
+/// true_ (Cauchy), e.g. true_stress_MPa; units MPa, kPa or Pa in the name.
+/// A time_s column makes the record timed (for --viscoelastic).
+/// Options of one record go in brackets before `=`:
+///   --data 'simple_shear[axial_stretch=0.9,weight=0.5]=FILE'
+/// (weight: of the record in a joint fit; axial_stretch: shear superposed on
+/// an axial stretch; stress_unit=kPa: the file's stresses are in kPa whatever
+/// its header says). Several --data options are fitted jointly with one
+/// parameter set.
 ///
 /// Benchmark C1 (38 x 9 mm cylinder between lubricated platens):
 /// `--benchmark C1 --data FILE` with columns `displacement_mm,force_N`.
@@ -27,10 +40,18 @@ pub struct Args {
     /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N.
     #[arg(long)]
     pub law: String,
-    /// Data to fit: TEST=FILE for homogeneous tests (TEST = uniaxial, biaxial,
-    /// planar), or just FILE with --benchmark C1. Repeat to fit jointly.
+    /// Data to fit: TEST=FILE or TEST[key=value,...]=FILE for homogeneous
+    /// tests (TEST = uniaxial, biaxial, planar, simple_shear; keys weight,
+    /// axial_stretch, stress_unit), or just FILE with --benchmark C1. Repeat
+    /// to fit jointly.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
+    /// Viscoelastic homogeneous tests (timed records, column time_s):
+    /// qlv:N (quasi-linear viscoelasticity, N Prony terms on the nominal
+    /// stress) or finite:N (uniaxial only: Prony terms on the isochoric second
+    /// Piola stress, finite-strain). Adds g1,tau1_s,... to the law's parameters.
+    #[arg(long, value_name = "FORM")]
+    pub viscoelastic: Option<String>,
     /// Fit a benchmark's force record instead of homogeneous stress data: C1
     /// (analytic, lubricated compression) or N1 (finite-element needle
     /// indentation, friction 0.8, coarse mesh; each evaluation is a full FE run).
@@ -62,6 +83,36 @@ pub fn split_pair<'a>(s: &'a str, what: &str) -> anyhow::Result<(&'a str, &'a st
         .ok_or_else(|| anyhow::anyhow!("`{s}`: expected {what}"))
 }
 
+/// Splits `TEST=FILE` or `TEST[key=value,...]=FILE` into the test, its
+/// reading options and the file.
+pub fn split_data(d: &str) -> anyhow::Result<(&str, ReadOptions, &str)> {
+    let mut options = ReadOptions::default();
+    if let Some(open) = d.find('[').filter(|&i| !d[..i].contains('=')) {
+        let close = d[open..]
+            .find(']')
+            .map(|c| open + c)
+            .ok_or_else(|| anyhow::anyhow!("--data {d}: `[` without `]`"))?;
+        let path = d[close + 1..]
+            .strip_prefix('=')
+            .filter(|p| !p.is_empty())
+            .ok_or_else(|| anyhow::anyhow!("--data {d}: expected `=FILE` after `]`"))?;
+        for kv in d[open + 1..close]
+            .split(',')
+            .filter(|s| !s.trim().is_empty())
+        {
+            let (k, v) = split_pair(kv, "key=value inside [...], e.g. weight=0.5")
+                .with_context(|| format!("--data {d}"))?;
+            options.set(k, v).with_context(|| format!("--data {d}"))?;
+        }
+        return Ok((&d[..open], options, path));
+    }
+    let (test, path) = split_pair(
+        d,
+        "TEST=FILE, e.g. uniaxial=data.csv (or use --benchmark C1 --data FILE)",
+    )?;
+    Ok((test, options, path))
+}
+
 /// Reads the `--data` options.
 pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec<TestData>> {
     let mut out = Vec::new();
@@ -91,13 +142,20 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
         ),
         None => {
             for d in data {
-                let (test, path) = split_pair(
-                    d,
-                    "TEST=FILE, e.g. uniaxial=data.csv (or use --benchmark C1 --data FILE)",
-                )
-                .map_err(|e| anyhow::anyhow!("--data {e}"))?;
+                let (test, options, path) =
+                    split_data(d).map_err(|e| anyhow::anyhow!("--data {e}"))?;
                 let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
-                out.push(TestData::read(test, kind, std::path::Path::new(path))?);
+                let name = if out.iter().any(|o: &TestData| o.name == test) {
+                    format!("{test}#{}", out.len() + 1)
+                } else {
+                    test.to_string()
+                };
+                out.push(TestData::read_with(
+                    &name,
+                    kind,
+                    std::path::Path::new(path),
+                    options,
+                )?);
             }
         }
     }
@@ -130,6 +188,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fixed.push((name.to_string(), v));
     }
     crate::checks::check_fixed(&law, &fixed, "--fix")?;
+    let viscous = args
+        .viscoelastic
+        .as_deref()
+        .map(Viscous::parse)
+        .transpose()
+        .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
     let data = read_data(&args.data, args.benchmark.as_deref())?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
@@ -143,6 +207,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         method,
         fixed,
         observer: None,
+        viscous,
     })?;
     print!("{}", calibration_table(&result));
     if let Some(p) = &args.json {

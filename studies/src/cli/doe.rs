@@ -493,6 +493,7 @@ fn run_calibrations(
                 method,
                 fixed: Vec::new(),
                 observer: None,
+                viscous: None,
             })
             .with_context(|| {
                 format!(
