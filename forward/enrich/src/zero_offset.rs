@@ -5,7 +5,7 @@ use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
     Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
-    ParamSpace, ParamSpec,
+    ParamRole, ParamSpace, ParamSpec,
 };
 use std::borrow::Cow;
 use std::sync::Arc;
@@ -31,7 +31,9 @@ impl ZeroOffset {
     pub fn from_arc(base: Arc<dyn ForwardModel>) -> Self {
         let space = base
             .space()
-            .extended(&[ParamSpec::new("d0_mm", "mm", -5.0, 5.0, 0.0)]);
+            .extended(&[ParamSpec::new("d0_mm", "mm", -5.0, 5.0, 0.0)
+                .with_role(ParamRole::Offset)
+                .with_plausible(-0.1, 0.1)]);
         ZeroOffset { base, space }
     }
 }

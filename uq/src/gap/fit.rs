@@ -132,7 +132,7 @@ pub(crate) fn scale_moduli(
         let scaled = specs
             .iter()
             .zip(theta)
-            .map(|(s, v)| if s.unit == "MPa" { v * a } else { *v })
+            .map(|(s, v)| if s.is_modulus() { v * a } else { *v })
             .collect();
         (a, scaled)
     })
