@@ -5,58 +5,142 @@
 use super::fit::{fit_from_starts, Fitted};
 use super::residual::residuals;
 use super::score::sensitivities_of;
-use super::GapError;
+use super::{FoldLayout, GapError};
 use nalgebra::DMatrix;
 use palpate_core::{ForwardModel, Loading};
 use std::sync::Arc;
 
-/// The folds of the cross-validation: the record cut into short contiguous
-/// chunks, dealt to the folds in turn (chunk k to fold k mod K), so that
-/// every fold holds chunks from every part of the history and every
-/// training set keeps every loading phase (ramp, hold, unloading).
+/// The folds of the cross-validation: each loading phase (a run of samples
+/// over which the drive rises, holds or falls) cut into short contiguous
+/// chunks, the chunks dealt to the folds in turn (one counter across the
+/// phases), so that every fold holds samples from every phase and every
+/// training set keeps every phase (ramp, hold, unloading).
 ///
-/// Why not K contiguous blocks: leaving out a whole phase (the hold of a
-/// relaxation test) removes the samples that identify the parameters of
-/// the effect that acts there (the time constants), and the refit then
-/// extrapolates an unidentified parameter into the left-out block; the
-/// cross-validation penalises the effect for the design of the folds, not
-/// for overfitting (issue 14, weakness 1). Chunks rather than single
-/// samples: under residual correlation, neighbouring samples of a left-out
-/// sample would otherwise predict it (Roberts et al. 2017, "Cross-validation
-/// strategies for data with temporal, spatial, hierarchical, or
-/// phylogenetic structure", Ecography 40: 913-929, recommend blocks at least
-/// as long as the correlation range). The chunk length is the running window
-/// of the structure tests halved (at least 2 samples) and small enough that
-/// each fold gets at least 4 chunks.
+/// Why not K contiguous blocks: leaving out a whole phase (the ramp or the
+/// hold of a relaxation test) removes the samples that identify the
+/// parameters of the effect that acts there (the time constants), and the
+/// refit then extrapolates an unidentified parameter into the left-out
+/// block; the cross-validation penalises the effect for the design of the
+/// folds, not for overfitting (issue 14, weakness 1). Chunks rather than
+/// single samples: under residual correlation, neighbouring samples of a
+/// left-out sample would otherwise predict it (Roberts et al. 2017,
+/// "Cross-validation strategies for data with temporal, spatial,
+/// hierarchical, or phylogenetic structure", Ecography 40: 913-929,
+/// recommend blocks at least as long as the correlation range). The chunk
+/// length is the running window of the structure tests halved, but within
+/// each phase at most phase length / (2 K), so that even the shortest phase
+/// (a fast ramp of ten samples) is spread over the folds.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct Folds {
-    /// The chunks [first, end) in order; chunk k belongs to fold k mod `count`.
+    /// The chunks [first, end) in order.
     pub chunks: Vec<(usize, usize)>,
+    /// The fold of each chunk.
+    pub fold_of: Vec<usize>,
     /// Number of folds.
     pub count: usize,
 }
 
+/// The loading phases of a drive: maximal runs [first, end) over which the
+/// increment keeps its sign (rising, holding within 1e-9 of the range, or
+/// falling). A sample where the direction changes starts the next phase.
+pub(crate) fn phases(drive: &[f64]) -> Vec<(usize, usize)> {
+    let n = drive.len();
+    if n < 2 {
+        return vec![(0, n)];
+    }
+    let (lo, hi) = drive
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &v| {
+            (a.min(v), b.max(v))
+        });
+    let tol = 1e-9 * (hi - lo).abs().max(f64::MIN_POSITIVE);
+    let direction = |i: usize| {
+        let d = drive[i + 1] - drive[i];
+        if d > tol {
+            1
+        } else if d < -tol {
+            -1
+        } else {
+            0
+        }
+    };
+    let mut out = Vec::new();
+    let mut start = 0;
+    let mut current = direction(0);
+    for i in 1..n - 1 {
+        let d = direction(i);
+        if d != current {
+            out.push((start, i + 1));
+            start = i + 1;
+            current = d;
+        }
+    }
+    out.push((start, n));
+    out.retain(|(a, b)| b > a);
+    out
+}
+
 impl Folds {
     /// Stratified folds of `n` samples into `count` folds with chunks of
-    /// about `window / 2` samples.
-    pub fn stratified(n: usize, count: usize, window: usize) -> Folds {
-        let most = (n / (4 * count)).max(1);
-        let len = (window / 2).clamp(2, most.max(2)).min(most);
-        let pieces = n.div_ceil(len).max(count);
-        let chunks = (0..pieces)
-            .map(|k| (k * n / pieces, (k + 1) * n / pieces))
-            .filter(|(a, b)| b > a)
+    /// about `window / 2` samples, shorter within short `phases`.
+    pub fn stratified(n: usize, count: usize, window: usize, phases: &[(usize, usize)]) -> Folds {
+        let whole = [(0, n)];
+        let phases = if phases.is_empty() {
+            &whole[..]
+        } else {
+            phases
+        };
+        let mut chunks = Vec::new();
+        let mut fold_of = Vec::new();
+        let mut next = 0;
+        for &(a, b) in phases {
+            let m = b - a;
+            let len = (window / 2).min(m / (2 * count)).max(1);
+            let pieces = m.div_ceil(len);
+            for k in 0..pieces {
+                let (s, e) = (a + k * m / pieces, a + (k + 1) * m / pieces);
+                if e > s {
+                    chunks.push((s, e));
+                    fold_of.push(next % count);
+                    next += 1;
+                }
+            }
+        }
+        Folds {
+            chunks,
+            fold_of,
+            count,
+        }
+    }
+
+    /// `count` contiguous blocks of `n` samples.
+    pub fn contiguous(n: usize, count: usize) -> Folds {
+        let chunks = (0..count)
+            .map(|k| (k * n / count, (k + 1) * n / count))
             .collect();
-        Folds { chunks, count }
+        Folds {
+            chunks,
+            fold_of: (0..count).collect(),
+            count,
+        }
+    }
+
+    /// The folds of `layout` for a record of drive `drive`.
+    pub fn new(layout: FoldLayout, drive: &[f64], count: usize, window: usize) -> Folds {
+        let n = drive.len();
+        match layout {
+            FoldLayout::Stratified => Folds::stratified(n, count, window, &phases(drive)),
+            FoldLayout::Contiguous => Folds::contiguous(n, count),
+        }
     }
 
     /// Held-out sample indices of fold `f`.
     pub fn held_out(&self, f: usize) -> Vec<usize> {
         self.chunks
             .iter()
-            .skip(f)
-            .step_by(self.count)
-            .flat_map(|&(a, b)| a..b)
+            .zip(&self.fold_of)
+            .filter(|(_, &k)| k == f)
+            .flat_map(|(&(a, b), _)| a..b)
             .collect()
     }
 
@@ -216,9 +300,25 @@ mod tests {
     use super::*;
 
     #[test]
+    fn phases_of_a_ramp_hold_unload() {
+        let mut d: Vec<f64> = (0..10).map(|i| i as f64).collect();
+        d.extend([9.0; 20]);
+        d.extend((0..9).rev().map(|i| i as f64));
+        let p = phases(&d);
+        assert_eq!(p, [(0, 10), (10, 30), (30, 39)]);
+        // a fast ramp of 10 samples in a record of 600: every fold has ramp samples
+        let mut d: Vec<f64> = (0..10).map(|i| i as f64).collect();
+        d.extend([9.0; 590]);
+        let folds = Folds::stratified(d.len(), 4, 40, &phases(&d));
+        for f in 0..4 {
+            assert!(folds.held_out(f).iter().any(|&i| i < 10), "fold {f}");
+        }
+    }
+
+    #[test]
     fn stratified_folds_cover_every_sample_once_and_every_phase() {
         for (n, k, w) in [(200, 8, 13), (41, 8, 8), (1001, 5, 60), (16, 8, 8)] {
-            let folds = Folds::stratified(n, k, w);
+            let folds = Folds::stratified(n, k, w, &[]);
             let mut seen = vec![0; n];
             for f in 0..k {
                 let held = folds.held_out(f);

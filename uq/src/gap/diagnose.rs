@@ -63,7 +63,7 @@ pub fn diagnose(
     }
     let p = base.space().len();
     let w = options.window.unwrap_or_else(|| default_window(n)).min(n);
-    let folds = Folds::stratified(n, options.folds, w);
+    let folds = Folds::new(options.fold_layout, &loading.drive, options.folds, w);
     let later = n - n / options.folds;
 
     // Base fit on all samples, and its held-out predictions.
@@ -181,8 +181,16 @@ pub fn diagnose(
         options.alpha,
         options.materiality,
     );
+    let detected: Vec<Effect> = decision
+        .verdict
+        .effect()
+        .into_iter()
+        .chain(decision.confounded.iter().copied())
+        .chain(decision.immaterial.iter().copied())
+        .collect();
     let undetectable = undetectable(
         &assessed,
+        &detected,
         loading,
         observed,
         p,

@@ -43,7 +43,7 @@ mod verdict;
 pub use diagnose::diagnose;
 pub use error::GapError;
 pub use noise::{difference_noise_sd, NoiseEstimate};
-pub use options::{CrossValidation, GapOptions};
+pub use options::{CrossValidation, FoldLayout, GapOptions};
 pub use profile::ProfileInterval;
 pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, PracticalSize, RankedEffect};
 pub use score::{score_test, sensitivities, ScoreTest};

@@ -32,6 +32,8 @@ pub struct GapOptions {
     pub confound_alpha: f64,
     /// How each left-out fold is refitted in the cross-validation.
     pub cross_validation: CrossValidation,
+    /// How the record is cut into folds.
+    pub fold_layout: FoldLayout,
     /// Materiality threshold: the smallest RMS of the systematic misfit an
     /// effect must remove, in noise SDs, for the verdict to name it
     /// (sqrt(MS_before - MS_after) / sigma). Below it an effect that earns
@@ -39,6 +41,21 @@ pub struct GapOptions {
     /// verdict stays `none`. Default 0.4: a model error of 0.4 noise SD
     /// raises the RMS prediction error by under 8 % (sqrt(1 + 0.4^2) = 1.077).
     pub materiality: f64,
+}
+
+/// How the record is cut into the folds of the cross-validation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FoldLayout {
+    /// Short contiguous chunks dealt to the folds in turn: every fold spans
+    /// every loading phase, so no training set loses the samples that
+    /// identify an effect (docs/gap-diagnosis.md).
+    #[default]
+    Stratified,
+    /// `folds` contiguous blocks (the first version's layout, kept for
+    /// comparison): leaving out the hold of a relaxation test leaves the time
+    /// constants unidentified in the refit, and a true effect can be rejected.
+    Contiguous,
 }
 
 /// Refit strategy of the blocked cross-validation.
@@ -79,6 +96,7 @@ impl Default for GapOptions {
             effects: None,
             confound_alpha: 0.01,
             cross_validation: CrossValidation::Auto,
+            fold_layout: FoldLayout::Stratified,
             materiality: 0.4,
         }
     }

@@ -47,10 +47,13 @@ pub struct Undetectable {
     pub p_value: [f64; 2],
 }
 
-/// For every assessed effect that does not earn its parameters and has
-/// parameters with a plausible range: the base refitted at the ends.
+/// For every assessed effect not in `detected` (the verdict, the effects
+/// confounded with it and the immaterial ones) that has parameters with a
+/// plausible range: the base refitted at the ends.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn undetectable(
     assessed: &[Assessed],
+    detected: &[Effect],
     loading: &Loading,
     observed: &[f64],
     p: usize,
@@ -61,7 +64,7 @@ pub(crate) fn undetectable(
     let jobs: Vec<(usize, usize)> = assessed
         .iter()
         .enumerate()
-        .filter(|(_, a)| !a.ranked.earns)
+        .filter(|(_, a)| !detected.contains(&a.ranked.effect))
         .flat_map(|(k, a)| {
             let specs = &a.model.space().params;
             (p..specs.len())
