@@ -6,7 +6,7 @@ use super::crossval::{cross_validate_by, Folds};
 use super::fit::{fit_from_starts, Fitted};
 use super::report::{PracticalSize, RankedEffect};
 use super::residual::{ar1_deviance, residuals, rms, sse};
-use super::score::{projected_columns, score_test, sensitivities};
+use super::score::{projected_columns, score_test, sensitivities_at};
 use super::starts::{candidate_starts, screen_starts};
 use super::structure::{chi2_isf, chi2_sf, whiteness};
 use super::GapError;
@@ -30,6 +30,10 @@ pub(crate) struct Context<'a> {
     pub base_full: &'a Fitted,
     pub base_cv: Vec<f64>,
     pub base_residual: Vec<f64>,
+    /// Sensitivities of the base parameters at the base optimum, when
+    /// computed (expensive models): reused for the score test of an
+    /// enrichment whose "off" point reproduces the base predictions.
+    pub base_jac: Option<&'a DMatrix<f64>>,
     pub candidates: usize,
     pub alpha: f64,
     pub rel_var_sd2: f64,
@@ -120,17 +124,60 @@ pub(crate) fn practical_size(
     }
 }
 
-/// Score test, refits and comparison of one enrichment.
+/// The enrichment's sensitivities at "off" (`f_off` its predictions there).
+/// When "off" reproduces the base fit's predictions, the base columns are
+/// the base model's sensitivities at its optimum, already computed
+/// (`ctx.base_jac`), and only the effect's own columns are differenced,
+/// through `f_off` (forward differences for an expensive model).
+fn sensitivities_at_off(
+    rich: &dyn ForwardModel,
+    off: &[f64],
+    f_off: &[f64],
+    ctx: &Context<'_>,
+) -> Result<DMatrix<f64>, GapError> {
+    let p = ctx.p;
+    let m = off.len();
+    let scale = ctx
+        .base_full
+        .predicted
+        .iter()
+        .fold(0.0f64, |a, v| a.max(v.abs()));
+    let reproduces = f_off
+        .iter()
+        .zip(&ctx.base_full.predicted)
+        .all(|(a, b)| (a - b).abs() <= 1e-12 * scale);
+    match ctx.base_jac {
+        Some(base_jac) if reproduces && base_jac.ncols() == p => {
+            let wanted: Vec<bool> = (0..m).map(|j| j >= p).collect();
+            let mut jac =
+                sensitivities_at(rich, off, ctx.loading, &wanted, Some(f_off), ctx.expensive)?;
+            jac.columns_mut(0, p).copy_from(base_jac);
+            Ok(jac)
+        }
+        _ => Ok(sensitivities_at(
+            rich,
+            off,
+            ctx.loading,
+            &vec![true; m],
+            Some(f_off),
+            ctx.expensive,
+        )?),
+    }
+}
+
+/// Score test, refits and comparison of one enrichment; `f_off` are its
+/// predictions at "off" (the base optimum embedded).
 pub(crate) fn assess(
     effect: Effect,
     rich: Arc<dyn ForwardModel>,
+    f_off: &[f64],
     ctx: &Context<'_>,
 ) -> Result<Assessed, GapError> {
     let (n, p) = (ctx.observed.len(), ctx.p);
     let specs = rich.space().params.clone();
     let q = specs.len() - p;
     let off = embed(rich.as_ref(), &ctx.base_theta);
-    let jac = sensitivities(rich.as_ref(), &off, ctx.loading)?;
+    let jac = sensitivities_at_off(rich.as_ref(), &off, f_off, ctx)?;
     let at_lower: Vec<bool> = (p..specs.len()).map(|j| off[j] <= specs[j].lower).collect();
     let at_upper: Vec<bool> = (p..specs.len()).map(|j| off[j] >= specs[j].upper).collect();
     let score = score_test(&ctx.base_residual, &jac, p, ctx.sigma, &at_lower, &at_upper);
@@ -180,6 +227,7 @@ pub(crate) fn assess(
         &full,
         &cv_starts,
         &[],
+        None,
     )?;
 
     let r_after = residuals(ctx.observed, &full.predicted);

@@ -1,10 +1,11 @@
 //! The base model's fit: the model as a shared proxy the calibration can
 //! own, its fit to the whole record and its held-out predictions.
 
-use super::crossval::{cross_validate_by, Folds};
+use super::crossval::{cross_validate_by, optimum_sensitivities, Folds};
 use super::fit::{fit_from_starts, Fitted};
 use super::starts::base_starts;
 use super::GapError;
+use nalgebra::DMatrix;
 use palpate_core::enrichable::{effects_of, embed, enrich};
 use palpate_core::{Effect, ForwardModel, Loading};
 use std::sync::Arc;
@@ -16,7 +17,11 @@ type Proxy = (Arc<dyn ForwardModel>, Vec<(String, f64)>);
 /// its enrichments with the effect's own parameters held at "off", which
 /// reproduces the base exactly. Preference goes to enrichments that need
 /// nothing from the history (zero offset, tool compliance, ...).
-fn base_proxy(base: &dyn ForwardModel, loading: &Loading) -> Result<Proxy, GapError> {
+fn base_proxy(
+    base: &dyn ForwardModel,
+    loading: &Loading,
+    want: Option<Vec<f64>>,
+) -> Result<Proxy, GapError> {
     let order = [
         Effect::ZeroOffset,
         Effect::ToolCompliance,
@@ -27,7 +32,10 @@ fn base_proxy(base: &dyn ForwardModel, loading: &Loading) -> Result<Proxy, GapEr
     let offered = effects_of(base);
     let p = base.space().len();
     let theta0 = base.space().initial();
-    let want = base.predict(&theta0, loading)?;
+    let want = match want {
+        Some(f) => f,
+        None => base.predict(&theta0, loading)?,
+    };
     for effect in order.iter().chain(offered.iter()) {
         if !offered.contains(effect) {
             continue;
@@ -66,6 +74,11 @@ pub(crate) struct BaseFit {
     pub theta: Vec<f64>,
     /// Held-out predictions (cross-validation).
     pub cv: Vec<f64>,
+    /// The sensitivities of the base parameters at the optimum (first `p`
+    /// columns), when the cross-validation computed them (linearised): the
+    /// candidates whose "off" point reproduces the base reuse them for
+    /// their score test.
+    pub jac: Option<DMatrix<f64>>,
 }
 
 /// Fits the base model to all samples and cross-validates it. An expensive
@@ -79,11 +92,9 @@ pub(crate) fn fit_base(
     linearised: bool,
 ) -> Result<BaseFit, GapError> {
     let p = base.space().len();
-    let (model, fixed) = base_proxy(base, loading)?;
-    let starts: Vec<Vec<f64>> = base_starts(base, loading, observed)
-        .iter()
-        .map(|s| embed(model.as_ref(), s))
-        .collect();
+    let (starts, f0) = base_starts(base, loading, observed);
+    let (model, fixed) = base_proxy(base, loading, f0)?;
+    let starts: Vec<Vec<f64>> = starts.iter().map(|s| embed(model.as_ref(), s)).collect();
     let expensive = base.expensive();
     let mut fitted = fit_from_starts(
         &model,
@@ -101,8 +112,31 @@ pub(crate) fn fit_base(
     let theta = full.theta[..p].to_vec();
     let mut cv_starts = vec![full.theta.clone()];
     cv_starts.extend(starts.iter().cloned());
+    let jac = if linearised {
+        Some(optimum_sensitivities(
+            model.as_ref(),
+            loading,
+            &full,
+            &fixed,
+        )?)
+    } else {
+        None
+    };
     let cv = cross_validate_by(
-        linearised, &model, loading, observed, folds, &full, &cv_starts, &fixed,
+        linearised,
+        &model,
+        loading,
+        observed,
+        folds,
+        &full,
+        &cv_starts,
+        &fixed,
+        jac.as_ref(),
     )?;
-    Ok(BaseFit { full, theta, cv })
+    Ok(BaseFit {
+        full,
+        theta,
+        cv,
+        jac: jac.map(|(_, j)| j.columns(0, p).into_owned()),
+    })
 }

@@ -4,7 +4,7 @@
 
 use super::fit::{fit_from_starts, Fitted};
 use super::residual::residuals;
-use super::score::sensitivities_of;
+use super::score::sensitivities_at;
 use super::{FoldLayout, GapError};
 use nalgebra::DMatrix;
 use palpate_core::{ForwardModel, Loading};
@@ -216,19 +216,14 @@ fn cross_validate(
 /// parameter from the step (it stays at its optimum), as a bounded refit would.
 fn cross_validate_linearised(
     model: &dyn ForwardModel,
-    loading: &Loading,
     observed: &[f64],
     folds: &Folds,
     fitted: &Fitted,
-    fixed: &[(String, f64)],
+    free: &[bool],
+    jac: &DMatrix<f64>,
 ) -> Result<Vec<f64>, GapError> {
     let n = observed.len();
     let specs = &model.space().params;
-    let free: Vec<bool> = specs
-        .iter()
-        .map(|s| !fixed.iter().any(|(name, _)| *name == s.name))
-        .collect();
-    let jac = sensitivities_of(model, &fitted.theta, loading, &free)?;
     let r = residuals(observed, &fitted.predicted);
     let mut out = fitted.predicted.clone();
     for f in 0..folds.count {
@@ -276,7 +271,35 @@ fn cross_validate_linearised(
     Ok(out)
 }
 
-/// Held-out predictions by the strategy the options and the model's cost select.
+/// The sensitivities of the free parameters (those not in `fixed`) at a
+/// fit's optimum, reusing its predictions there; forward differences for an
+/// expensive model (one evaluation per free parameter).
+pub(crate) fn optimum_sensitivities(
+    model: &dyn ForwardModel,
+    loading: &Loading,
+    fitted: &Fitted,
+    fixed: &[(String, f64)],
+) -> Result<(Vec<bool>, DMatrix<f64>), GapError> {
+    let free: Vec<bool> = model
+        .space()
+        .params
+        .iter()
+        .map(|s| !fixed.iter().any(|(name, _)| *name == s.name))
+        .collect();
+    let jac = sensitivities_at(
+        model,
+        &fitted.theta,
+        loading,
+        &free,
+        Some(&fitted.predicted),
+        model.expensive(),
+    )?;
+    Ok((free, jac))
+}
+
+/// Held-out predictions by the strategy the options and the model's cost
+/// select. The linearised form uses `jac`, the sensitivities at the optimum
+/// (from [`optimum_sensitivities`]), when the caller has them.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn cross_validate_by(
     linearised: bool,
@@ -287,9 +310,18 @@ pub(crate) fn cross_validate_by(
     fitted: &Fitted,
     starts: &[Vec<f64>],
     fixed: &[(String, f64)],
+    jac: Option<&(Vec<bool>, DMatrix<f64>)>,
 ) -> Result<Vec<f64>, GapError> {
     if linearised {
-        cross_validate_linearised(model.as_ref(), loading, observed, folds, fitted, fixed)
+        let owned;
+        let (free, jac) = match jac {
+            Some(j) => j,
+            None => {
+                owned = optimum_sensitivities(model.as_ref(), loading, fitted, fixed)?;
+                &owned
+            }
+        };
+        cross_validate_linearised(model.as_ref(), observed, folds, fitted, free, jac)
     } else {
         cross_validate(model, loading, observed, folds, starts, fixed)
     }

@@ -117,18 +117,19 @@ pub fn diagnose(
             .collect(),
         None => effects_of(base),
     };
-    let mut enriched: Vec<(Effect, Arc<dyn ForwardModel>)> = Vec::new();
-    for e in effects {
-        if let Ok(rich) = enrich(base, e) {
-            // Skip enrichments that cannot run on this history (e.g. no time for QLV).
-            if rich
+    // Each enrichment's predictions at "off": enrichments that cannot run
+    // on this history (e.g. no time for QLV) are skipped, the others reuse
+    // them in their score test.
+    let enriched: Vec<(Effect, Arc<dyn ForwardModel>, Vec<f64>)> = effects
+        .into_par_iter()
+        .filter_map(|e| {
+            let rich: Arc<dyn ForwardModel> = Arc::from(enrich(base, e).ok()?);
+            let f_off = rich
                 .predict(&embed(rich.as_ref(), &base_theta), loading)
-                .is_ok()
-            {
-                enriched.push((e, Arc::from(rich)));
-            }
-        }
-    }
+                .ok()?;
+            Some((e, rich, f_off))
+        })
+        .collect();
     let ctx = Context {
         loading,
         observed,
@@ -140,6 +141,7 @@ pub fn diagnose(
         base_full: &base_fit.full,
         base_cv: base_fit.cv.clone(),
         base_residual: base_residual.clone(),
+        base_jac: base_fit.jac.as_ref(),
         candidates: enriched.len(),
         alpha: options.alpha,
         rel_var_sd2: noise.rel_var_sd2,
@@ -150,7 +152,7 @@ pub fn diagnose(
     // Candidates are independent: assessed in parallel, collected in order.
     let outcomes: Vec<(Effect, Result<Assessed, GapError>)> = enriched
         .into_par_iter()
-        .map(|(e, rich)| (e, assess(e, rich, &ctx)))
+        .map(|(e, rich, f_off)| (e, assess(e, rich, &f_off, &ctx)))
         .collect();
     let mut assessed = Vec::new();
     let mut failed = Vec::new();

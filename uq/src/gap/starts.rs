@@ -8,21 +8,23 @@ use rayon::prelude::*;
 
 /// Starting points of the base fit: the space's initial values, and the same
 /// with every modulus ([`ParamRole::Modulus`]) scaled by the least-squares
-/// factor <f0, y>/<f0, f0> (exact for laws linear in their moduli).
+/// factor <f0, y>/<f0, f0> (exact for laws linear in their moduli); and the
+/// prediction f0 at the initial values when it could be made.
 pub(crate) fn base_starts(
     base: &dyn ForwardModel,
     loading: &Loading,
     observed: &[f64],
-) -> Vec<Vec<f64>> {
+) -> (Vec<Vec<f64>>, Option<Vec<f64>>) {
     let theta0 = base.space().initial();
     let mut starts = Vec::new();
-    if let Ok(f0) = base.predict(&theta0, loading) {
-        if let Some((_, scaled)) = scale_moduli(&base.space().params, &theta0, &f0, observed) {
+    let f0 = base.predict(&theta0, loading).ok();
+    if let Some(f0) = &f0 {
+        if let Some((_, scaled)) = scale_moduli(&base.space().params, &theta0, f0, observed) {
             starts.push(scaled);
         }
     }
     starts.push(theta0);
-    starts
+    (starts, f0)
 }
 
 /// Extra starts for the new parameters of an enrichment: its time constants
