@@ -172,7 +172,12 @@ pub fn gap_summary(r: &GapReport) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "verdict: {}", r.verdict);
     if !r.confounded.is_empty() {
-        let _ = writeln!(s, "cannot be told apart from: {}", r.confounded.join(", "));
+        let names: Vec<&str> = r.confounded.iter().map(|e| e.name()).collect();
+        let _ = writeln!(s, "cannot be told apart from: {}", names.join(", "));
+    }
+    if !r.immaterial.is_empty() {
+        let names: Vec<&str> = r.immaterial.iter().map(|e| e.name()).collect();
+        let _ = writeln!(s, "detectable but immaterial: {}", names.join(", "));
     }
     let _ = writeln!(
         s,
@@ -201,6 +206,29 @@ pub fn gap_summary(r: &GapReport) -> String {
             e.heldout_before,
             e.heldout_after,
             e.identifiable
+        );
+    }
+    for u in &r.undetectable {
+        let moves: Vec<String> = u
+            .base_params
+            .iter()
+            .map(|(k, v)| {
+                format!(
+                    "{k} {:.4e} .. {:.4e} ({:+.1} %)",
+                    v[0],
+                    v[1],
+                    100.0 * u.relative_shift[k]
+                )
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "not seen: {} with {} in [{}, {}] would move {}",
+            u.effect,
+            u.param,
+            u.range[0],
+            u.range[1],
+            moves.join(", ")
         );
     }
     let _ = write!(s, "{}", r.explanation);

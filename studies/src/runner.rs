@@ -551,11 +551,12 @@ fn run_diagnose(run: &Run, step: &DiagnoseStep, report: &mut String) -> anyhow::
                 if gap.confounded.is_empty() {
                     String::new()
                 } else {
-                    format!(" (confounded with {})", gap.confounded.join(", "))
+                    let names: Vec<&str> = gap.confounded.iter().map(|e| e.name()).collect();
+                    format!(" (confounded with {})", names.join(", "))
                 },
                 gap.noise_sd,
                 gap.base.misfit,
-                best.map(|b| b.effect.clone()).unwrap_or_default(),
+                best.map(|b| b.effect.to_string()).unwrap_or_default(),
                 best.map(|b| format!("{:.4}", b.misfit_after))
                     .unwrap_or_default(),
                 best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))

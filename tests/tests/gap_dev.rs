@@ -309,11 +309,11 @@ fn a_series_spring_and_relaxation_on_a_single_ramp_are_reported_as_confounded() 
         "confounded: {:?}",
         r.confounded
     );
-    let best = entry(&r, &r.verdict);
+    let best = entry(&r, r.verdict.as_str());
     assert!(!best.identifiable && best.confounded_with.iter().any(|e| e == other));
     // Locally the two act on nearly the same direction of the prediction.
     assert!(
-        best.sensitivity_overlap[other] > 0.95,
+        best.sensitivity_overlap[&other.parse::<palpate_core::Effect>().unwrap()] > 0.95,
         "{:?}",
         best.sensitivity_overlap
     );

@@ -5,7 +5,7 @@ use crate::convert::{check_law_params, check_loading, law_space, split};
 use palpate_core::enrichable::not_applicable;
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
-    ParamSpace, ParamSpec,
+    ParamRole, ParamSpace, ParamSpec,
 };
 use palpate_enrich::{wrap, WRAPPER_EFFECTS};
 use palpate_material::{homogeneous, Law};
@@ -39,7 +39,9 @@ impl Compressible {
     pub fn with_geometry(law: Law, geometry: C1Geometry) -> Self {
         let base = law_space(&law);
         let law_space_len = base.len();
-        let space = base.extended(&[ParamSpec::new("D1", "1/MPa", 0.0, f64::INFINITY, 1.0)]);
+        let space = base
+            .extended(&[ParamSpec::new("D1", "1/MPa", 0.0, f64::INFINITY, 1.0)
+                .with_role(ParamRole::Compliance)]);
         Compressible {
             law,
             geometry,

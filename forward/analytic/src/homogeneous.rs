@@ -7,8 +7,12 @@ use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
-use palpate_enrich::{richer_law, MaterialForm, Viscoelastic, DEFAULT_PRONY_TERMS};
+use palpate_enrich::{
+    richer_law, MaterialForm, TensionCompressionAsymmetry, Viscoelastic, ZeroOffset,
+    DEFAULT_PRONY_TERMS,
+};
 use palpate_material::{homogeneous, Law};
+use std::sync::Arc;
 
 /// Nominal (first Piola-Kirchhoff) stress along the loading direction of a
 /// homogeneous incompressible test, in MPa, against the principal stretch.
@@ -105,6 +109,8 @@ impl Enrichable for Homogeneous {
             e.push(Effect::MaterialForm);
         }
         e.push(Effect::Viscoelasticity);
+        e.push(Effect::ZeroOffset);
+        e.push(Effect::TensionCompressionAsymmetry);
         e
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
@@ -123,6 +129,10 @@ impl Enrichable for Homogeneous {
                 Box::new(self.clone()),
                 DEFAULT_PRONY_TERMS,
             ))),
+            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::on_stretch(Arc::new(self.clone())))),
+            Effect::TensionCompressionAsymmetry => Ok(Box::new(
+                TensionCompressionAsymmetry::from_arc(Arc::new(self.clone())),
+            )),
             _ => Err(not_applicable(effect, &self.name())),
         }
     }

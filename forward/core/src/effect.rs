@@ -20,11 +20,16 @@ pub enum Effect {
     BoundaryCondition,
     ToolCompliance,
     Inclusion,
+    /// Different stiffness in compression and in tension (bimodular
+    /// response, e.g. brain tissue; Budday et al. 2017): only visible in a
+    /// record that spans both.
+    TensionCompressionAsymmetry,
 }
 
 impl Effect {
-    /// Every effect, in the order of `GAP.md`.
-    pub const ALL: [Effect; 9] = [
+    /// Every effect, in the order of `GAP.md` (then the homogeneous-test
+    /// effect `tension_compression_asymmetry`).
+    pub const ALL: [Effect; 10] = [
         Effect::MaterialForm,
         Effect::Viscoelasticity,
         Effect::ZeroOffset,
@@ -34,6 +39,7 @@ impl Effect {
         Effect::BoundaryCondition,
         Effect::ToolCompliance,
         Effect::Inclusion,
+        Effect::TensionCompressionAsymmetry,
     ];
 
     /// Canonical snake-case name.
@@ -48,13 +54,26 @@ impl Effect {
             Effect::BoundaryCondition => "boundary_condition",
             Effect::ToolCompliance => "tool_compliance",
             Effect::Inclusion => "inclusion",
+            Effect::TensionCompressionAsymmetry => "tension_compression_asymmetry",
         }
+    }
+}
+
+impl PartialEq<str> for Effect {
+    fn eq(&self, other: &str) -> bool {
+        self.name() == other
+    }
+}
+
+impl PartialEq<&str> for Effect {
+    fn eq(&self, other: &&str) -> bool {
+        self.name() == *other
     }
 }
 
 impl fmt::Display for Effect {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.name())
+        f.pad(self.name())
     }
 }
 

@@ -34,4 +34,4 @@ pub use enrichable::Enrichable;
 pub use error::ForwardError;
 pub use loading::{Drive, Loading, Observable, Output};
 pub use model::{check_output_slots, Evaluator, ForwardModel, ModelExt};
-pub use param::{ParamSpace, ParamSpec, Transform};
+pub use param::{ParamRole, ParamSpace, ParamSpec, Transform};

@@ -21,6 +21,34 @@ pub enum Transform {
     Logit,
 }
 
+/// What a parameter does in its model, for consumers that treat parameters
+/// by kind rather than by name (the gap diagnosis rescales the moduli,
+/// starts time constants across the record's duration, orders Prony terms by
+/// their time constant). The model that declares the parameter sets it; the
+/// default is [`ParamRole::Other`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", tag = "kind")]
+pub enum ParamRole {
+    /// An elastic modulus: the response is proportional to it when it is the
+    /// only modulus (e.g. C10 of neo-Hookean under prescribed displacement).
+    Modulus,
+    /// A dimensionless shape parameter of a law (Ogden alpha, Arruda-Boyce N).
+    Shape,
+    /// The weight g_i of Prony term `term` (1-based) of a relaxation function.
+    RelaxationWeight { term: usize },
+    /// The time constant tau_i (s) of Prony term `term` (1-based).
+    TimeConstant { term: usize },
+    /// A shift of the drive's zero (e.g. the contact point d0).
+    Offset,
+    /// A compliance that is zero in the stiff limit (1/K, series compliance).
+    Compliance,
+    /// A friction coefficient.
+    Friction,
+    /// Anything else.
+    #[default]
+    Other,
+}
+
 /// One named parameter.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct ParamSpec {
@@ -34,6 +62,20 @@ pub struct ParamSpec {
     pub upper: f64,
     /// A sensible starting value inside the bounds.
     pub initial: f64,
+    /// What the parameter does in its model.
+    #[serde(default, skip_serializing_if = "is_other")]
+    pub role: ParamRole,
+    /// For the parameter of an effect (`Enrichable`): the range of values it
+    /// plausibly takes in practice, narrower than the bounds (e.g. friction
+    /// 0 to 0.8 against bounds 0 to 2). The gap diagnosis refits the base
+    /// model with the effect held at the ends of this range to show how far
+    /// an effect the data cannot see would move the base parameters.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plausible: Option<(f64, f64)>,
+}
+
+fn is_other(r: &ParamRole) -> bool {
+    *r == ParamRole::Other
 }
 
 impl ParamSpec {
@@ -51,7 +93,26 @@ impl ParamSpec {
             lower,
             upper,
             initial,
+            role: ParamRole::Other,
+            plausible: None,
         }
+    }
+
+    /// The same parameter with its role.
+    pub fn with_role(mut self, role: ParamRole) -> Self {
+        self.role = role;
+        self
+    }
+
+    /// The same parameter with a plausible range (see [`ParamSpec::plausible`]).
+    pub fn with_plausible(mut self, lower: f64, upper: f64) -> Self {
+        self.plausible = Some((lower, upper));
+        self
+    }
+
+    /// Whether the parameter is an elastic modulus.
+    pub fn is_modulus(&self) -> bool {
+        self.role == ParamRole::Modulus
     }
 
     /// The transform implied by the bounds.

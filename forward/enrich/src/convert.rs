@@ -1,7 +1,7 @@
 //! Small shared helpers: material parameters as a [`ParamSpace`], and the
 //! split of a wrapper's parameter vector.
 
-use palpate_core::{ForwardError, ParamSpace, ParamSpec};
+use palpate_core::{ForwardError, ParamRole, ParamSpace, ParamSpec};
 use palpate_material::Law;
 
 /// The law's parameters (names, units, bounds, starting values) as a space.
@@ -9,7 +9,15 @@ pub fn law_space(law: &Law) -> ParamSpace {
     ParamSpace::new(
         law.params()
             .into_iter()
-            .map(|m| ParamSpec::new(m.name, m.unit, m.lower, m.upper, m.initial))
+            .map(|m| {
+                ParamSpec::new(m.name, m.unit, m.lower, m.upper, m.initial).with_role(
+                    if m.modulus {
+                        ParamRole::Modulus
+                    } else {
+                        ParamRole::Shape
+                    },
+                )
+            })
             .collect(),
     )
 }

@@ -9,6 +9,7 @@
 //! * [`Viscoelastic`] — quasi-linear viscoelasticity (Fung) with a Prony
 //!   series applied to the wrapped model's prediction (exact for homogeneous
 //!   tests, the usual force-level approximation for a structure);
+//! * [`TensionCompressionAsymmetry`] — a bimodular homogeneous response;
 //! * [`MaterialForm`] with [`richer_law`] — the next richer law of the same
 //!   family, with the "off" point that reproduces the base law.
 //!
@@ -39,6 +40,7 @@
 //! # Ok::<(), palpate_core::ForwardError>(())
 //! ```
 
+mod asymmetry;
 mod convert;
 mod material_form;
 mod tool_compliance;
@@ -46,6 +48,7 @@ mod viscoelastic;
 mod wrap;
 mod zero_offset;
 
+pub use asymmetry::TensionCompressionAsymmetry;
 pub use convert::law_space;
 pub use material_form::{richer_law, MaterialForm, RicherLaw};
 pub use tool_compliance::ToolCompliance;

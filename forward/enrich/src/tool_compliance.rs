@@ -5,7 +5,7 @@ use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
     Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
-    ParamSpace, ParamSpec,
+    ParamRole, ParamSpace, ParamSpec,
 };
 use std::sync::Arc;
 
@@ -49,7 +49,8 @@ impl ToolCompliance {
             0.0,
             f64::INFINITY,
             1e-3,
-        )]);
+        )
+        .with_role(ParamRole::Compliance)]);
         ToolCompliance { base, space }
     }
 }

@@ -4,7 +4,7 @@ use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
     check_output_slots, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading,
-    Observable, Output, ParamSpace, ParamSpec,
+    Observable, Output, ParamRole, ParamSpace, ParamSpec,
 };
 use std::sync::Arc;
 
@@ -46,14 +46,20 @@ impl Viscoelastic {
     pub fn from_arc(base: Arc<dyn ForwardModel>, terms: usize) -> Self {
         let mut own = Vec::with_capacity(2 * terms);
         for i in 1..=terms {
-            own.push(ParamSpec::new(format!("g{i}"), "1", 0.0, 1.0, 0.1));
-            own.push(ParamSpec::new(
-                format!("tau{i}_s"),
-                "s",
-                0.0,
-                f64::INFINITY,
-                Self::default_tau(i),
-            ));
+            own.push(
+                ParamSpec::new(format!("g{i}"), "1", 0.0, 1.0, 0.1)
+                    .with_role(ParamRole::RelaxationWeight { term: i }),
+            );
+            own.push(
+                ParamSpec::new(
+                    format!("tau{i}_s"),
+                    "s",
+                    0.0,
+                    f64::INFINITY,
+                    Self::default_tau(i),
+                )
+                .with_role(ParamRole::TimeConstant { term: i }),
+            );
         }
         let space = base.space().extended(&own);
         Viscoelastic { base, terms, space }

@@ -5,7 +5,7 @@ use crate::convert::split;
 use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
     Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
-    ParamSpace, ParamSpec,
+    ParamRole, ParamSpace, ParamSpec,
 };
 use std::borrow::Cow;
 use std::sync::Arc;
@@ -21,6 +21,23 @@ pub struct ZeroOffset {
     space: ParamSpace,
 }
 
+/// The offset of a displacement drive: `d0_mm` in [-5, 5] mm, plausibly
+/// within 0.1 mm of the recorded zero.
+fn displacement_offset() -> ParamSpec {
+    ParamSpec::new("d0_mm", "mm", -5.0, 5.0, 0.0)
+        .with_role(ParamRole::Offset)
+        .with_plausible(-0.1, 0.1)
+}
+
+/// The offset of a stretch drive (homogeneous tests): `d0_stretch` in
+/// [-0.5, 0.5], the true stretch being the recorded one minus it (a zero of
+/// displacement off by d0_stretch x the gauge length), plausibly within 0.02.
+fn stretch_offset() -> ParamSpec {
+    ParamSpec::new("d0_stretch", "1", -0.5, 0.5, 0.0)
+        .with_role(ParamRole::Offset)
+        .with_plausible(-0.02, 0.02)
+}
+
 impl ZeroOffset {
     /// Zero offset around `base` (a displacement-driven model).
     pub fn new(base: Box<dyn ForwardModel>) -> Self {
@@ -29,9 +46,17 @@ impl ZeroOffset {
 
     /// Same, sharing the base model.
     pub fn from_arc(base: Arc<dyn ForwardModel>) -> Self {
-        let space = base
-            .space()
-            .extended(&[ParamSpec::new("d0_mm", "mm", -5.0, 5.0, 0.0)]);
+        Self::with_spec(base, displacement_offset())
+    }
+
+    /// Zero offset of the stretch around a stretch-driven model (homogeneous
+    /// tests): lambda = recorded - d0_stretch.
+    pub fn on_stretch(base: Arc<dyn ForwardModel>) -> Self {
+        Self::with_spec(base, stretch_offset())
+    }
+
+    fn with_spec(base: Arc<dyn ForwardModel>, spec: ParamSpec) -> Self {
+        let space = base.space().extended(&[spec]);
         ZeroOffset { base, space }
     }
 }
@@ -106,7 +131,8 @@ impl Enrichable for ZeroOffset {
         wrapper_effects(self.base.as_ref(), Effect::ZeroOffset)
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        let this = Arc::new(ZeroOffset::from_arc(self.base.clone()));
+        let spec = self.space.params[self.space.len() - 1].clone();
+        let this = Arc::new(ZeroOffset::with_spec(self.base.clone(), spec));
         enrich_wrapper(this, self.base.as_ref(), Effect::ZeroOffset, effect)
     }
     /// Base parameters, then d0 = 0.

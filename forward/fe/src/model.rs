@@ -4,7 +4,7 @@
 //! conversion of solver failures into [`ForwardError`].
 
 use palpate_core::{
-    check_output_slots, Drive, Evaluator, ForwardError, Loading, ParamSpace, ParamSpec,
+    check_output_slots, Drive, Evaluator, ForwardError, Loading, ParamRole, ParamSpace, ParamSpec,
 };
 use palpate_material::{Law, Volumetric};
 
@@ -47,7 +47,15 @@ pub fn law_space(law: &Law) -> ParamSpace {
     ParamSpace::new(
         law.params()
             .into_iter()
-            .map(|p| ParamSpec::new(p.name, p.unit, p.lower, p.upper, p.initial))
+            .map(|p| {
+                ParamSpec::new(p.name, p.unit, p.lower, p.upper, p.initial).with_role(
+                    if p.modulus {
+                        ParamRole::Modulus
+                    } else {
+                        ParamRole::Shape
+                    },
+                )
+            })
             .collect(),
     )
 }

@@ -20,8 +20,8 @@
 //!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
 
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
-    ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole,
+    ParamSpace, ParamSpec,
 };
 use palpate_enrich::{richer_law, MaterialForm, ZeroOffset};
 use palpate_material::Law;
@@ -408,13 +408,16 @@ impl Enrichable for N1Needle {
             Effect::Friction if !self.friction_is_parameter => {
                 let mut m = self.clone();
                 m.friction_is_parameter = true;
+                // plausible range: a lubricated to a dry needle in soft tissue
                 m.space = self.space.extended(&[ParamSpec::new(
                     "friction",
                     "1",
                     0.0,
                     2.0,
                     self.friction,
-                )]);
+                )
+                .with_role(ParamRole::Friction)
+                .with_plausible(0.0, 0.8)]);
                 Ok(Box::new(m))
             }
             Effect::BoundaryCondition if self.base == Base::Bonded => {

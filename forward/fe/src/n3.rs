@@ -14,8 +14,8 @@
 //! facets. Effects: `friction` (a parameter, 0..2) and `zero_offset`.
 
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace,
-    ParamSpec,
+    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole,
+    ParamSpace, ParamSpec,
 };
 use palpate_enrich::ZeroOffset;
 use palpate_material::Law;
@@ -355,13 +355,16 @@ impl Enrichable for N3Needle {
             Effect::Friction if !self.friction_is_parameter => {
                 let mut m = self.clone();
                 m.friction_is_parameter = true;
+                // plausible range: a lubricated to a dry needle in soft tissue
                 m.space = self.space.extended(&[ParamSpec::new(
                     "friction",
                     "1",
                     0.0,
                     2.0,
                     self.friction,
-                )]);
+                )
+                .with_role(ParamRole::Friction)
+                .with_plausible(0.0, 0.8)]);
                 Ok(Box::new(m))
             }
             Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(self.clone())))),

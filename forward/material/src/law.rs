@@ -57,6 +57,9 @@ pub struct MaterialParam {
     pub upper: f64,
     /// Starting value inside the bounds.
     pub initial: f64,
+    /// Whether the strain energy is linear in this parameter (a modulus: C_ij, mu, mu_i; every
+    /// parameter in MPa), as opposed to a shape parameter (`lambda_m`, `alpha_i`).
+    pub modulus: bool,
 }
 
 impl MaterialParam {
@@ -73,6 +76,7 @@ impl MaterialParam {
             lower,
             upper,
             initial,
+            modulus: unit == "MPa",
         }
     }
 }

@@ -95,11 +95,11 @@ impl ForwardModel for Masked {
 fn gap_lm_options(expensive: bool) -> LmOptions {
     if expensive {
         LmOptions {
-            ftol: 1e-7,
-            xtol: 1e-6,
+            ftol: 1e-6,
+            xtol: 1e-5,
             gtol: 1e-8,
-            max_evaluations: 200,
-            max_iterations: 30,
+            max_evaluations: 120,
+            max_iterations: 20,
             ..LmOptions::default()
         }
     } else {
@@ -132,7 +132,7 @@ pub(crate) fn scale_moduli(
         let scaled = specs
             .iter()
             .zip(theta)
-            .map(|(s, v)| if s.unit == "MPa" { v * a } else { *v })
+            .map(|(s, v)| if s.is_modulus() { v * a } else { *v })
             .collect();
         (a, scaled)
     })
@@ -259,7 +259,13 @@ pub(crate) fn fit_from_starts(
         }
     };
     let theta = report.theta();
-    let predicted = model.predict(&theta, loading)?;
+    // On the whole record the fit's own predictions at the optimum are the
+    // record's (one model evaluation saved per fit); with samples left out
+    // the left-out ones need a prediction.
+    let predicted = match (keep, report.sets.first()) {
+        (None, Some(set)) if set.predicted.len() == observed.len() => set.predicted.clone(),
+        _ => model.predict(&theta, loading)?,
+    };
     let sse = match keep {
         None => predicted
             .iter()

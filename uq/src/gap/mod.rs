@@ -22,21 +22,31 @@
 //! 4. **Verdict**: `none` when the base misfit is consistent with noise or no
 //!    effect earns its parameters; else the best effect that does.
 
+mod assess;
+mod base;
+mod crossval;
 mod diagnose;
 mod error;
 mod fit;
 pub mod noise;
 mod options;
 pub mod profile;
+mod rank;
 mod report;
+mod residual;
 pub mod score;
+mod starts;
 pub mod structure;
+mod undetectable;
+mod verdict;
 
 pub use diagnose::diagnose;
 pub use error::GapError;
 pub use noise::{difference_noise_sd, NoiseEstimate};
-pub use options::{CrossValidation, GapOptions};
+pub use options::{CrossValidation, FoldLayout, GapOptions};
 pub use profile::ProfileInterval;
-pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, RankedEffect};
+pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, PracticalSize, RankedEffect};
 pub use score::{score_test, sensitivities, ScoreTest};
 pub use structure::{discrepancy_band, significant_windows, whiteness, GapWindow, WhitenessTests};
+pub use undetectable::Undetectable;
+pub use verdict::{PartlyExplained, Verdict};

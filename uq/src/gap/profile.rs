@@ -72,7 +72,7 @@ fn profile_sse(
         let others_scaled = specs
             .iter()
             .enumerate()
-            .any(|(k, s)| k != j && s.unit == "MPa");
+            .any(|(k, s)| k != j && s.is_modulus());
         let a = if others_scaled {
             scale_moduli(specs, &start, &f, observed).map_or(1.0, |(a, _)| a)
         } else {

@@ -5,6 +5,9 @@ use super::noise::NoiseEstimate;
 use super::profile::ProfileInterval;
 use super::score::ScoreTest;
 use super::structure::{GapWindow, WhitenessTests};
+use super::undetectable::Undetectable;
+use super::verdict::{PartlyExplained, Verdict};
+use palpate_core::Effect;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -12,8 +15,8 @@ use std::fmt::Write;
 /// One candidate effect, refitted (GAP.md `ranking` entry).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RankedEffect {
-    /// Canonical effect name.
-    pub effect: String,
+    /// The effect (serialised by its canonical name).
+    pub effect: Effect,
     /// The effect's own fitted parameters (physical units).
     pub params: BTreeMap<String, f64>,
     /// RMS residual of the base fit on the fitted samples (data unit).
@@ -35,14 +38,16 @@ pub struct RankedEffect {
     /// confounded with another effect.
     pub identifiable: bool,
     /// Effects whose fits the data cannot tell apart from this one.
-    pub confounded_with: Vec<String>,
+    pub confounded_with: Vec<Effect>,
     /// For every other candidate, the cosine of the smallest principal angle
     /// between the two effects' sensitivity directions at "off" (base
     /// directions removed): near 1, the two are locally indistinguishable.
-    pub sensitivity_overlap: BTreeMap<String, f64>,
+    pub sensitivity_overlap: BTreeMap<Effect, f64>,
     /// Whether the effect earns its parameters (significant likelihood ratio
     /// and held-out gain).
     pub earns: bool,
+    /// How much misfit it removes, beside the statistics of whether it removes any.
+    pub practical: PracticalSize,
     /// Enriched model name.
     pub model: String,
     /// Every parameter of the enriched fit.
@@ -72,10 +77,29 @@ pub struct RankedEffect {
     pub profile: Vec<ProfileInterval>,
 }
 
+/// The practical size of an effect, beside its statistical significance:
+/// a misfit can be detectable (many samples, slightly correlated noise) and
+/// still too small to matter.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct PracticalSize {
+    /// RMS misfit / noise SD of the base fit and of the enriched fit.
+    pub misfit_over_noise_before: f64,
+    pub misfit_over_noise_after: f64,
+    /// Share of the excess mean-square misfit (above the noise variance)
+    /// the effect removes, (MS_before - MS_after) / (MS_before - sigma^2);
+    /// absent when the base misfit is not above the noise.
+    pub excess_explained: Option<f64>,
+    /// RMS of the systematic component the effect removes,
+    /// sqrt(MS_before - MS_after), in noise SDs.
+    pub removed_over_noise: f64,
+    /// Whether that reaches the materiality threshold (`GapOptions::materiality`).
+    pub material: bool,
+}
+
 /// A candidate whose refit could not be made (reported, not hidden).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct FailedCandidate {
-    pub effect: String,
+    pub effect: Effect,
     pub error: String,
 }
 
@@ -112,10 +136,11 @@ pub struct GapPlot {
     pub band_lower: Vec<f64>,
     pub band_upper: Vec<f64>,
     /// The best-ranked enrichment's fit and residuals.
-    pub enriched_effect: Option<String>,
+    pub enriched_effect: Option<Effect>,
     pub enriched_fit: Option<Vec<f64>>,
     pub enriched_residual: Option<Vec<f64>>,
-    /// Cross-validation blocks [first, end) of sample indices.
+    /// Cross-validation chunks [first, end) of sample indices, in order;
+    /// chunk k belongs to fold k mod `GapReport::folds`.
     pub folds: Vec<(usize, usize)>,
     /// Held-out (cross-validated) predictions of the base model.
     pub base_cv: Vec<f64>,
@@ -125,8 +150,8 @@ pub struct GapPlot {
 /// `ranking`, plus supporting fields).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct GapReport {
-    /// An effect name, or `none`.
-    pub verdict: String,
+    /// An effect, or `none` (serialised as GAP.md's string).
+    pub verdict: Verdict,
     /// Noise SD estimated from the data (data unit).
     pub noise_sd: f64,
     /// Windows of significant base misfit.
@@ -138,7 +163,21 @@ pub struct GapReport {
     pub failed: Vec<FailedCandidate>,
     /// Effects the data cannot tell apart from the verdict (empty when the
     /// verdict is clear).
-    pub confounded: Vec<String>,
+    pub confounded: Vec<Effect>,
+    /// Effects that earn their parameters (significant likelihood ratio and
+    /// cross-validated gain) but remove a systematic misfit below the
+    /// materiality threshold: "detectable but immaterial". When every earning
+    /// effect is immaterial the verdict is `none`.
+    #[serde(default)]
+    pub immaterial: Vec<Effect>,
+    /// Set when the verdict's effect leaves the misfit significantly above
+    /// the noise: the gap is only partly explained, by this much.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub partly_explained: Option<PartlyExplained>,
+    /// Effects not detected, held at the ends of their plausible range: how
+    /// far each would move the base parameters.
+    #[serde(default)]
+    pub undetectable: Vec<Undetectable>,
     /// One paragraph saying why.
     pub explanation: String,
     pub base: BaseSummary,
@@ -159,7 +198,23 @@ impl GapReport {
             let _ = writeln!(
                 s,
                 "\n**Cannot be told apart** from `{}` with these data.",
-                self.confounded.join("`, `")
+                names(&self.confounded).join("`, `")
+            );
+        }
+        if !self.immaterial.is_empty() {
+            let _ = writeln!(
+                s,
+                "\n**Detectable but immaterial**: `{}`.",
+                names(&self.immaterial).join("`, `")
+            );
+        }
+        if let Some(p) = &self.partly_explained {
+            let _ = writeln!(
+                s,
+                "\n**Only partly explained**: {:.0} % of the excess misfit removed, {:.2} -> {:.2} x noise.",
+                100.0 * p.excess_explained,
+                p.misfit_over_noise_before,
+                p.misfit_over_noise_after
             );
         }
         let _ = writeln!(s, "\n{}\n", self.explanation);
@@ -247,7 +302,7 @@ impl GapReport {
                 if r.confounded_with.is_empty() {
                     String::new()
                 } else {
-                    format!(" (confounded with {})", r.confounded_with.join(", "))
+                    format!(" (confounded with {})", names(&r.confounded_with).join(", "))
                 }
             );
         }
@@ -262,6 +317,50 @@ impl GapReport {
         for r in &self.ranking {
             let _ = writeln!(s, "- **{}**: {}", r.effect, r.evidence);
         }
+        if !self.undetectable.is_empty() {
+            let _ = writeln!(s, "\n## Effects the record cannot see\n");
+            let _ = writeln!(
+                s,
+                "The base model refitted with each undetected effect held at the ends of its plausible \
+                 range: the base parameters the record cannot be trusted for move this much.\n"
+            );
+            let _ = writeln!(
+                s,
+                "| effect | parameter | range | base parameters at the ends | misfit at the ends | p (LR vs base) |"
+            );
+            let _ = writeln!(s, "|---|---|---|---|---|---|");
+            for u in &self.undetectable {
+                let params: Vec<String> = u
+                    .base_params
+                    .iter()
+                    .map(|(k, v)| {
+                        format!(
+                            "{k}: {:.4e} -> {:.4e} ({:+.1} %)",
+                            v[0],
+                            v[1],
+                            100.0 * u.relative_shift[k]
+                        )
+                    })
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | [{}, {}] | {} | {:.3e}, {:.3e} | {:.2}, {:.2} |",
+                    u.effect,
+                    u.param,
+                    u.range[0],
+                    u.range[1],
+                    params.join("; "),
+                    u.misfit[0],
+                    u.misfit[1],
+                    u.p_value[0],
+                    u.p_value[1]
+                );
+            }
+        }
         s
     }
+}
+
+fn names(effects: &[Effect]) -> Vec<&'static str> {
+    effects.iter().map(|e| e.name()).collect()
 }

@@ -1,0 +1,161 @@
+//! Speed of the N1 gap diagnosis (issue 14, item 6: a 10 mm record in 60 s
+//! or less on 2 cores). Writes (once, to `target/bench_gap_n1.csv`) a 10 mm
+//! needle record every 0.25 mm (41 samples) with friction 0.5 on the MEDIUM
+//! mesh, C10 1.2e-3 MPa, noise 1 % of the peak force, then diagnoses it
+//! with the CLI's N1 base (neo-Hookean, frictionless, bonded, coarse mesh)
+//! and candidates (friction, boundary_condition), and prints the verdict,
+//! the number of FE simulations, wall and CPU seconds (user + system of the
+//! process, `/proc/self/stat`).
+//!
+//! `cargo run --release -p palpate-tests --example bench_gap_n1 [-- --effects friction,material_form]`
+
+use palpate_core::{
+    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
+    ParamSpace, Table,
+};
+use palpate_fe::{MeshDensity, N1Needle};
+use palpate_material::Law;
+use palpate_uq::gap::{diagnose, GapOptions};
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use std::fmt::Write;
+use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::Arc;
+use std::time::Instant;
+
+/// FE simulations made through [`Counted`].
+static RUNS: AtomicUsize = AtomicUsize::new(0);
+
+/// A model that counts its predictions, and whose enrichments do too.
+struct Counted(Arc<dyn ForwardModel>);
+
+struct CountedEval<'a>(Box<dyn Evaluator + 'a>);
+
+impl Evaluator for CountedEval<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        RUNS.fetch_add(1, Ordering::Relaxed);
+        self.0.predict_into(theta, loading, out)
+    }
+}
+
+impl ForwardModel for Counted {
+    fn name(&self) -> String {
+        self.0.name()
+    }
+    fn space(&self) -> &ParamSpace {
+        self.0.space()
+    }
+    fn observable(&self) -> Observable {
+        self.0.observable()
+    }
+    fn expensive(&self) -> bool {
+        self.0.expensive()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(CountedEval(self.0.evaluator()))
+    }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        Some(self)
+    }
+}
+
+impl Enrichable for Counted {
+    fn effects(&self) -> Vec<Effect> {
+        palpate_core::enrichable::effects_of(self.0.as_ref())
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        let rich = palpate_core::enrichable::enrich(self.0.as_ref(), effect)?;
+        Ok(Box::new(Counted(Arc::from(rich))))
+    }
+    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
+        palpate_core::enrichable::embed(self.0.as_ref(), base_theta)
+    }
+}
+
+/// User + system CPU seconds of this process.
+fn cpu_seconds() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let after = stat.rsplit(')').next().unwrap_or("");
+    let fields: Vec<&str> = after.split_whitespace().collect();
+    let ticks = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (ticks(11) + ticks(12)) / 100.0
+}
+
+fn record() -> (Loading, Vec<f64>) {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../target/bench_gap_n1.csv");
+    if !path.exists() {
+        let depths: Vec<f64> = (0..=40).map(|i| 0.25 * i as f64).collect();
+        let loading = Loading::quasi_static(Drive::DisplacementMm, depths.clone());
+        let mut m = N1Needle::new(Law::NeoHookean);
+        m.friction = 0.5;
+        m.mesh = MeshDensity::MEDIUM;
+        let f = m.predict(&[1.2e-3], &loading).expect("N1 record");
+        let peak = f.iter().cloned().fold(0.0, f64::max);
+        let noise = Normal::new(0.0, 0.01 * peak).expect("sd");
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(7);
+        let mut csv = String::from("displacement_mm,force_N\n");
+        for (d, v) in depths.iter().zip(&f) {
+            let _ = writeln!(csv, "{d},{:.6e}", v + noise.sample(&mut rng));
+        }
+        std::fs::write(&path, csv).expect("write record");
+    }
+    let t = Table::read(&path).expect("record");
+    let d = t.column("displacement_mm").unwrap().to_vec();
+    let f = t.column("force_N").unwrap().to_vec();
+    (Loading::quasi_static(Drive::DisplacementMm, d), f)
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let effects: Vec<Effect> = match args.iter().position(|a| a == "--effects") {
+        Some(k) => args[k + 1]
+            .split(',')
+            .map(|e| e.parse().expect("effect"))
+            .collect(),
+        None => vec![Effect::Friction, Effect::BoundaryCondition],
+    };
+    let (loading, f) = record();
+    let mut base = N1Needle::new(Law::NeoHookean);
+    base.friction = 0.0;
+    base.mesh = MeshDensity::COARSE;
+    let base = Counted(Arc::new(base));
+    let options = GapOptions {
+        effects: Some(effects.clone()),
+        ..GapOptions::default()
+    };
+    let (wall, cpu) = (Instant::now(), cpu_seconds());
+    let r = diagnose(&base, &loading, &f, &options).expect("diagnosis");
+    let (wall, cpu) = (wall.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+    let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
+    println!("| record | candidates | verdict | FE runs | wall s | CPU s (user+sys) | threads |");
+    println!("|---|---|---|---|---|---|---|");
+    println!(
+        "| N1 10 mm, 41 samples, friction 0.5 | {} | {} | {} | {wall:.1} | {cpu:.1} | {} |",
+        names.join(", "),
+        r.verdict,
+        RUNS.load(Ordering::Relaxed),
+        rayon::current_num_threads()
+    );
+    for e in &r.ranking {
+        println!(
+            "  {}: misfit {:.3e} -> {:.3e}, held-out {:.3e} -> {:.3e}, params {:?}",
+            e.effect, e.misfit_before, e.misfit_after, e.heldout_before, e.heldout_after, e.params
+        );
+    }
+    for u in &r.undetectable {
+        println!(
+            "  not seen: {} {:?} -> {:?}",
+            u.effect, u.range, u.base_params
+        );
+    }
+}
