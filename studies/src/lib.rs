@@ -14,3 +14,4 @@ pub mod plot;
 pub mod provenance;
 pub mod report;
 pub mod runner;
+pub mod surrogate;
