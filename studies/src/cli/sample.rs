@@ -700,7 +700,7 @@ mod tests {
             design: None,
             holdout: None,
             cache: None,
-            max_draws: None,
+            max_draws: Some(300),
             sampler: "demc".into(),
             draws: Some(300),
             tune: Some(300),
