@@ -19,3 +19,4 @@ pub mod provenance;
 pub mod report;
 pub mod run_folder;
 pub mod runner;
+pub mod surrogate;

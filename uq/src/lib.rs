@@ -6,8 +6,8 @@
 
 pub mod anova;
 pub mod doe;
-pub mod emulator;
 pub mod gap;
 pub mod likelihood;
 pub mod mcmc;
 pub mod stats;
+pub mod surrogate;

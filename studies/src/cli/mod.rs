@@ -9,6 +9,7 @@ pub mod diagnose;
 pub mod doe;
 pub mod run;
 pub mod sample;
+pub mod sample_fe;
 pub mod simulate;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify

@@ -1,6 +1,8 @@
 //! `palpate sample`: the Bayesian posterior of a law's parameters by MCMC,
 //! with diagnostics, a Laplace approximation beside it, chains, a corner plot
-//! and posterior-predictive bands.
+//! and posterior-predictive bands. The draws are extended until converged
+//! (`palpate_uq::mcmc::sample_until_converged`); finite-element benchmarks
+//! are sampled through a cached surrogate ([`super::sample_fe`]).
 
 use crate::cli::calibrate::read_data;
 use crate::output::{write_atomic, write_json};
@@ -12,8 +14,8 @@ use palpate_uq::likelihood::{
     NoiseSd, Posterior, Prior,
 };
 use palpate_uq::mcmc::{
-    correlation, summarize, Chains, DemcSettings, EnsembleSettings, NutsSettings, SampleRun,
-    Sampler,
+    correlation, sample_until_converged, summarize, Chains, Convergence, DemcSettings,
+    EnsembleSettings, NutsSettings, SampleRun, Sampler,
 };
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
@@ -24,6 +26,21 @@ use std::path::{Path, PathBuf};
 /// (TEST = uniaxial, biaxial, planar; columns stretch,stress_MPa) or
 /// `--benchmark C1 --data FILE` (columns displacement_mm,force_N).
 ///
+/// Finite-element benchmarks, `--benchmark N1|N3|Q1 --data FILE` (columns
+/// displacement_mm,force_N; Q1 also time_s), are sampled through a surrogate
+/// of the FE model (reduced basis + Gaussian processes) trained once on a
+/// Halton design of FE runs inside --box (required for every law parameter:
+/// the posterior's support) on the record's own loading history, and cached
+/// (--cache) under a hash of the model, mesh, code version, record, box and
+/// design, so a second run reuses it. Its error on held-out FE runs is
+/// printed and added to the likelihood as a variance per sample. The FE model
+/// is the BENCHMARKS.md set-up on the coarse mesh unless --mesh.
+///
+/// Convergence: the draws per chain are doubled (the run repeated from the
+/// same seed and continued) until every R-hat < 1.01 and every bulk ESS >=
+/// 400, up to --max-draws; a line on stderr reports each extension, and a
+/// warning says so when the cap is reached before convergence.
+///
 /// Likelihood: Gaussian; the noise SD of each data set is inferred (prior
 /// half-normal with scale = the set's peak |observation|) unless --sigma is
 /// given; --ar1 adds an AR(1) residual correlation per data set. Priors on
@@ -31,6 +48,7 @@ use std::path::{Path, PathBuf};
 /// The chains start from the least-squares fit's Laplace approximation.
 ///
 /// Example: palpate sample --benchmark C1 --law reduced-polynomial:2 --data c1.csv --sampler nuts --json post.json --plot figs
+/// Example: palpate sample --benchmark N1 --law neo-hookean --data n1.csv --box C10=0.0005,0.002 --json post.json
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
@@ -40,15 +58,42 @@ pub struct Args {
     /// Data: TEST=FILE for homogeneous tests, or FILE with --benchmark C1. Repeatable.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
-    /// Benchmark whose force record the data are (C1).
+    /// Benchmark whose force record the data are: C1 (analytic), or N1, N3, Q1 (finite elements, through a surrogate).
     #[arg(long, value_name = "ID")]
     pub benchmark: Option<String>,
+    /// N1, N3, Q1: the box the surrogate is trained in and the posterior lives in, NAME=LO,HI for every law parameter (physical units). Repeatable.
+    #[arg(long = "box", value_name = "NAME=LO,HI")]
+    pub boxes: Vec<String>,
+    /// N1, N3, Q1: mesh of the FE model: coarse, medium, fine or a level N [default: coarse].
+    #[arg(long)]
+    pub mesh: Option<String>,
+    /// N1, N3, Q1: incompressibility, exact or a ratio K/mu [default: exact].
+    #[arg(long)]
+    pub bulk: Option<String>,
+    /// N1, N3: Coulomb friction between needle and material [default: 0.8].
+    #[arg(long)]
+    pub friction: Option<f64>,
+    /// Q1: the Prony series g1=..,tau1=.. held fixed (the law's parameters are sampled).
+    #[arg(long, value_name = "g1=..,tau1=..")]
+    pub prony: Option<String>,
+    /// N1, N3, Q1: FE runs of the surrogate's training design [default: max(30, 15 x parameters)].
+    #[arg(long, value_name = "N")]
+    pub design: Option<usize>,
+    /// N1, N3, Q1: held-out FE runs measuring the surrogate's error [default: max(8, 3 x parameters)].
+    #[arg(long, value_name = "N")]
+    pub holdout: Option<usize>,
+    /// N1, N3, Q1: folder of cached surrogates [default: $PALPATE_CACHE, else $XDG_CACHE_HOME/palpate/surrogates, else ~/.cache/palpate/surrogates].
+    #[arg(long, value_name = "DIR")]
+    pub cache: Option<PathBuf>,
     /// Sampler: ensemble (affine-invariant stretch move), demc (DE-MCz) or nuts.
     #[arg(long, default_value = "nuts")]
     pub sampler: String,
-    /// Stored draws per chain (default: ensemble 2000 per walker, demc 5000, nuts 1000).
+    /// Stored draws per chain of the first run (default: ensemble 2000 per walker, demc 5000, nuts 1000); doubled until converged.
     #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
     pub draws: Option<usize>,
+    /// Cap of the stored draws per chain when extending until R-hat < 1.01 and bulk ESS >= 400 [default: 16 x --draws]; equal to --draws: no extension.
+    #[arg(long, value_name = "N", value_parser = crate::limits::parse_count::<usize>)]
+    pub max_draws: Option<usize>,
     /// Warm-up iterations (default: ensemble 1000, demc 2000, nuts 1000).
     #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
     pub tune: Option<usize>,
@@ -147,14 +192,30 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
         "stored draws",
         8.0 * (dim as f64 + 2.0),
     )?;
-    let iterations = units as f64 * (tune as f64 + draws as f64 * thin as f64);
+    let cap = max_draws(args, draws);
+    anyhow::ensure!(
+        cap >= draws,
+        "--max-draws {cap}: below the {draws} draws per chain of the first run (--draws)"
+    );
+    crate::limits::check_count(
+        &format!("--max-draws {cap} x --parallel {units} ({per_unit} chains each)"),
+        cap as f64 * units as f64 * per_unit as f64,
+        "stored draws",
+        8.0 * (dim as f64 + 2.0),
+    )?;
+    let iterations = units as f64 * (tune as f64 + cap as f64 * thin as f64);
     anyhow::ensure!(
         iterations <= 2f64.powi(53),
-        "--tune {} / --draws {}: {iterations:.3e} iterations, more than can be counted (2^53)",
+        "--tune {} / --draws {} (--max-draws {cap}): {iterations:.3e} iterations, more than can be counted (2^53)",
         args.tune.unwrap_or(tune),
         draws
     );
     Ok(())
+}
+
+/// The cap of the draws per chain: --max-draws, else 16 x the first run's.
+fn max_draws(args: &Args, draws: usize) -> usize {
+    args.max_draws.unwrap_or(draws.saturating_mul(16))
 }
 
 /// Runs `palpate sample`.
@@ -165,49 +226,72 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
     let sampler = sampler_from(&args)?;
     check_sizes(&args, &sampler, law.params().len() + 2 * args.data.len())?;
-    let data = read_data(&args.data, args.benchmark.as_deref())?;
-    let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
-    crate::output::check_outputs_and_dirs(
-        &inputs,
-        &crate::output::given(&[("--json", &args.json), ("--chains", &args.chains_out)]),
-        &crate::output::given(&[("--plot", &args.plot)]),
-    )?;
+    super::sample_fe::check_options(&args)?;
+    let fe_kind = super::sample_fe::fe_benchmark(args.benchmark.as_deref());
     if let Some(s) = args.sigma {
         anyhow::ensure!(
             s.is_finite() && s > 0.0,
             "--sigma {s}: must be a positive number"
         );
     }
-    let sets: Vec<DataSet> = data
-        .iter()
-        .map(|t| -> anyhow::Result<DataSet> {
-            let peak = t
-                .observed
-                .iter()
-                .fold(0.0f64, |m, v| m.max(v.abs()))
-                .max(1e-12);
-            Ok(DataSet {
-                name: t.name.clone(),
-                model: t.test.model(law)?,
-                loading: t.loading.clone(),
-                observed: t.observed.clone(),
-                noise: NoiseModel {
-                    sd: match args.sigma {
-                        Some(s) => NoiseSd::Known(s),
-                        None => NoiseSd::Inferred(Prior::HalfNormal { sd: peak }),
-                    },
-                    correlation: if args.ar1 {
-                        Correlation::Ar1Inferred(Prior::Uniform {
-                            lower: -1.0,
-                            upper: 1.0,
-                        })
-                    } else {
-                        Correlation::Independent
-                    },
-                },
+    let noise_of = |observed: &[f64]| {
+        let peak = observed
+            .iter()
+            .fold(0.0f64, |m, v| m.max(v.abs()))
+            .max(1e-12);
+        NoiseModel {
+            sd: match args.sigma {
+                Some(s) => NoiseSd::Known(s),
+                None => NoiseSd::Inferred(Prior::HalfNormal { sd: peak }),
+            },
+            correlation: if args.ar1 {
+                Correlation::Ar1Inferred(Prior::Uniform {
+                    lower: -1.0,
+                    upper: 1.0,
+                })
+            } else {
+                Correlation::Independent
+            },
+        }
+    };
+    let outputs = crate::output::given(&[("--json", &args.json), ("--chains", &args.chains_out)]);
+    let output_dirs = crate::output::given(&[("--plot", &args.plot)]);
+    let (sets, fe) = if let Some(kind) = fe_kind {
+        anyhow::ensure!(
+            !args.ar1,
+            "--ar1: the surrogate's error variance is added to independent noise only; leave out --ar1 with --benchmark {kind}"
+        );
+        for d in &args.data {
+            let p = d.split_once('=').map_or(d.as_str(), |x| x.1);
+            crate::output::check_outputs_and_dirs(&[Path::new(p)], &outputs, &output_dirs)?;
+        }
+        let fe = super::sample_fe::setup(kind, &args)?;
+        let set = DataSet {
+            name: kind.to_string(),
+            model: fe.surrogate.clone(),
+            loading: fe.data.loading.clone(),
+            observed: fe.data.observed.clone(),
+            noise: noise_of(&fe.data.observed),
+        };
+        (vec![set], Some(fe))
+    } else {
+        let data = read_data(&args.data, args.benchmark.as_deref())?;
+        let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
+        crate::output::check_outputs_and_dirs(&inputs, &outputs, &output_dirs)?;
+        let sets: Vec<DataSet> = data
+            .iter()
+            .map(|t| -> anyhow::Result<DataSet> {
+                Ok(DataSet {
+                    name: t.name.clone(),
+                    model: t.test.model(law)?,
+                    loading: t.loading.clone(),
+                    observed: t.observed.clone(),
+                    noise: noise_of(&t.observed),
+                })
             })
-        })
-        .collect::<anyhow::Result<_>>()?;
+            .collect::<anyhow::Result<_>>()?;
+        (sets, None)
+    };
     let space = sets[0].model.space().clone();
     let mut priors = vec![Prior::Flat; space.len()];
     for p in &args.prior {
@@ -233,7 +317,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             .parse()
             .map_err(|e| anyhow::anyhow!("--prior {p}: {e}"))?;
     }
-    let post = Posterior::new(sets, priors)?;
+    let mut post = Posterior::new(sets, priors)?;
+    if let Some(fe) = &fe {
+        post = post.with_model_error(0, fe.surrogate.error_variance(0))?;
+    }
     anyhow::ensure!(
         !args.evidence || post.priors_proper(),
         "--evidence needs a proper prior on every parameter (give --prior NAME=SPEC for each law parameter)"
@@ -244,27 +331,75 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let start = fit_and_laplace(&post).context("finding the start of the chains")?;
     let (lap_mean, lap_sd) = start.laplace_physical(&post);
 
-    let bar = crate::limits::Progress::new(
-        sampler.total_iterations(),
-        &args.sampler,
-        "{msg} [{bar:40}] {pos}/{len} iterations ({eta})",
-    );
-    let tick = |n: u64| bar.inc(n);
-    let run = sampler.run(&post, &start.start, args.seed, Some(&tick))?;
-    bar.finish();
-
+    let first_draws = palpate_uq::mcmc::converge::draws_of(&sampler);
+    let convergence = Convergence {
+        max_draws: max_draws(&args, first_draws),
+        ..Default::default()
+    };
+    let bar = std::sync::RwLock::new(None::<crate::limits::Progress>);
+    let template = "{msg} [{bar:40}] {pos}/{len} iterations ({eta})";
+    let tick = |n: u64| {
+        if let Ok(b) = bar.read() {
+            if let Some(b) = b.as_ref() {
+                b.inc(n);
+            }
+        }
+    };
+    let to_physical = |z: &[f64]| post.space().from_unbounded(z);
+    let converged = sample_until_converged(
+        &sampler,
+        &post,
+        &start.start,
+        args.seed,
+        &convergence,
+        &to_physical,
+        Some(&tick),
+        &mut |total| {
+            if let Ok(mut b) = bar.write() {
+                if let Some(old) = b.take() {
+                    old.finish();
+                }
+                *b = Some(crate::limits::Progress::new(total, &args.sampler, template));
+            }
+        },
+        &mut |w, next| {
+            eprintln!(
+                "{}: after {} draws per chain max R-hat = {:.4} ({}), min bulk ESS = {:.0} ({}): not yet R-hat < {} and ESS >= {}; extending to {next} draws per chain (cap {}, --max-draws)",
+                args.sampler,
+                w.draws,
+                w.rhat_max,
+                names[w.rhat_param],
+                w.ess_bulk_min,
+                names[w.ess_param],
+                convergence.rhat_below,
+                convergence.ess_bulk_at_least,
+                convergence.max_draws
+            );
+        },
+    )?;
+    if let Ok(mut b) = bar.write() {
+        if let Some(old) = b.take() {
+            old.finish();
+        }
+    }
+    let run = &converged.run;
     let x = run.chains.map(|z| post.space().from_unbounded(z));
     let summary = summarize(&x, &names);
     let corr = correlation(&x);
 
     println!(
-        "{} on {} ({} chains x {} draws, {} evaluations, {:.2} s)",
+        "{} on {} ({} chains x {} draws, {} evaluations, {:.2} s{})",
         run.sampler,
         post.datasets()[0].model.name(),
         x.n_chains,
         x.n_draws,
-        run.evaluations,
-        run.wall_time_s
+        converged.evaluations,
+        converged.wall_time_s,
+        if converged.history.len() > 1 {
+            format!(", {} runs to converge", converged.history.len())
+        } else {
+            String::new()
+        }
     );
     println!(
         "{:<10} {:>12} {:>11} {:>12} {:>12} {:>7} {:>8} {:>8} {:>12} {:>11}",
@@ -292,9 +427,27 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             println!("  {:<10}{}", names[i], cells.join(" "));
         }
     }
-    let worst = summary.iter().map(|s| s.rhat).fold(0.0, f64::max);
-    if worst >= 1.01 {
-        eprintln!("warning: max R-hat = {worst:.4} >= 1.01: run longer (--draws) before trusting the summary");
+    let w = &converged.worst;
+    if !converged.converged {
+        eprintln!(
+            "warning: not converged at the cap of {} draws per chain: max R-hat = {:.4} ({}), min bulk ESS = {:.0} ({}), wanted R-hat < {} and ESS >= {}; do not trust the summary yet: raise --max-draws (or try another --sampler)",
+            convergence.max_draws,
+            w.rhat_max,
+            names[w.rhat_param],
+            w.ess_bulk_min,
+            names[w.ess_param],
+            convergence.rhat_below,
+            convergence.ess_bulk_at_least
+        );
+    }
+    if let Some(fe) = &fe {
+        let cut = super::sample_fe::truncated(fe.surrogate.bounds(), &summary);
+        if !cut.is_empty() {
+            eprintln!(
+                "warning: the posterior of {} reaches the edge of the surrogate's box (--box): the box truncates it; widen --box for those parameters",
+                cut.join(", ")
+            );
+        }
     }
 
     let ti = if args.evidence {
@@ -315,8 +468,42 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     };
     if let Some(path) = &args.json {
         let mut v = report(
-            &args, &post, &run, &summary, &corr, &lap_mean, &lap_sd, &start,
+            &args, &post, run, &summary, &corr, &lap_mean, &lap_sd, &start,
         );
+        v["evaluations"] = json!(converged.evaluations);
+        v["wall_time_s"] = json!(converged.wall_time_s);
+        v["convergence"] = json!({
+            "converged": converged.converged,
+            "rhat_max": w.rhat_max,
+            "ess_bulk_min": w.ess_bulk_min,
+            "rhat_below": convergence.rhat_below,
+            "ess_bulk_at_least": convergence.ess_bulk_at_least,
+            "max_draws": convergence.max_draws,
+            "draws_tried": converged.history.iter().map(|h| h.draws).collect::<Vec<_>>(),
+        });
+        if let Some(fe) = &fe {
+            let s = &fe.surrogate;
+            let val = s.validation();
+            let b = s.bounds();
+            v["surrogate"] = json!({
+                "model": format!("{:?}", fe.spec),
+                "fe_runs": s.fe_runs,
+                "training_runs": s.options().training_runs,
+                "held_out_runs": val.points,
+                "failed_runs": s.failed.len(),
+                "basis_size": s.basis_size(),
+                "max_rel_error": val.max_relative_error,
+                "rms_rel_error": val.rms_relative_error,
+                "max_abs_error_N": val.max_abs_error.first(),
+                "box": (0..b.len()).map(|k| json!({"name": b.names[k], "lower": b.lower[k], "upper": b.upper[k]})).collect::<Vec<_>>(),
+                "box_truncates": super::sample_fe::truncated(b, &summary),
+                "build_time_s": s.build_time_s,
+                "build_cpu_s": s.build_cpu_s,
+                "cache": fe.status.word(),
+                "cache_file": fe.status.path().display().to_string(),
+                "key": s.key(),
+            });
+        }
         if let Some(ti) = &ti {
             v["thermodynamic_integration"] = json!({
                 "log_evidence": ti.log_evidence,
@@ -502,6 +689,15 @@ mod tests {
             law: "reduced-polynomial:2".into(),
             data: vec![data.display().to_string()],
             benchmark: Some("C1".into()),
+            boxes: vec![],
+            mesh: None,
+            bulk: None,
+            friction: None,
+            prony: None,
+            design: None,
+            holdout: None,
+            cache: None,
+            max_draws: Some(300),
             sampler: "demc".into(),
             draws: Some(300),
             tune: Some(300),
@@ -547,6 +743,15 @@ mod tests {
             law: "neo-hookean".into(),
             data: vec!["x.csv".into()],
             benchmark: Some("C1".into()),
+            boxes: vec![],
+            mesh: None,
+            bulk: None,
+            friction: None,
+            prony: None,
+            design: None,
+            holdout: None,
+            cache: None,
+            max_draws: None,
             sampler: sampler.into(),
             draws: None,
             tune: None,

@@ -18,7 +18,10 @@ pub mod prior;
 
 pub use evidence::{thermodynamic_integration, ThermodynamicEvidence};
 pub use map_start::{fit_and_laplace, PosteriorStart, StartError};
-pub use noise::{ar1_log_likelihood, gaussian_log_likelihood, Correlation, NoiseModel, NoiseSd};
+pub use noise::{
+    ar1_log_likelihood, gaussian_log_likelihood, gaussian_log_likelihood_with_model_error,
+    Correlation, NoiseModel, NoiseSd,
+};
 pub use posterior::{DataSet, LikelihoodError, Posterior, Tempered};
 pub use predictive::{predictive_band, PredictiveBand};
 pub use prior::Prior;

@@ -64,6 +64,39 @@ pub fn gaussian_log_likelihood(residuals: &[f64], sigma: f64) -> f64 {
     -0.5 * n * LN_2PI - n * sigma.ln() - 0.5 * ss / (sigma * sigma)
 }
 
+/// log-likelihood of independent residuals whose variance is the noise
+/// variance plus a known model-error variance per sample,
+/// r_i ~ N(0, sigma^2 + v_i):
+///
+///   ln L = -1/2 sum_i [ ln(2 pi (sigma^2 + v_i)) + r_i^2 / (sigma^2 + v_i) ].
+///
+/// This is the "approximation error" model of Kaipio & Somersalo (2005,
+/// *Statistical and Computational Inverse Problems*, Springer, sec. 7.4;
+/// Kaipio & Somersalo 2007, *J. Comput. Appl. Math.* 198, 493-504): the
+/// difference between the accurate model and a reduced one (here the
+/// surrogate) is treated as Gaussian, independent of the parameters and of
+/// the noise, with its covariance estimated from runs of both models; here
+/// its diagonal, v_i = mean over held-out runs of (surrogate - model)^2 at
+/// sample i (the second moment, which keeps any mean error in the variance
+/// rather than subtracting it), as Kennedy & O'Hagan (2001, *J. R. Stat.
+/// Soc. B* 63, 425-464, sec. 4.2) add the code uncertainty of an emulator
+/// to the observation variance.
+pub fn gaussian_log_likelihood_with_model_error(
+    residuals: &[f64],
+    sigma: f64,
+    model_variance: &[f64],
+) -> f64 {
+    let s2 = sigma * sigma;
+    residuals
+        .iter()
+        .zip(model_variance)
+        .map(|(r, v)| {
+            let t = s2 + v;
+            -0.5 * (LN_2PI + t.ln() + r * r / t)
+        })
+        .sum()
+}
+
 /// Exact log-likelihood of a stationary AR(1) residual series with marginal
 /// SD sigma and coefficient phi, e_t = phi e_{t-1} + u_t,
 /// u_t ~ N(0, sigma^2 (1 - phi^2)) (Box, Jenkins & Reinsel, *Time Series
@@ -114,5 +147,23 @@ mod tests {
         assert!(
             (ar1_log_likelihood(&r, sigma, 0.0) - gaussian_log_likelihood(&r, sigma)).abs() < 1e-12
         );
+    }
+
+    /// With zero model error it is the plain Gaussian; with a model error it
+    /// is the Gaussian of the summed variance, sample by sample.
+    #[test]
+    fn model_error_adds_to_the_noise_variance() {
+        let r = [0.3, -0.1, 0.5];
+        let plain = gaussian_log_likelihood(&r, 0.4);
+        let with = gaussian_log_likelihood_with_model_error(&r, 0.4, &[0.0; 3]);
+        assert!((plain - with).abs() < 1e-12);
+        let v = [0.09, 0.0, 0.2];
+        let direct: f64 = r
+            .iter()
+            .zip(&v)
+            .map(|(r, v)| gaussian_log_likelihood(&[*r], (0.16f64 + v).sqrt()))
+            .sum();
+        let got = gaussian_log_likelihood_with_model_error(&r, 0.4, &v);
+        assert!((direct - got).abs() < 1e-12, "{direct} {got}");
     }
 }

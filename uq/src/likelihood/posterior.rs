@@ -12,7 +12,10 @@
 //! the posterior of x. A forward-model error (a parameter the model rejects,
 //! a non-converged solve) gives `-inf`: the point is rejected.
 
-use super::noise::{ar1_log_likelihood, gaussian_log_likelihood, Correlation, NoiseModel, NoiseSd};
+use super::noise::{
+    ar1_log_likelihood, gaussian_log_likelihood, gaussian_log_likelihood_with_model_error,
+    Correlation, NoiseModel, NoiseSd,
+};
 use super::prior::Prior;
 use crate::mcmc::{fd_value_and_gradient, DensityWorker, LogDensity};
 use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec};
@@ -44,6 +47,8 @@ pub enum LikelihoodError {
     InvalidPrior { name: String, reason: String },
     #[error("data set `{name}`: {reason}")]
     InvalidNoise { name: String, reason: String },
+    #[error("data set `{name}`: model-error variance: {reason}")]
+    InvalidModelError { name: String, reason: String },
 }
 
 /// One data set: a model of the experiment, its loading, what was observed
@@ -72,6 +77,7 @@ pub struct Posterior {
     n_model: usize,
     slots: Vec<NoiseSlots>,
     sensitivities: Vec<Option<Arc<dyn Sensitivities>>>,
+    model_error: Vec<Option<Vec<f64>>>,
 }
 
 impl Posterior {
@@ -170,6 +176,7 @@ impl Posterior {
         }
         Ok(Posterior {
             sensitivities: vec![None; datasets.len()],
+            model_error: vec![None; datasets.len()],
             n_model: base.len(),
             datasets,
             space: ParamSpace::new(specs),
@@ -195,8 +202,51 @@ impl Posterior {
         self
     }
 
+    /// A known model-error variance per observation of data set `s` (e.g. a
+    /// surrogate's held-out error, [`crate::surrogate::Surrogate::error_variance`]),
+    /// added to the noise variance: r_i ~ N(0, sigma^2 + v_i)
+    /// ([`super::noise::gaussian_log_likelihood_with_model_error`], the
+    /// approximation-error model of Kaipio & Somersalo 2005, sec. 7.4).
+    /// Independent noise only; the error names the data set.
+    pub fn with_model_error(
+        mut self,
+        s: usize,
+        variance: Vec<f64>,
+    ) -> Result<Self, LikelihoodError> {
+        let Some(ds) = self.datasets.get(s) else {
+            return Err(LikelihoodError::NoData);
+        };
+        let bad = |reason: String| LikelihoodError::InvalidModelError {
+            name: ds.name.clone(),
+            reason,
+        };
+        if variance.len() != ds.observed.len() {
+            return Err(bad(format!(
+                "{} variances for {} observations",
+                variance.len(),
+                ds.observed.len()
+            )));
+        }
+        if let Some(v) = variance.iter().find(|v| !(v.is_finite() && **v >= 0.0)) {
+            return Err(bad(format!("{v} is not a variance (finite, >= 0)")));
+        }
+        if !matches!(ds.noise.correlation, Correlation::Independent) {
+            return Err(bad(
+                "only with independent noise (no AR(1) correlation)".into()
+            ));
+        }
+        self.model_error[s] = Some(variance);
+        Ok(self)
+    }
+
+    /// The model-error variances of data set `s`, if any.
+    pub fn model_error(&self, s: usize) -> Option<&[f64]> {
+        self.model_error.get(s).and_then(|v| v.as_deref())
+    }
+
     fn exact_gradient(&self) -> bool {
-        self.sensitivities.iter().all(Option::is_some)
+        self.model_error.iter().all(Option::is_none)
+            && self.sensitivities.iter().all(Option::is_some)
             && self
                 .datasets
                 .iter()
@@ -333,8 +383,11 @@ impl PosteriorWorker<'_> {
             if sigma.is_nan() || sigma <= 0.0 || phi.is_nan() || phi.abs() >= 1.0 {
                 return f64::NEG_INFINITY;
             }
-            ll += match ds.noise.correlation {
-                Correlation::Independent => gaussian_log_likelihood(pred, sigma),
+            ll += match (ds.noise.correlation, &post.model_error[s]) {
+                (Correlation::Independent, Some(v)) => {
+                    gaussian_log_likelihood_with_model_error(pred, sigma, v)
+                }
+                (Correlation::Independent, None) => gaussian_log_likelihood(pred, sigma),
                 _ => ar1_log_likelihood(pred, sigma, phi),
             };
         }

@@ -17,6 +17,7 @@
 #![allow(clippy::needless_range_loop)]
 
 pub mod chains;
+pub mod converge;
 pub mod demc;
 pub mod density;
 pub mod diagnostics;
@@ -30,6 +31,7 @@ pub mod start;
 pub mod summary;
 
 pub use chains::{Chains, SampleRun};
+pub use converge::{sample_until_converged, ConvergedRun, Convergence, Worst};
 pub use demc::{sample_demc, DemcSettings};
 pub use density::{fd_value_and_gradient, DensityWorker, FnDensity, GradFnDensity, LogDensity};
 pub use ensemble::{sample_ensemble, EnsembleSettings};

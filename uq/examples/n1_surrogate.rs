@@ -2,21 +2,21 @@
 //! 0.8, exact incompressibility), reduced polynomial N = 2 (C10, C20).
 //!
 //! Direct MCMC on the FE model would need ~1e5 solves; instead a GP curve
-//! emulator is trained on a Halton design of FE runs in a box of +-40 %
+//! surrogate is trained on a Halton design of FE runs in a box of +-40 %
 //! (C10) and 0..2x (C20) around the values of the synthetic experiment, validated against fresh
-//! FE runs, and the posterior is sampled on the emulator (DE-MCz).
+//! FE runs, and the posterior is sampled on the surrogate (DE-MCz).
 //!
 //! The "measurement" is the FE curve at ecoflex-rp2 (C10 = 686.428 Pa,
 //! C20 = 1929.606 Pa), every 0.25 mm to 10 mm, plus Gaussian noise of SD 2 %
 //! of the peak force (seeded).
 //!
-//!     cargo run --release -p palpate-uq --example n1_emulator [RUNS]
+//!     cargo run --release -p palpate-uq --example n1_surrogate [RUNS]
 
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::{Bulk, MeshDensity, N1Needle};
-use palpate_uq::emulator::CurveEmulator;
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, Posterior, Prior};
 use palpate_uq::mcmc::{chain_rng, summarize, DemcSettings, Sampler};
+use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use rand::Rng;
 use std::sync::Arc;
 use std::time::Instant;
@@ -49,27 +49,34 @@ fn main() {
         .collect();
     println!("one FE run: {one_run:.2} s; peak force {peak:.4} N, sigma {sigma:.4} N");
 
-    // The box must hold the whole posterior (the emulator's bounds are the
+    // The box must hold the whole posterior (the surrogate's bounds are the
     // posterior's support): C20 is much less well determined by this curve
     // than C10, so its range is wider.
     let lower = [0.6 * truth[0], 0.0];
     let upper = [1.4 * truth[0], 2.0 * truth[1]];
     let t = Instant::now();
-    let em = CurveEmulator::train(&fe, &loading, &lower, &upper, runs).expect("training runs");
+    let request = SurrogateRequest {
+        model: &fe,
+        loading: &loading,
+        bounds: ParamBox::new(fe.space(), &lower, &upper).expect("box"),
+        options: SurrogateOptions {
+            training_runs: runs,
+            validation_runs: 6,
+            ..Default::default()
+        },
+        description: "n1_surrogate example".into(),
+    };
+    let em = Surrogate::build(&request, None).expect("training runs");
     let train_s = t.elapsed().as_secs_f64();
+    let v = em.validation().clone();
     println!(
-        "trained on {runs} FE runs in {train_s:.1} s; length scales {:?}",
-        em.length_scales()
-    );
-    let t = Instant::now();
-    let v = em.validate(&fe, 6).expect("validation runs");
-    println!(
-        "validation against 6 fresh FE runs ({:.1} s): max |error| = {:.2e} of the peak force ({:.3} sigma), RMS {:.2e}",
-        t.elapsed().as_secs_f64(),
+        "trained on {runs} FE runs + 6 held out in {train_s:.1} s ({} basis vectors); held-out max |error| = {:.2e} of the peak force ({:.3} sigma), RMS {:.2e}",
+        em.basis_size(),
         v.max_relative_error,
         v.max_relative_error * peak / sigma,
         v.rms_relative_error
     );
+    let error_variance = em.error_variance(0);
 
     let ds = DataSet {
         name: "n1".into(),
@@ -78,7 +85,10 @@ fn main() {
         observed,
         noise: NoiseModel::known(sigma),
     };
-    let post = Posterior::new(vec![ds], vec![Prior::Flat; 2]).unwrap();
+    let post = Posterior::new(vec![ds], vec![Prior::Flat; 2])
+        .unwrap()
+        .with_model_error(0, error_variance)
+        .unwrap();
     let t = Instant::now();
     let st = fit_and_laplace(&post).expect("start");
     let run = Sampler::Demc(DemcSettings {
@@ -92,7 +102,7 @@ fn main() {
         &post.names(),
     );
     println!(
-        "posterior on the emulator in {:.2} s ({} emulator evaluations):",
+        "posterior on the surrogate in {:.2} s ({} surrogate evaluations):",
         t.elapsed().as_secs_f64(),
         run.evaluations
     );

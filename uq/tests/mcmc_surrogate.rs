@@ -1,12 +1,13 @@
-//! The GP curve emulator reproduces the C1 model inside its training box and
-//! gives the same posterior as the model itself (the analytic stand-in for
-//! an FE model, whose direct sampling would be too slow).
+//! The surrogate (reduced basis + GP per coefficient) reproduces the C1
+//! model inside its training box, refuses outside it, survives its stored
+//! form, and gives the same posterior as the model itself (the analytic
+//! stand-in for an FE model, whose direct sampling would be too slow).
 
 use palpate_analytic::C1Compression;
 use palpate_core::ForwardModel;
-use palpate_uq::emulator::CurveEmulator;
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, Posterior, Prior};
 use palpate_uq::mcmc::{summarize, DemcSettings, Sampler};
+use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use std::sync::Arc;
 
 mod common;
@@ -34,13 +35,42 @@ fn emulated_posterior_matches_the_direct_one() {
     let lower: Vec<f64> = (0..2).map(|k| mean[k] - 8.0 * sd[k]).collect();
     let upper: Vec<f64> = (0..2).map(|k| mean[k] + 8.0 * sd[k]).collect();
     let (loading, _, sigma) = data();
-    let em = CurveEmulator::train(model.as_ref(), &loading, &lower, &upper, 30).unwrap();
-    let v = em.validate(model.as_ref(), 20).unwrap();
-    eprintln!("length scales {:?}; validation {v:?}", em.length_scales());
+    let request = SurrogateRequest {
+        model: model.as_ref(),
+        loading: &loading,
+        bounds: ParamBox::new(model.space(), &lower, &upper).unwrap(),
+        options: SurrogateOptions {
+            training_runs: 30,
+            validation_runs: 20,
+            ..Default::default()
+        },
+        description: "C1 rp2, test".into(),
+    };
+    let em = Surrogate::build(&request, None).unwrap();
+    let v = em.validation().clone();
+    eprintln!("basis {}; validation {v:?}", em.basis_size());
     // Far below the noise (sigma is 2 % of the peak force).
     assert!(v.max_relative_error < 1e-3, "{v:?}");
     let peak = 2.72;
     assert!(v.max_relative_error * peak < 0.05 * sigma);
+    assert_eq!(em.error_variance(0).len(), loading.len());
+    assert_eq!(em.key(), request.key());
+
+    // The stored form answers the same.
+    let back = Surrogate::from_json(&em.to_json()).unwrap();
+    let mid: Vec<f64> = (0..2).map(|k| 0.5 * (lower[k] + upper[k])).collect();
+    assert_eq!(
+        back.predict(&mid, &loading).unwrap(),
+        em.predict(&mid, &loading).unwrap()
+    );
+    // Outside the box: a refusal naming the parameter and the box.
+    let mut out = mid.clone();
+    out[1] = upper[1] + 0.5 * (upper[1] - lower[1]);
+    let e = em.predict(&out, &loading).unwrap_err().to_string();
+    assert!(e.contains("C20") && e.contains("trained box"), "{e}");
+    // Another loading: refused too.
+    let other = loading.with_drive(loading.drive.iter().map(|d| 0.5 * d).collect());
+    assert!(em.predict(&mid, &other).is_err());
 
     let emulated = posterior(Arc::new(em));
     let st_e = fit_and_laplace(&emulated).unwrap();

@@ -1,0 +1,250 @@
+//! `palpate sample --benchmark N1|N3|Q1`: the record's finite-element model
+//! behind a surrogate (`palpate_uq::surrogate`, cached by
+//! [`crate::surrogate::load_or_build`]), whose held-out error is added to the
+//! likelihood as a variance ([`palpate_uq::likelihood::Posterior::with_model_error`]).
+//!
+//! The surrogate is trained on the record's own loading history (its
+//! displacement samples, and times for Q1), inside the box given by `--box`
+//! for every law parameter: the box is the posterior's support, since the
+//! surrogate does not extrapolate.
+
+use super::sample::Args;
+use crate::calibration::{TestData, TestKind};
+use crate::models::{ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
+use crate::surrogate::{default_cache_dir, load_or_build, CacheStatus};
+use palpate_core::ForwardModel;
+use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+/// The benchmarks sampled through a surrogate.
+pub const FE_BENCHMARKS: [&str; 3] = ["N1", "N3", "Q1"];
+
+/// The FE benchmark named by `--benchmark`, upper case, if it is one.
+pub fn fe_benchmark(benchmark: Option<&str>) -> Option<&'static str> {
+    let b = benchmark?;
+    FE_BENCHMARKS
+        .iter()
+        .find(|k| k.eq_ignore_ascii_case(b))
+        .copied()
+}
+
+/// Refuses an FE option without an FE benchmark, or one of another FE
+/// benchmark, naming it.
+pub fn check_options(args: &Args) -> anyhow::Result<()> {
+    let kind = fe_benchmark(args.benchmark.as_deref());
+    let given: [(bool, &str, &[&str]); 8] = [
+        (!args.boxes.is_empty(), "--box", &FE_BENCHMARKS),
+        (args.mesh.is_some(), "--mesh", &FE_BENCHMARKS),
+        (args.design.is_some(), "--design", &FE_BENCHMARKS),
+        (args.holdout.is_some(), "--holdout", &FE_BENCHMARKS),
+        (args.cache.is_some(), "--cache", &FE_BENCHMARKS),
+        (args.bulk.is_some(), "--bulk", &FE_BENCHMARKS),
+        (args.friction.is_some(), "--friction", &["N1", "N3"]),
+        (args.prony.is_some(), "--prony", &["Q1"]),
+    ];
+    for (on, name, users) in given {
+        if on && !kind.is_some_and(|k| users.contains(&k)) {
+            anyhow::bail!(
+                "{name}: an option of --benchmark {} (sampled through a finite-element surrogate); {}",
+                users.join(", "),
+                match kind {
+                    Some(k) => format!("--benchmark {k} does not use it"),
+                    None => "give one of them".into(),
+                }
+            );
+        }
+    }
+    Ok(())
+}
+
+/// The model spec of the record: the BENCHMARKS.md set-up with the
+/// options given (mesh coarse unless `--mesh`).
+pub fn model_spec(kind: &str, args: &Args) -> ModelSpec {
+    let mesh = Some(args.mesh.clone().unwrap_or_else(|| "coarse".into()));
+    match kind {
+        "N1" => ModelSpec::N1Needle(N1NeedleSpec {
+            law: args.law.clone(),
+            friction: args.friction,
+            mesh,
+            bulk: args.bulk.clone(),
+            ..Default::default()
+        }),
+        "N3" => ModelSpec::N3Needle(N3NeedleSpec {
+            law: args.law.clone(),
+            friction: args.friction,
+            mesh,
+            bulk: args.bulk.clone(),
+            ..Default::default()
+        }),
+        _ => ModelSpec::Q1(Q1Spec {
+            law: args.law.clone(),
+            mesh,
+            bulk: args.bulk.clone(),
+            prony: args.prony.clone(),
+            ..Default::default()
+        }),
+    }
+}
+
+/// Parses `--box NAME=LO,HI` for every parameter of `model`; the error names
+/// the option or the missing parameters (with a suggestion around the law's
+/// typical value).
+pub fn parse_box(boxes: &[String], model: &dyn ForwardModel) -> anyhow::Result<ParamBox> {
+    let space = model.space();
+    let mut lower = vec![f64::NAN; space.len()];
+    let mut upper = vec![f64::NAN; space.len()];
+    for b in boxes {
+        let (name, range) = super::calibrate::split_pair(b, "NAME=LO,HI, e.g. C10=0.0005,0.002")?;
+        let k = space.index_of(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--box {b}: unknown parameter `{name}` (the model has {})",
+                space.names().join(", ")
+            )
+        })?;
+        if !lower[k].is_nan() {
+            anyhow::bail!("--box {b}: a box for {name} is given twice; give each parameter once");
+        }
+        let (lo, hi) = range
+            .split_once(',')
+            .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
+            .ok_or_else(|| anyhow::anyhow!("--box {b}: expected NAME=LO,HI with two numbers"))?;
+        lower[k] = lo;
+        upper[k] = hi;
+    }
+    let missing: Vec<String> = space
+        .params
+        .iter()
+        .zip(&lower)
+        .filter(|(_, l)| l.is_nan())
+        .map(|(p, _)| {
+            format!(
+                "{} (e.g. --box {}={},{})",
+                p.name,
+                p.name,
+                p.initial / 4.0,
+                p.initial * 4.0
+            )
+        })
+        .collect();
+    if !missing.is_empty() {
+        anyhow::bail!(
+            "--box: the surrogate is trained inside a box that must hold the posterior; give NAME=LO,HI for {}",
+            missing.join(", ")
+        );
+    }
+    ParamBox::new(space, &lower, &upper).map_err(|e| anyhow::anyhow!("--box: {e}"))
+}
+
+/// The record, its surrogate and where it came from.
+pub struct FeRecord {
+    pub data: TestData,
+    pub spec: ModelSpec,
+    pub surrogate: Arc<Surrogate>,
+    pub status: CacheStatus,
+}
+
+/// Reads the record, builds or loads the surrogate of its FE model.
+pub fn setup(kind: &str, args: &Args) -> anyhow::Result<FeRecord> {
+    anyhow::ensure!(
+        args.data.len() == 1,
+        "--benchmark {kind}: give one record (--data FILE), got {}",
+        args.data.len()
+    );
+    let d = &args.data[0];
+    let path = d
+        .split_once('=')
+        .filter(|(t, _)| t.eq_ignore_ascii_case(kind))
+        .map_or(d.as_str(), |(_, p)| p);
+    let data = TestData::read(kind, TestKind::N1, Path::new(path))?;
+    if kind == "Q1" && data.loading.time.is_none() {
+        anyhow::bail!(
+            "{}: a Q1 record is a timed ramp-and-hold: it needs a time_s column (as `palpate simulate --benchmark Q1 --csv` writes)",
+            path
+        );
+    }
+    let spec = model_spec(kind, args);
+    let model = spec
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}", e.as_option()))?
+        .into_forward();
+    let bounds = parse_box(&args.boxes, model.as_ref())?;
+    let mut options = SurrogateOptions::for_dimension(bounds.len());
+    if let Some(n) = args.design {
+        anyhow::ensure!(
+            n >= bounds.len() + 2,
+            "--design {n}: at least {} training runs are needed for {} parameters",
+            bounds.len() + 2,
+            bounds.len()
+        );
+        options.training_runs = n;
+    }
+    if let Some(n) = args.holdout {
+        anyhow::ensure!(n >= 1, "--holdout {n}: at least 1 held-out run is needed");
+        options.validation_runs = n;
+    }
+    let cache: PathBuf = args.cache.clone().unwrap_or_else(default_cache_dir);
+    let t0 = std::time::Instant::now();
+    let (s, status) = load_or_build(
+        model.as_ref(),
+        &data.loading,
+        bounds,
+        options,
+        &format!("{spec:?}"),
+        &cache,
+        &format!("surrogate of {}", model.name()),
+    )?;
+    let v = s.validation();
+    match &status {
+        CacheStatus::Hit(p) => eprintln!(
+            "surrogate loaded from the cache {} in {:.2} s (built from {} FE runs in {:.1} s)",
+            p.display(),
+            t0.elapsed().as_secs_f64(),
+            s.fe_runs,
+            s.build_time_s
+        ),
+        CacheStatus::Built(p) => eprintln!(
+            "surrogate built from {} FE runs in {:.1} s wall{}, stored in {}",
+            s.fe_runs,
+            s.build_time_s,
+            s.build_cpu_s
+                .map(|c| format!(" ({c:.1} s CPU, {} threads)", rayon::current_num_threads()))
+                .unwrap_or_default(),
+            p.display()
+        ),
+    }
+    eprintln!(
+        "surrogate error on {} held-out FE runs: max {:.3e}, RMS {:.3e} of the peak force ({} basis vectors); added to the likelihood as a variance",
+        v.points,
+        v.max_relative_error,
+        v.rms_relative_error,
+        s.basis_size()
+    );
+    if !s.failed.is_empty() {
+        eprintln!(
+            "warning: {} FE runs of the design failed and were left out (first at {:?}: {})",
+            s.failed.len(),
+            s.failed[0].theta,
+            s.failed[0].reason
+        );
+    }
+    Ok(FeRecord {
+        data,
+        spec,
+        surrogate: Arc::new(s),
+        status,
+    })
+}
+
+/// The parameters whose 94 % HDI reaches within 1 % of the box width of a
+/// box bound: the box truncates their posterior.
+pub fn truncated(bounds: &ParamBox, summary: &[palpate_uq::mcmc::ParamSummary]) -> Vec<String> {
+    (0..bounds.len())
+        .filter(|&k| {
+            let w = bounds.upper[k] - bounds.lower[k];
+            summary[k].hdi_3 - bounds.lower[k] < 0.01 * w
+                || bounds.upper[k] - summary[k].hdi_97 < 0.01 * w
+        })
+        .map(|k| bounds.names[k].clone())
+        .collect()
+}
