@@ -595,6 +595,13 @@ fn timed_history(
     if !(hold >= 0.0 && hold.is_finite()) {
         bail!("--hold {hold}: must be a duration in s, zero or more");
     }
+    // one ramp sample lasts ramp x step / depth: a shorter hold is a typo
+    let one_step = ramp * (drive.get(1).copied().unwrap_or(depth)) / depth;
+    if hold > 0.0 && hold < one_step {
+        bail!(
+            "--hold {hold}: shorter than one step of the ramp ({one_step} s); give 0 for no hold or at least {one_step} s"
+        );
+    }
     let mut time: Vec<f64> = drive.iter().map(|d| ramp * d / depth).collect();
     if hold > 0.0 {
         const HOLD_SAMPLES: usize = 200;
