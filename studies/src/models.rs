@@ -14,6 +14,7 @@
 //! element = "quad4"            # quad4 (Q1/P0) | quad9 (Q2/P1), N1 only
 //! base = "bonded"             # bonded | sliding
 //! tool = "needle"             # needle | sphere:R | punch:R | platen
+//! prony = "g1=0.3,tau1=0.5"   # viscoelastic (as c1_fe; needs timed data)
 //!
 //! [models.needle3d.n3_needle] # N3 needle indentation, 3D quarter block (finite elements)
 //! law = "neo-hookean"
@@ -202,6 +203,10 @@ pub struct N1NeedleSpec {
     /// same grading, each cell made quadratic).
     #[serde(default)]
     pub element: Option<String>,
+    /// A Prony series `g1=..,tau1=..,g2=..,tau2=..` on the law's isochoric
+    /// stress (`palpate_fe::Viscoelastic`); none: elastic.
+    #[serde(default)]
+    pub prony: Option<String>,
 }
 
 /// `[... .q1]`
@@ -427,12 +432,7 @@ impl ModelSpec {
                 let level = parse_mesh(K, s.mesh.as_deref())?;
                 m.elements = (19 * level, 9 * level);
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
-                if let Some(p) = &s.prony {
-                    let prony = p
-                        .parse::<Prony>()
-                        .map_err(|e| ModelError::new(K, "prony", p, e.to_string()))?;
-                    m.prony = Some(prony);
-                }
+                m.prony = parse_prony(K, s.prony.as_deref())?;
                 Model::C1Fe(m)
             }
             ModelSpec::Q1(s) => {
@@ -441,12 +441,7 @@ impl ModelSpec {
                 m.level = parse_mesh(K, s.mesh.as_deref())?;
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
                 m.element = parse_element(K, s.element.as_deref())?;
-                if let Some(p) = &s.prony {
-                    let prony = p
-                        .parse::<Prony>()
-                        .map_err(|e| ModelError::new(K, "prony", p, e.to_string()))?;
-                    m.prony = Some(prony);
-                }
+                m.prony = parse_prony(K, s.prony.as_deref())?;
                 Model::Q1(m)
             }
             ModelSpec::N1Needle(s) => {
@@ -480,6 +475,7 @@ impl ModelSpec {
                 };
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
                 m.element = parse_element(K, s.element.as_deref())?;
+                m.prony = parse_prony(K, s.prony.as_deref())?;
                 Model::N1Needle(m)
             }
             ModelSpec::N3Needle(s) => {
@@ -515,6 +511,15 @@ impl ModelSpec {
             }
         })
     }
+}
+
+/// A `prony = "g1=..,tau1=.."` field; errors name it.
+fn parse_prony(kind: &'static str, text: Option<&str>) -> Result<Option<Prony>, ModelError> {
+    text.map(|p| {
+        p.parse::<Prony>()
+            .map_err(|e| ModelError::new(kind, "prony", p, e.to_string()))
+    })
+    .transpose()
 }
 
 /// The displacement unknowns of N3 mesh `level` (3 per node), counted from

@@ -574,12 +574,12 @@ fn options_of_the_other_benchmark_are_refused_by_name() {
         ("C1", vec!["--element", "quad9"], "--element quad9"),
         ("N1", vec!["--bonded"], "--bonded"),
         (
-            "N1",
+            "N3",
             vec!["--prony", "g1=0.3,tau1=0.5"],
             "--prony g1=0.3,tau1=0.5",
         ),
-        ("N1", vec!["--ramp", "1"], "--ramp"),
-        ("N1", vec!["--hold", "2"], "--hold"),
+        ("N3", vec!["--ramp", "1"], "--ramp"),
+        ("N3", vec!["--hold", "2"], "--hold"),
     ] {
         let o = simulate(&s, bench, &extra);
         refused(&o, &[needle, "benchmark"]);

@@ -401,6 +401,7 @@ fn simulate_q1_ramp_and_hold() {
     ];
     for (extra, says) in [
         (&["--hold=-1"][..], &["--hold", "zero or more"][..]),
+        (&["--hold", "0.001"], &["--hold", "shorter than one step"]),
         (&["--ramp", "0"], &["--ramp", "positive"]),
         (&["--prony", "g1=0.3,tau1=-1"], &["tau1", "positive"]),
         (&["--element", "quad8"], &["--element", "quad4 or quad9"]),

@@ -40,6 +40,7 @@ use crate::stepper::Progress;
 use crate::surface::Profile2d;
 use crate::system::{SolverOptions, System};
 use crate::tool::ToolShape;
+use crate::viscoelastic::Prony;
 use crate::FeError;
 
 /// Mesh density of the N1 model: level `n` has elements of `0.4 / n` mm in a
@@ -143,6 +144,12 @@ pub struct N1Needle {
     /// Q2/P1 on the same grading made quadratic (each cell of the grading
     /// becomes one 9-node cell: twice the nodes per direction).
     pub element: N1Element,
+    /// A Prony series on the law's isochoric stress
+    /// ([`crate::viscoelastic::Viscoelastic`], as C1 and Q1); `None`:
+    /// elastic. A viscoelastic run needs timed loading and steps by at most
+    /// `options.max_time_step` (a tenth of the shortest relaxation time
+    /// when unset).
+    pub prony: Option<Prony>,
     pub options: SolverOptions,
     friction_is_parameter: bool,
     space: ParamSpace,
@@ -169,6 +176,7 @@ impl N1Needle {
             penetration_tol: 2e-3,
             contact_points: ContactPoints::EdgeGauss,
             element: N1Element::Quad4,
+            prony: None,
             options: SolverOptions {
                 max_step: 0.25,
                 first_step: 0.05,
@@ -280,6 +288,9 @@ impl Setup for N1Needle {
     fn options(&self) -> SolverOptions {
         self.options
     }
+    fn prony(&self) -> Option<&Prony> {
+        self.prony.as_ref()
+    }
     fn build(&self) -> Result<System, FeError> {
         if !(self.friction >= 0.0 && self.friction.is_finite()) {
             return Err(FeError::InvalidConfig {
@@ -358,10 +369,14 @@ impl ForwardModel for N1Needle {
             Base::Bonded => "",
             Base::Sliding => ", sliding base",
         };
-        format!(
+        let mut name = format!(
             "N1 FE needle indentation, {}, friction {}{base}",
             self.law, self.friction
-        )
+        );
+        if let Some(p) = &self.prony {
+            name += &format!(", Prony {p}");
+        }
+        name
     }
     fn space(&self) -> &ParamSpace {
         &self.space

@@ -198,3 +198,56 @@ fn material_form_and_zero_offset_effects_on_n1() {
     let with_friction = m.enrich(Effect::Friction).unwrap();
     assert!(!effects_of(with_friction.as_ref()).contains(&Effect::MaterialForm));
 }
+
+/// N1 with a Prony series (`--prony` on N1): the needle ramps to 2 mm at
+/// the benchmark's 0.4 mm/s, then holds. Frictionless neo-Hookean, so the
+/// relaxed state does not depend on the path: long after the ramp
+/// (here 40 tau) the force is `g_inf` times the elastic force at 2 mm,
+/// whatever the time steps (the recursive update is exact at constant
+/// strain). With relaxation times far beyond the test (1e4 s) the ramp
+/// is the elastic curve.
+#[test]
+fn viscoelastic_needle_relaxes_to_g_inf_times_the_elastic_force() {
+    use palpate_fe::Prony;
+    let mut m = model("neo-hookean", 0.0);
+    // the contact multipliers augmented to a tight penetration, so that
+    // neither run keeps a history of its increments in the contact
+    m.options.max_augmentations = 30;
+    m.penetration_tol = 1e-6;
+    let drive: Vec<f64> = (1..=8).map(|k| 0.25 * k as f64).collect();
+    let elastic = m
+        .predict(
+            &NH,
+            &Loading::quasi_static(Drive::DisplacementMm, drive.clone()),
+        )
+        .unwrap();
+    let mut time: Vec<f64> = drive.iter().map(|d| d / 0.4).collect();
+    let mut d = drive.clone();
+    for k in 1..=4 {
+        time.push(5.0 + 5.0 * k as f64);
+        d.push(2.0);
+    }
+    let loading = Loading::timed(Drive::DisplacementMm, time, d);
+    m.prony = Some(Prony::new(vec![(0.3, 0.25), (0.2, 0.5)]).unwrap());
+    m.options.max_time_step = Some(2.5);
+    let f = m.predict(&NH, &loading).unwrap();
+    let relaxed = 0.5 * elastic[7];
+    println!(
+        "elastic {:.6e} N, ramp end {:.6e} N, end of hold {:.6e} N (g_inf F_el {relaxed:.6e})",
+        elastic[7], f[7], f[11]
+    );
+    assert!(f[7] < elastic[7] && f[7] > f[11]);
+    assert!((f[11] / relaxed - 1.0).abs() < 2e-4, "{} {relaxed}", f[11]);
+
+    m.prony = Some(Prony::new(vec![(0.3, 1e4), (0.2, 2e4)]).unwrap());
+    m.options.max_time_step = Some(1.0);
+    let f = m.predict(&NH, &loading).unwrap();
+    for k in 0..8 {
+        assert!(
+            (f[k] / elastic[k] - 1.0).abs() < 2e-4,
+            "{k}: {} {}",
+            f[k],
+            elastic[k]
+        );
+    }
+}

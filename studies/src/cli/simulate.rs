@@ -67,13 +67,13 @@ pub struct Args {
     /// Order of convergence P for the error estimate instead of the model's documented one (N1 1.22, C1 bonded 0.58); a smaller P gives a larger estimate.
     #[arg(long, value_name = "P")]
     pub order: Option<f64>,
-    /// C1 and Q1: viscoelastic material, a Prony series g1=..,tau1=..,g2=..,tau2=.. on the law's isochoric stress (G(t) = 1 - sum g_i (1 - exp(-t/tau_i)), tau in s); the history becomes timed: ramp to --depth in --ramp seconds, then hold --hold seconds.
+    /// N1, C1 and Q1: viscoelastic material, a Prony series g1=..,tau1=..,g2=..,tau2=.. on the law's isochoric stress (G(t) = 1 - sum g_i (1 - exp(-t/tau_i)), tau in s); the history becomes timed: ramp to --depth in --ramp seconds, then hold --hold seconds.
     #[arg(long, value_name = "g1=..,tau1=..")]
     pub prony: Option<String>,
-    /// With --prony (C1) or Q1: duration of the ramp to --depth in s [default: 1; Q1: 0.5].
+    /// With --prony (N1, C1) or Q1: duration of the ramp to --depth in s [default: C1 1; N1 depth / 0.4 mm/s (BENCHMARKS.md); Q1 0.5].
     #[arg(long, value_name = "SECONDS")]
     pub ramp: Option<f64>,
-    /// With --prony (C1) or Q1: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0; Q1: 60].
+    /// With --prony (N1, C1) or Q1: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0; Q1: 60].
     #[arg(long, value_name = "SECONDS")]
     pub hold: Option<f64>,
     /// Write the force curve as CSV (columns [time_s,]displacement_mm,force_N[,error_estimate_N], time_s with --prony and for Q1; `#` lines state the model, the volumetric treatment and the error estimate).
@@ -153,19 +153,19 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
             args.prony.is_some(),
             "--prony",
             args.prony.clone().unwrap_or_default(),
-            &["C1", "Q1"],
+            &["N1", "C1", "Q1"],
         ),
         (
             args.ramp.is_some(),
             "--ramp",
             format!("{:?}", args.ramp.unwrap_or(0.0)),
-            &["C1", "Q1"],
+            &["N1", "C1", "Q1"],
         ),
         (
             args.hold.is_some(),
             "--hold",
             format!("{:?}", args.hold.unwrap_or(0.0)),
-            &["C1", "Q1"],
+            &["N1", "C1", "Q1"],
         ),
         (
             args.friction.is_some(),
@@ -222,6 +222,7 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
             base: args.sliding_base.then(|| "sliding".into()),
             tool: args.tool.clone(),
             element: args.element.clone(),
+            prony: args.prony.clone(),
         })
     } else {
         ModelSpec::C1Fe(C1FeSpec {
@@ -582,16 +583,33 @@ fn timed_history(
         }
         return Ok(None);
     }
-    if !(args.benchmark.eq_ignore_ascii_case("c1") || q1) {
-        bail!("--prony: only C1 and Q1 have the viscoelastic material so far");
+    if !(args.benchmark.eq_ignore_ascii_case("c1")
+        || args.benchmark.eq_ignore_ascii_case("n1")
+        || q1)
+    {
+        bail!("--prony: only N1, C1 and Q1 have the viscoelastic material so far");
     }
-    let ramp = args.ramp.unwrap_or(if q1 { 0.5 } else { 1.0 });
+    // N1: the needle's 0.4 mm/s (BENCHMARKS.md), C1: 1 s, Q1: 0.5 s
+    let ramp = args.ramp.unwrap_or(if q1 {
+        0.5
+    } else if args.benchmark.eq_ignore_ascii_case("n1") {
+        depth / 0.4
+    } else {
+        1.0
+    });
     let hold = args.hold.unwrap_or(if q1 { 60.0 } else { 0.0 });
     if !(ramp > 0.0 && ramp.is_finite()) {
         bail!("--ramp {ramp}: must be a positive duration in s");
     }
     if !(hold >= 0.0 && hold.is_finite()) {
         bail!("--hold {hold}: must be a duration in s, zero or more");
+    }
+    // one ramp sample lasts ramp x step / depth: a shorter hold is a typo
+    let one_step = ramp * (drive.get(1).copied().unwrap_or(depth)) / depth;
+    if hold > 0.0 && hold < one_step {
+        bail!(
+            "--hold {hold}: shorter than one step of the ramp ({one_step} s); give 0 for no hold or at least {one_step} s"
+        );
     }
     let mut time: Vec<f64> = drive.iter().map(|d| ramp * d / depth).collect();
     if hold > 0.0 {
