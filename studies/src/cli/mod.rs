@@ -10,6 +10,7 @@ pub mod doe;
 pub mod run;
 pub mod sample;
 pub mod simulate;
+pub mod simulate_r2;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify
 /// their uncertainty and diagnose the gap between simulation and measurement.
