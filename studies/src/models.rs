@@ -35,6 +35,14 @@
 //! element = "quad4"           # quad4 (Q1/P0) | quad9 (Q2/P1)
 //! prony = "g1=0.3,tau1=0.5,g2=0.2,tau2=10"
 //!
+//! [models.rolling.r2]        # R2 rolling indentation over nodules, plane stress (finite elements)
+//! law = "arruda-boyce"        # tissue law (default arruda-boyce: rtv6166-ab)
+//! nodule_law = "arruda-boyce" # nodule law (default arruda-boyce: rubber-ab)
+//! rd = 6                      # rolling depth (mm), required
+//! nodules = "37.5:10,75:15,112.5:20"  # X:DEPTH list (mm) or "none"; "75:15" is R2-1
+//! friction = 0                # Coulomb coefficient wheel/block (default 0)
+//! mesh = "coarse"             # coarse (default) | medium | fine | N: 9-node elements of 2/N mm
+//!
 //! [models.press-analytic.c1]  # C1 compression (analytic, lubricated)
 //! law = "neo-hookean"
 //!
@@ -61,8 +69,8 @@ use palpate_analytic::{
 };
 use palpate_core::{Effect, ForwardModel};
 use palpate_fe::{
-    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Needle, Platens, Prony, Q1Punch,
-    ToolShape,
+    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Needle, Nodule, Platens, Prony, Q1Punch,
+    R2Rolling, ToolShape,
 };
 use palpate_material::Law;
 use serde::Deserialize;
@@ -92,7 +100,48 @@ pub enum ModelSpec {
     Q1(Q1Spec),
     /// Benchmark N3, needle indentation of a block in 3D by finite elements.
     N3Needle(N3NeedleSpec),
+    /// Benchmark R2 (and R2-1), rolling indentation over bonded nodules,
+    /// plane stress, by finite elements.
+    R2(R2Spec),
 }
+
+/// `[... .r2]`
+#[derive(Debug, Clone, PartialEq, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct R2Spec {
+    /// The tissue law (default `arruda-boyce`, for `rtv6166-ab`).
+    #[serde(default = "arruda_boyce")]
+    pub law: String,
+    /// The nodules' law (default `arruda-boyce`, for `rubber-ab`); its
+    /// parameters follow the tissue's, named `nodule_...`.
+    #[serde(default)]
+    pub nodule_law: Option<String>,
+    /// Rolling depth (mm).
+    pub rd: f64,
+    /// `X:DEPTH,...` (mm) or `none`; default BENCHMARKS.md's three nodules.
+    #[serde(default)]
+    pub nodules: Option<String>,
+    /// Coulomb friction between wheel and block (default 0).
+    #[serde(default)]
+    pub friction: Option<f64>,
+    /// `coarse` (default), `medium`, `fine` or a level 1..R2_MAX_LEVEL:
+    /// 9-node elements of 2/N mm at the surface and around the nodules.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub mesh: Option<String>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "text_or_number")]
+    pub bulk: Option<String>,
+}
+
+fn arruda_boyce() -> String {
+    "arruda-boyce".into()
+}
+
+/// BENCHMARKS.md's default R2 nodules.
+pub const R2_DEFAULT_NODULES: &str = "37.5:10,75:15,112.5:20";
+/// The finest R2 level accepted: level 4 (0.5 mm elements) has ~150,000
+/// unknowns, a rolled pass of hours on 2 cores.
+pub const R2_MAX_LEVEL: usize = 3;
 
 /// `[... .homogeneous]`
 #[derive(Debug, Clone, PartialEq, Deserialize)]
@@ -323,6 +372,7 @@ pub enum Model {
     N1Needle(N1Needle),
     Q1(Q1Punch),
     N3Needle(N3Needle),
+    R2(R2Rolling),
 }
 
 impl Model {
@@ -341,6 +391,7 @@ impl Model {
             Model::N1Needle(m) => Box::new(m),
             Model::Q1(m) => Box::new(m),
             Model::N3Needle(m) => Box::new(m),
+            Model::R2(m) => Box::new(m),
         }
     }
 }
@@ -352,8 +403,15 @@ pub fn build(spec: &ModelSpec) -> Result<Box<dyn ForwardModel>, ModelError> {
 
 impl ModelSpec {
     /// The kinds, as spelled in manifests.
-    pub const KINDS: [&'static str; 6] =
-        ["homogeneous", "c1", "c1_fe", "n1_needle", "n3_needle", "q1"];
+    pub const KINDS: [&'static str; 7] = [
+        "homogeneous",
+        "c1",
+        "c1_fe",
+        "n1_needle",
+        "n3_needle",
+        "q1",
+        "r2",
+    ];
 
     /// The kind, as spelled in manifests.
     pub fn kind(&self) -> &'static str {
@@ -364,6 +422,7 @@ impl ModelSpec {
             ModelSpec::N1Needle(_) => "n1_needle",
             ModelSpec::Q1(_) => "q1",
             ModelSpec::N3Needle(_) => "n3_needle",
+            ModelSpec::R2(_) => "r2",
         }
     }
 
@@ -376,6 +435,7 @@ impl ModelSpec {
             ModelSpec::N1Needle(s) => &s.law,
             ModelSpec::Q1(s) => &s.law,
             ModelSpec::N3Needle(s) => &s.law,
+            ModelSpec::R2(s) => &s.law,
         }
     }
 
@@ -403,6 +463,14 @@ impl ModelSpec {
                     "test",
                     "Q1",
                     "Q1 records are not a test kind of calibrate/sample yet",
+                ))
+            }
+            ModelSpec::R2(_) => {
+                return Err(ModelError::new(
+                    "r2",
+                    "test",
+                    "R2",
+                    "R2 rolling records are not a test kind of calibrate/sample yet",
                 ))
             }
         })
@@ -509,6 +577,7 @@ impl ModelSpec {
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
                 Model::N3Needle(m)
             }
+            ModelSpec::R2(s) => Model::R2(r2_model(s, law)?),
         })
     }
 }
@@ -520,6 +589,69 @@ fn parse_prony(kind: &'static str, text: Option<&str>) -> Result<Option<Prony>, 
             .map_err(|e| ModelError::new(kind, "prony", p, e.to_string()))
     })
     .transpose()
+}
+
+/// The R2 model of a spec: every field checked, the geometry (nodules
+/// inside the block, not overlapping, RD) by building the mesh once.
+fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
+    const K: &str = "r2";
+    let nodule_law = match &s.nodule_law {
+        None => Law::ArrudaBoyce,
+        Some(t) => t
+            .parse::<Law>()
+            .map_err(|e| ModelError::new(K, "nodule_law", t, e.to_string()))?,
+    };
+    if !(s.rd > 0.0 && s.rd.is_finite()) {
+        return Err(ModelError::new(
+            K,
+            "rd",
+            s.rd,
+            "expected a rolling depth > 0 mm",
+        ));
+    }
+    let mut m = R2Rolling::new(law, nodule_law, s.rd);
+    let text = s.nodules.as_deref().unwrap_or(R2_DEFAULT_NODULES);
+    m.nodules = Nodule::parse_list(text).map_err(|e| ModelError::new(K, "nodules", text, e))?;
+    let friction = s.friction.unwrap_or(0.0);
+    if !(friction >= 0.0 && friction.is_finite()) {
+        return Err(ModelError::new(
+            K,
+            "friction",
+            friction,
+            "expected a coefficient >= 0",
+        ));
+    }
+    m.friction = friction;
+    let mesh = s.mesh.as_deref().unwrap_or("coarse");
+    let level = parse_mesh(K, Some(mesh))?;
+    if level > R2_MAX_LEVEL {
+        return Err(ModelError::new(
+            K,
+            "mesh",
+            mesh,
+            format!(
+                "R2 accepts levels 1..{R2_MAX_LEVEL} (elements of 2, 1, 0.67 mm); finer meshes are for examples/convergence_r2"
+            ),
+        ));
+    }
+    m.level = level;
+    m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+    // the scalars and the geometry, named (rd deeper than the wheel allows,
+    // a nodule outside the block or overlapping another)
+    palpate_fe::r2::check_model(&m).map_err(|(field, reason)| {
+        let value = match field.as_str() {
+            "rd" => s.rd.to_string(),
+            "friction" => friction.to_string(),
+            _ => text.to_string(),
+        };
+        let field: &'static str = match field.as_str() {
+            "rd" => "rd",
+            "friction" => "friction",
+            _ => "nodules",
+        };
+        ModelError::new(K, field, value, reason)
+    })?;
+    Ok(m)
 }
 
 /// The displacement unknowns of N3 mesh `level` (3 per node), counted from

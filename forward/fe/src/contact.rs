@@ -147,6 +147,22 @@ pub struct RigidContact {
     pub surface: Box<dyn RigidSurface>,
     pub motion: ToolMotion,
     pub options: ContactOptions,
+    /// A pure penalty (`lambda = 0` always: no Uzawa update at commit, no
+    /// augmentation): the contact force is a function of the current
+    /// configuration alone, so a frictionless state depends on the tool's
+    /// position only, not on the path that led there (R2's rolled pass),
+    /// at the price of a penetration `t_N / eps_N` (a force bias that falls
+    /// as `1 / eps_N`). Default `false` (augmented Lagrangian).
+    pub pure_penalty: bool,
+    /// Width `delta` (mm) of a softened onset of the normal force: with
+    /// the penetration `s = lambda / eps_N - g`,
+    /// `t_N = eps_N (s + delta/2)^2 / (2 delta)` for `|s| < delta/2` and
+    /// `t_N = eps_N s` beyond (continuous with its derivative, the same
+    /// force as the sharp law once `s >= delta/2`, so a loaded point has no
+    /// bias). The kink at first touch is what makes Newton chatter when a
+    /// stiff penalty meets a moving contact edge (R2's wheel). 0 (default):
+    /// the sharp law.
+    pub smoothing: f64,
     points: Vec<ContactPoint>,
     facets: Vec<Vec<usize>>,
     committed: Vec<PointHistory>,
@@ -202,6 +218,8 @@ impl RigidContact {
             surface,
             motion,
             options,
+            pure_penalty: false,
+            smoothing: 0.0,
             committed: vec![PointHistory::default(); points.len()],
             trial: vec![PointHistory::default(); points.len()],
             lambda: vec![0.0; points.len()],
@@ -379,6 +397,8 @@ struct Tool<'a> {
     pose: &'a Pose,
     pose_committed: &'a Pose,
     options: &'a ContactOptions,
+    /// [`RigidContact::smoothing`].
+    smoothing: f64,
     dim: usize,
 }
 
@@ -396,7 +416,20 @@ impl Tool<'_> {
         let (o, dim, surface) = (self.options, self.dim, self.surface);
         let pr = self.pose.project(surface, x);
         let (eps_n, eps_t) = (o.penalty_normal * area, o.penalty_tangent * area);
-        let tn = lambda - eps_n * pr.gap;
+        let mut tn = lambda - eps_n * pr.gap;
+        // d t_N / d(-g): eps_N, or less on the softened onset
+        let mut slope = eps_n;
+        let half = 0.5 * self.smoothing;
+        if half > 0.0 && eps_n > 0.0 {
+            let s = tn / eps_n;
+            if s <= -half {
+                tn = 0.0;
+            } else if s < half {
+                let r = s + half;
+                tn = eps_n * r * r / (4.0 * half);
+                slope = eps_n * r / (2.0 * half);
+            }
+        }
         let mut t = PointHistory {
             pos: c.pos,
             lambda,
@@ -408,7 +441,7 @@ impl Tool<'_> {
         }
         t.normal_force = tn;
         let nv = pr.normal;
-        let dtn: [f64; 3] = std::array::from_fn(|j| -eps_n * nv[j]);
+        let dtn: [f64; 3] = std::array::from_fn(|j| -slope * nv[j]);
         let mut f: [f64; 3] = std::array::from_fn(|i| tn * nv[i]);
         let mut kmat = [[0.0; 3]; 3];
         for i in 0..dim {
@@ -569,6 +602,7 @@ impl Contribution for RigidContact {
             pose: &pose,
             pose_committed: &pose_c,
             options: &o,
+            smoothing: self.smoothing,
             dim,
         };
         for (k, p) in self.points.iter().enumerate() {
@@ -612,7 +646,7 @@ impl Contribution for RigidContact {
     }
 
     fn augment(&mut self) -> bool {
-        if self.max_penetration() <= self.options.penetration_tol {
+        if self.pure_penalty || self.max_penetration() <= self.options.penetration_tol {
             return false;
         }
         for (l, t) in self.lambda.iter_mut().zip(&self.trial) {
@@ -625,7 +659,11 @@ impl Contribution for RigidContact {
         for (k, p) in self.points.iter().enumerate() {
             self.committed[k] = PointHistory {
                 pos: p.position(|n| ctx.position(n)),
-                lambda: self.trial[k].normal_force,
+                lambda: if self.pure_penalty {
+                    0.0
+                } else {
+                    self.trial[k].normal_force
+                },
                 ..self.trial[k]
             };
             self.lambda[k] = self.committed[k].lambda;
@@ -765,6 +803,7 @@ mod tests {
                     pose: &pose,
                     pose_committed: &pose,
                     options: &o,
+                    smoothing: 0.0,
                     dim: 3,
                 };
                 let stuck = PointHistory {
@@ -830,6 +869,7 @@ mod tests {
                 pose: &pose,
                 pose_committed: &pose,
                 options: &o,
+                smoothing: 0.0,
                 dim: 2,
             };
             let c = PointHistory {

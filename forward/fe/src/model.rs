@@ -91,10 +91,41 @@ pub(crate) trait Setup: Send + Sync {
         material: RegionMaterial,
         extra: &[f64],
     ) -> Result<(), FeError>;
+    /// The stepper's path for `loading` (channel values per station) and
+    /// how many of its first stations are a preload whose outputs are not
+    /// samples. Default: one channel driven by the displacement samples
+    /// (`Drive::DisplacementMm`), no preload; a model with several channels
+    /// or another drive (R2's wheel pressed, then rolled through positions)
+    /// builds its own.
+    fn path(&self, loading: &Loading, opts: &SolverOptions) -> Result<Path, ForwardError> {
+        if loading.drive_kind != Drive::DisplacementMm {
+            return Err(ForwardError::InvalidLoading(format!(
+                "FE models are driven by {}, got {}",
+                Drive::DisplacementMm.column(),
+                loading.drive_kind.column()
+            )));
+        }
+        Ok(Path {
+            path: LoadPath::from_loading(
+                &loading.drive,
+                loading.time.as_deref(),
+                opts.max_step,
+                opts.max_time_step,
+            ),
+            preload: 0,
+        })
+    }
     /// The outputs of a converged state: as many as the model's
     /// [`palpate_core::ForwardModel::outputs`], in that order (the
     /// evaluator checks); the first is the force a one-output consumer sees.
     fn observe(&self, sys: &System) -> Vec<f64>;
+}
+
+/// A loading as the stepper runs it: the path, and the number of its first
+/// stations that are a preload (run, not reported as samples).
+pub(crate) struct Path {
+    pub path: LoadPath,
+    pub preload: usize,
 }
 
 pub(crate) fn to_forward(e: FeError) -> ForwardError {
@@ -114,8 +145,11 @@ pub(crate) fn to_forward(e: FeError) -> ForwardError {
 }
 
 /// A failed run as a [`ForwardError`]; `completed` holds the first output of
-/// each converged sample, or (`all_outputs`) every output, row-major.
-fn failure(f: RunFailure, all_outputs: bool) -> ForwardError {
+/// each converged sample, or (`all_outputs`) every output, row-major; the
+/// first `preload` stations are not samples.
+fn failure(mut f: RunFailure, all_outputs: bool, preload: usize) -> ForwardError {
+    f.completed.drain(..preload.min(f.completed.len()));
+    f.sample = f.sample.saturating_sub(preload);
     match f.error {
         FeError::InvalidConfig { .. }
         | FeError::InvalidMesh { .. }
@@ -161,13 +195,6 @@ fn simulate_with(
     all_outputs: bool,
 ) -> Result<Simulation, ForwardError> {
     space.check(theta)?;
-    if loading.drive_kind != Drive::DisplacementMm {
-        return Err(ForwardError::InvalidLoading(format!(
-            "FE models are driven by {}, got {}",
-            Drive::DisplacementMm.column(),
-            loading.drive_kind.column()
-        )));
-    }
     loading.validate().map_err(ForwardError::InvalidLoading)?;
     let law = setup.law();
     let n_law = law.params().len();
@@ -195,15 +222,11 @@ fn simulate_with(
     setup
         .prepare(sys, material, &theta[n_law..])
         .map_err(to_forward)?;
-    let path = LoadPath::from_loading(
-        &loading.drive,
-        loading.time.as_deref(),
-        opts.max_step,
-        opts.max_time_step,
-    );
+    let Path { path, preload } = setup.path(loading, &opts)?;
     let mut observe = |s: &System| setup.observe(s);
-    let outputs = stepper::run(sys, &path, &opts, &mut observe, progress)
-        .map_err(|f| failure(f, all_outputs))?;
+    let mut outputs = stepper::run(sys, &path, &opts, &mut observe, progress)
+        .map_err(|f| failure(f, all_outputs, preload))?;
+    outputs.drain(..preload.min(outputs.len()));
     Ok(Simulation {
         forces: outputs.iter().map(|o| o[0]).collect(),
         outputs,

@@ -39,6 +39,12 @@ pub struct SolverOptions {
     /// materials); `Some(dt)`: holds advance in increments of at most `dt`
     /// (rate-dependent materials).
     pub max_time_step: Option<f64>,
+    /// The largest entry of a full Newton update (mm for displacements):
+    /// a longer update is scaled down to it before the line search. A
+    /// guard for contact whose active set jumps (a wheel moved sideways
+    /// into the material, R2), where the first tangent can send the body
+    /// millimetres through the tool. `None` (default): no limit.
+    pub max_update: Option<f64>,
 }
 
 impl Default for SolverOptions {
@@ -53,6 +59,7 @@ impl Default for SolverOptions {
             stagnation_tolerance: 1e-4,
             reuse_factorisation: true,
             max_time_step: None,
+            max_update: None,
         }
     }
 }
@@ -416,6 +423,13 @@ impl System {
             self.values = values;
             solved?;
             self.stats.factorisations += 1;
+            if let Some(cap) = opts.max_update {
+                let big = du.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+                if big > cap {
+                    let f = cap / big;
+                    du.iter_mut().for_each(|v| *v *= f);
+                }
+            }
             let u0 = self.u.clone();
             let mut alpha = 1.0;
             let mut last_err = None;

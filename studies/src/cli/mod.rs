@@ -11,6 +11,7 @@ pub mod run;
 pub mod sample;
 pub mod sample_fe;
 pub mod simulate;
+pub mod simulate_r2;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify
 /// their uncertainty and diagnose the gap between simulation and measurement.

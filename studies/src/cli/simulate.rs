@@ -17,7 +17,7 @@ use palpate_fe::discretisation::{richardson, Coarser};
 use palpate_fe::{Bulk, Progress, Simulation};
 use palpate_material::Law;
 
-use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
+use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec, R2Spec};
 use crate::output::write_atomic;
 use crate::plot::{Plot, Series};
 
@@ -25,18 +25,30 @@ use crate::plot::{Plot, Series};
 #[derive(Debug, clap::Args)]
 #[command(allow_negative_numbers = true)]
 pub struct Args {
-    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), N3 (the same needle into a 70 x 80 x 80 mm block, 3D quarter model), C1 (compression of a 38 x 9 mm cylinder) or Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm).
-    #[arg(long, value_parser = ["N1", "N3", "C1", "Q1", "n1", "n3", "c1", "q1"])]
+    /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), N3 (the same needle into a 70 x 80 x 80 mm block, 3D quarter model), C1 (compression of a 38 x 9 mm cylinder), Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm) or R2 (a wheel of diameter 8 mm pressed to --rd at x = 10 mm and rolled to x = 140 mm over a 150 x 30 mm block, 50 mm thick, with bonded nodules of diameter 10 mm; plane stress).
+    #[arg(long, value_parser = ["N1", "N3", "C1", "Q1", "R2", "n1", "n3", "c1", "q1", "r2"])]
     pub benchmark: String,
-    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N (required, except R2: the tissue law, default arruda-boyce with rtv6166-ab's mu=0.00498, lambda_m=1.05).
     #[arg(long)]
-    pub law: String,
+    pub law: Option<String>,
     /// A law parameter in MPa (or 1), e.g. --param C10=0.001101295; repeat for each parameter of the law.
     #[arg(long = "param", value_name = "NAME=VALUE")]
     pub params: Vec<String>,
-    /// N1, N3: Coulomb friction coefficient between needle and material [default: 0.8].
+    /// N1, N3: Coulomb friction coefficient between needle and material [default: 0.8]; R2: between wheel and block [default: 0, frictionless].
     #[arg(long)]
     pub friction: Option<f64>,
+    /// R2: rolling depth of the wheel in mm (required; 0 < RD < 8, the wheel diameter).
+    #[arg(long, value_name = "RD")]
+    pub rd: Option<f64>,
+    /// R2: the nodules as X:DEPTH,... in mm (centre position along the block, centre depth below the surface), or none [default: 37.5:10,75:15,112.5:20]; 75:15 alone is R2-1.
+    #[arg(long, value_name = "X:DEPTH,...")]
+    pub nodules: Option<String>,
+    /// R2: the nodules' law [default: arruda-boyce with rubber-ab's mu=0.0734, lambda_m=1.01].
+    #[arg(long)]
+    pub nodule_law: Option<String>,
+    /// R2: a parameter of the nodule law, e.g. --nodule-param mu=0.0734; repeat for each.
+    #[arg(long = "nodule-param", value_name = "NAME=VALUE")]
+    pub nodule_params: Vec<String>,
     /// C1: bonded (no-slip) platens instead of frictionless ones.
     #[arg(long)]
     pub bonded: bool,
@@ -52,10 +64,10 @@ pub struct Args {
     /// Final tool displacement in mm (default: 10 for N1, 2 for C1, 5 for Q1).
     #[arg(long)]
     pub depth: Option<f64>,
-    /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1, depth/100 for Q1).
+    /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1, depth/100 for Q1, 0.5 mm of wheel travel for R2).
     #[arg(long)]
     pub step: Option<f64>,
-    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch; N3: hexahedra of 0.8/N mm, levels 1..2) [default: medium; N3: coarse].
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch; N3: hexahedra of 0.8/N mm, levels 1..2, default coarse; R2: 9-node elements of 2/N mm at the surface and around the nodules, levels 1..3, default coarse) [default: medium].
     #[arg(long)]
     pub mesh: Option<String>,
     /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
@@ -76,7 +88,7 @@ pub struct Args {
     /// With --prony (N1, C1) or Q1: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0; Q1: 60].
     #[arg(long, value_name = "SECONDS")]
     pub hold: Option<f64>,
-    /// Write the force curve as CSV (columns [time_s,]displacement_mm,force_N[,error_estimate_N], time_s with --prony and for Q1; `#` lines state the model, the volumetric treatment and the error estimate).
+    /// Write the force curve as CSV (columns [time_s,]displacement_mm,force_N[,error_estimate_N], time_s with --prony and for Q1; R2: position_mm,force_N,force_x_N[,error_estimate_N] for the rolled pass and the pressing phase in OUT.press.csv as displacement_mm,force_N,force_x_N; `#` lines state the model, the volumetric treatment and the error estimate).
     #[arg(long, value_name = "OUT.csv")]
     pub csv: Option<PathBuf>,
     /// Write the final deformed state as a VTK .vtu file for ParaView.
@@ -87,7 +99,7 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
-fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
+pub(crate) fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
     let specs = law.params();
     let mut values = vec![None; specs.len()];
     for g in given {
@@ -139,6 +151,8 @@ fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f64>> {
 pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
     let kind = if is_q1(args) {
         "Q1"
+    } else if args.benchmark.eq_ignore_ascii_case("r2") {
+        "R2"
     } else if args.benchmark.eq_ignore_ascii_case("n3") {
         "N3"
     } else if args.benchmark.eq_ignore_ascii_case("n1") {
@@ -147,7 +161,37 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
         "C1"
     };
     // (option, value shown, the benchmarks that use it)
-    let options: [(bool, &str, String, &[&str]); 8] = [
+    let options: [(bool, &str, String, &[&str]); 13] = [
+        (
+            args.rd.is_some(),
+            "--rd",
+            args.rd.map(|f| f.to_string()).unwrap_or_default(),
+            &["R2"],
+        ),
+        (
+            args.nodules.is_some(),
+            "--nodules",
+            args.nodules.clone().unwrap_or_default(),
+            &["R2"],
+        ),
+        (
+            args.nodule_law.is_some(),
+            "--nodule-law",
+            args.nodule_law.clone().unwrap_or_default(),
+            &["R2"],
+        ),
+        (
+            !args.nodule_params.is_empty(),
+            "--nodule-param",
+            args.nodule_params.join(" "),
+            &["R2"],
+        ),
+        (
+            args.depth.is_some(),
+            "--depth",
+            format!("{:?}", args.depth.unwrap_or(0.0)),
+            &["N1", "N3", "C1", "Q1"],
+        ),
         (args.bonded, "--bonded", String::new(), &["C1"]),
         (
             args.prony.is_some(),
@@ -171,7 +215,7 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
             args.friction.is_some(),
             "--friction",
             args.friction.map(|f| f.to_string()).unwrap_or_default(),
-            &["N1", "N3"],
+            &["N1", "N3", "R2"],
         ),
         (args.sliding_base, "--sliding-base", String::new(), &["N1"]),
         (
@@ -197,9 +241,27 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
             users.join(" and ")
         );
     }
+    if kind == "R2" {
+        let rd = args.rd.ok_or_else(|| {
+            anyhow!("--benchmark R2 needs --rd RD (the rolling depth in mm, e.g. 6)")
+        })?;
+        return Ok(ModelSpec::R2(R2Spec {
+            law: args.law.clone().unwrap_or_else(|| "arruda-boyce".into()),
+            nodule_law: args.nodule_law.clone(),
+            rd,
+            nodules: args.nodules.clone(),
+            friction: args.friction,
+            mesh: args.mesh.clone(),
+            bulk: args.bulk.clone(),
+        }));
+    }
+    let law = args
+        .law
+        .clone()
+        .ok_or_else(|| anyhow!("--benchmark {kind} needs --law (e.g. --law neo-hookean)"))?;
     Ok(if kind == "Q1" {
         ModelSpec::Q1(Q1Spec {
-            law: args.law.clone(),
+            law: law.clone(),
             mesh: args.mesh.clone(),
             bulk: args.bulk.clone(),
             element: args.element.clone(),
@@ -207,7 +269,7 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
         })
     } else if kind == "N3" {
         ModelSpec::N3Needle(N3NeedleSpec {
-            law: args.law.clone(),
+            law: law.clone(),
             friction: args.friction,
             mesh: args.mesh.clone(),
             bulk: args.bulk.clone(),
@@ -215,7 +277,7 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
         })
     } else if kind == "N1" {
         ModelSpec::N1Needle(N1NeedleSpec {
-            law: args.law.clone(),
+            law: law.clone(),
             friction: args.friction,
             mesh: args.mesh.clone(),
             bulk: args.bulk.clone(),
@@ -226,7 +288,7 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
         })
     } else {
         ModelSpec::C1Fe(C1FeSpec {
-            law: args.law.clone(),
+            law,
             platens: args.bonded.then(|| "bonded".into()),
             mesh: args.mesh.clone(),
             bulk: args.bulk.clone(),
@@ -244,10 +306,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let model = model_spec(&args)?
         .validate()
         .map_err(|e| anyhow!("{}", e.as_option()))?;
-    let law: Law = args
-        .law
+    if let Model::R2(m) = model {
+        return super::simulate_r2::run(&args, m);
+    }
+    let law_text = args.law.clone().unwrap_or_default();
+    let law: Law = law_text
         .parse()
-        .map_err(|e| anyhow!("--law `{}`: {e}", args.law))?;
+        .map_err(|e| anyhow!("--law `{law_text}`: {e}"))?;
     let theta = parse_params(&law, &args.params)?;
     crate::output::check_outputs(
         &[],
@@ -444,14 +509,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 }
 
 /// The volumetric treatment in words.
-fn volumetric(bulk: Bulk) -> String {
+pub(crate) fn volumetric(bulk: Bulk) -> String {
     match bulk {
         Bulk::Exact => "exact incompressibility (Lagrange multiplier per element)".into(),
         Bulk::Ratio(r) => format!("nearly incompressible, K = {r} x mu (mean-dilatation penalty)"),
     }
 }
 
-fn progress_bar(len: usize, prefix: &str) -> (ProgressBar, impl FnMut(&Progress)) {
+pub(crate) fn progress_bar(len: usize, prefix: &str) -> (ProgressBar, impl FnMut(&Progress)) {
     let bar = ProgressBar::new(len as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} samples  {msg}  [{elapsed_precise}]")

@@ -21,6 +21,7 @@
 
 pub mod gmsh;
 pub mod grading;
+pub mod inclusions;
 pub mod jacobian;
 pub mod quadratic;
 pub mod structured;
@@ -33,6 +34,7 @@ use serde::{Deserialize, Serialize};
 use crate::FeError;
 
 pub use grading::Grading;
+pub use inclusions::InclusionBlock;
 
 /// The shape of a cell or facet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
