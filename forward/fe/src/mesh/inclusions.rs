@@ -696,7 +696,7 @@ mod tests {
     #[test]
     fn no_nodules() {
         let m = block(vec![], 2.0).mesh().unwrap();
-        assert!(m.regions.get("nodule").is_none());
+        assert!(!m.regions.contains_key("nodule"));
         assert!((area(&m, "tissue") - 4500.0).abs() < 1e-6);
     }
 
