@@ -109,7 +109,8 @@ pub fn split_data(d: &str) -> anyhow::Result<(&str, ReadOptions, &str)> {
     let (test, path) = split_pair(
         d,
         "TEST=FILE, e.g. uniaxial=data.csv (or use --benchmark C1 --data FILE)",
-    )?;
+    )
+    .map_err(|e| anyhow::anyhow!("--data {e}"))?;
     Ok((test, options, path))
 }
 
@@ -142,8 +143,7 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
         ),
         None => {
             for d in data {
-                let (test, options, path) =
-                    split_data(d).map_err(|e| anyhow::anyhow!("--data {e}"))?;
+                let (test, options, path) = split_data(d)?;
                 let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
                 let name = if out.iter().any(|o: &TestData| o.name == test) {
                     format!("{test}#{}", out.len() + 1)
