@@ -77,10 +77,15 @@ fn main() {
     let mut fine = model.clone();
     fine.element_size = Some(1.0);
     for &x in &xs {
-        let k = positions
-            .iter()
-            .position(|&p| (p - x).abs() < 1e-9)
-            .expect("x on the pass grid (a multiple of the step from 10 mm)");
+        // the pass position nearest to x (56.25 is between grid points)
+        let k = (0..positions.len())
+            .min_by(|&a, &b| {
+                (positions[a] - x)
+                    .abs()
+                    .total_cmp(&(positions[b] - x).abs())
+            })
+            .expect("a pass position");
+        let x = positions[k];
         let mut p = fine.clone();
         p.press_x = x;
         let n = (rd / 0.5).round() as usize;
