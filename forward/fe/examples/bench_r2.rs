@@ -1,0 +1,109 @@
+//! R2 speed bench (issue 11: a full pass in 30 s or less on 2 cores): the
+//! BENCHMARKS.md R2 rolled pass, x 10 -> 140 mm every 0.5 mm, RD 6, the
+//! three default nodules, frictionless, at the accuracy-level mesh (level 1,
+//! h = 2 mm: within 0.63 % of h = 1 at the RD 3 presses of
+//! docs/validation/fe.md R2), solved by `R2Rolling::rolled_pass` in
+//! `--segments` parallel segments (default 2, the cores here). Prints the
+//! wall time, the CPU time (user + sys of the process, all threads), and the
+//! force error of the pass against presses on the finer mesh (h = 1 mm) at
+//! a few positions over and between the nodules (a press at x equals the
+//! rolled state at x for this contact, tests/r2_rolling.rs).
+//!
+//! `cargo run --release -p palpate-fe --example bench_r2 -- [--segments 2]
+//!  [--step 0.5] [--rd 6] [--x 37.5,56.25,75,112.5]`
+
+use std::time::Instant;
+
+use palpate_core::{Drive, ForwardModel, Loading};
+use palpate_fe::R2Rolling;
+use palpate_material::Law;
+
+#[path = "common/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
+
+fn list(v: &str) -> Vec<f64> {
+    v.split(',').map(|x| x.parse().expect("a number")).collect()
+}
+
+fn main() {
+    let mut segments = 2usize;
+    let mut step = 0.5;
+    let mut rd = 6.0;
+    let mut xs = vec![37.5, 56.25, 75.0, 112.5];
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let mut it = args.iter();
+    while let Some(a) = it.next() {
+        let mut value = || it.next().expect("a value after the option").clone();
+        match a.as_str() {
+            "--segments" => segments = value().parse().expect("a count"),
+            "--step" => step = value().parse().expect("mm"),
+            "--rd" => rd = value().parse().expect("mm"),
+            "--x" => xs = list(&value()),
+            other => panic!("unknown option {other}"),
+        }
+    }
+    let theta = R2Rolling::BENCHMARK_PARAMS;
+    let model = R2Rolling::new(Law::ArrudaBoyce, Law::ArrudaBoyce, rd);
+    let positions = model.pass_positions(step);
+    let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    println!(
+        "R2 full pass: x {}..{} mm every {step} mm ({} positions), RD {rd}, nodules 37.5:10,75:15,112.5:20, level {} (h = {} mm), {segments} segments, {cores} cores",
+        model.press_x,
+        model.roll_to,
+        positions.len(),
+        model.level,
+        model.h()
+    );
+    let (c0, t0) = (cpu_seconds(false), Instant::now());
+    let (pass, _) = model
+        .rolled_pass(&theta, &positions, segments, None)
+        .unwrap_or_else(|e| panic!("the pass failed: {e}"));
+    let (wall, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds(false) - c0);
+    let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
+    println!(
+        "| pass | wall s | CPU s (user+sys) | target |\n|---|---|---|---|\n| {} positions | {wall:.1} | {cpu:.1} | 30 s wall on 2 cores: {} |",
+        positions.len(),
+        if wall <= 30.0 { "met" } else { "NOT met" }
+    );
+    println!(
+        "load average at the end: {}",
+        load.split_whitespace()
+            .take(3)
+            .collect::<Vec<_>>()
+            .join(" ")
+    );
+    println!("\n| x mm | pass h=2 N | press h=1 N | error h=2 | Fx pass N | CPU s (h=1 press) |\n|---|---|---|---|---|---|");
+    let mut fine = model.clone();
+    fine.element_size = Some(1.0);
+    for &x in &xs {
+        // the pass position nearest to x (56.25 is between grid points)
+        let k = (0..positions.len())
+            .min_by(|&a, &b| {
+                (positions[a] - x)
+                    .abs()
+                    .total_cmp(&(positions[b] - x).abs())
+            })
+            .expect("a pass position");
+        let x = positions[k];
+        let mut p = fine.clone();
+        p.press_x = x;
+        let n = (rd / 0.5).round() as usize;
+        let depths: Vec<f64> = (1..=n).map(|j| rd * j as f64 / n as f64).collect();
+        let c = cpu_seconds(false);
+        let f = p
+            .predict(
+                &theta,
+                &Loading::quasi_static(Drive::DisplacementMm, depths),
+            )
+            .unwrap_or_else(|e| panic!("press at {x} (h = 1): {e}"));
+        let f1 = *f.last().expect("one sample");
+        println!(
+            "| {x} | {:.4} | {f1:.4} | {:+.2} % | {:+.4} | {:.1} |",
+            pass[k][0],
+            100.0 * (pass[k][0] - f1) / f1,
+            pass[k][1],
+            cpu_seconds(false) - c
+        );
+    }
+}
