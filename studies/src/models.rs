@@ -865,35 +865,80 @@ pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
 }
 
 /// The base model of the gap diagnosis for a record of `test`: C1 analytic
-/// (lubricated platens), or N1 with a frictionless needle on the coarse mesh
+/// (lubricated platens), N1 with a frictionless needle on the coarse mesh
 /// and a bonded base, so that `friction` and `boundary_condition` are
-/// effects to find.
+/// effects to find, or the analytic homogeneous test of the record's kind
+/// (elastic: viscoelasticity is an effect to find). A record's own options
+/// (a simple-shear record's axial stretch) are set by [`gap_base_for`].
 pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
-    let law = law.to_string();
+    let spec_law = law.to_string();
     match test {
-        TestKind::C1 => Ok(ModelSpec::C1(C1Spec { law })),
+        TestKind::C1 => Ok(ModelSpec::C1(C1Spec { law: spec_law })),
         TestKind::N1 => Ok(ModelSpec::N1Needle(N1NeedleSpec {
-            law,
+            law: spec_law,
             friction: Some(0.0),
             mesh: Some("coarse".into()),
             ..Default::default()
         })),
         TestKind::Homogeneous(_) | TestKind::GeneralBiaxial | TestKind::SimpleShear => {
-            anyhow::bail!(
-                "the gap diagnosis supports C1 (analytic) and N1 (finite elements) force records"
-            )
+            Ok(for_test(test, law))
         }
     }
 }
 
-/// The default candidate effects of the gap diagnosis for a base model
-/// (`None`: every effect the model offers). N1: GAP.md's `friction` and
-/// `boundary_condition`; the N1 model also offers `material_form` and
-/// `zero_offset`, but on one force-depth curve friction and a stiffening law
-/// are confounded (docs/gap-diagnosis.md), so they are candidates on request only.
-pub fn default_effects(base: &ModelSpec) -> Option<Vec<Effect>> {
-    matches!(base, ModelSpec::N1Needle(_))
-        .then(|| vec![Effect::Friction, Effect::BoundaryCondition])
+/// [`gap_base`] for one record read by [`crate::calibration::TestData`]:
+/// a simple-shear record keeps the axial stretch it was read with.
+pub fn gap_base_for(record: &crate::calibration::TestData, law: Law) -> anyhow::Result<ModelSpec> {
+    if record.test.is_homogeneous() {
+        Ok(record.spec(law, None))
+    } else {
+        gap_base(record.test, law)
+    }
+}
+
+/// The default candidate effects of the gap diagnosis for a base model and
+/// the record it is diagnosed on (`None`: every effect the model offers).
+///
+/// - N1: GAP.md's `friction` and `boundary_condition`; the N1 model also
+///   offers `material_form` and `zero_offset`, but on one force-depth curve
+///   friction and a stiffening law are confounded (docs/gap-diagnosis.md),
+///   so they are candidates on request only.
+/// - Homogeneous records: those of the model's effects the record can show:
+///   `viscoelasticity` only on a timed record (a `time_s` column), and
+///   `tension_compression_asymmetry` only when the stretches lie on both
+///   sides of 1 (elsewhere its sensitivity is zero, [`spans_tension_and_compression`]).
+///   `material_form` and (stretch-driven tests) `zero_offset` always.
+/// - C1: every effect the model offers.
+pub fn default_effects(
+    base: &ModelSpec,
+    model: &dyn ForwardModel,
+    loading: &palpate_core::Loading,
+) -> Option<Vec<Effect>> {
+    match base {
+        ModelSpec::N1Needle(_) => Some(vec![Effect::Friction, Effect::BoundaryCondition]),
+        ModelSpec::Homogeneous(_) => Some(
+            palpate_core::enrichable::effects_of(model)
+                .into_iter()
+                .filter(|e| match e {
+                    Effect::Viscoelasticity => loading.time.is_some(),
+                    Effect::TensionCompressionAsymmetry => {
+                        spans_tension_and_compression(&loading.drive)
+                    }
+                    _ => true,
+                })
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
+/// Whether a stretch history has samples in compression (< 1) and in
+/// tension (> 1), two at least on each side (one sample is not a slope).
+pub fn spans_tension_and_compression(stretch: &[f64]) -> bool {
+    const EPS: f64 = 1e-9;
+    let below = stretch.iter().filter(|&&s| s < 1.0 - EPS).count();
+    let above = stretch.iter().filter(|&&s| s > 1.0 + EPS).count();
+    below >= 2 && above >= 2
 }
 
 /// Checks that a model offers every requested effect; the error (`E: ...`)

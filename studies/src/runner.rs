@@ -13,7 +13,7 @@
 
 use crate::calibration::{calibrate, parse_method, Calibration, Request, TestData, TestKind};
 use crate::manifest::{CalibrateStep, DiagnoseStep, Manifest, ModelForm, Step};
-use crate::models::{build, default_effects, gap_base, parse_effects};
+use crate::models::{build, default_effects, gap_base_for, parse_effects};
 use crate::output::{write_atomic, write_json};
 use crate::provenance::{crate_versions, git_state, hash_file, Provenance};
 use crate::report::{fit_plot, gap_svg};
@@ -517,7 +517,7 @@ fn run_diagnose(run: &Run, step: &DiagnoseStep, report: &mut String) -> anyhow::
                 let law: Law = base_name
                     .parse()
                     .map_err(|e| anyhow::anyhow!("step `{}`: base: {e}", step.name))?;
-                gap_base(d.test, law).with_context(|| format!("step `{}`: `{name}`", step.name))?
+                gap_base_for(d, law).with_context(|| format!("step `{}`: `{name}`", step.name))?
             }
         };
         let label = format!("{}: diagnosing {name}", step.name);
@@ -538,7 +538,7 @@ fn run_diagnose(run: &Run, step: &DiagnoseStep, report: &mut String) -> anyhow::
                         parse_effects(list)
                             .with_context(|| format!("step `{}`: effects", step.name))?,
                     ),
-                    None => default_effects(&spec),
+                    None => default_effects(&spec, model.as_ref(), &d.loading),
                 },
                 ..Default::default()
             };

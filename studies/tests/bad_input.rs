@@ -813,7 +813,6 @@ fn manifest_mistakes_name_the_manifest_and_the_field() {
         (format!("{head}{DATA}[models.x.c1_fe]\nlaw = \"neo-hookean\"\nplatens = \"glued\"\n{}", step("f", "")), vec!["models.x.c1_fe.platens", "glued"]),
         (format!("{head}{DATA}{}", step("f", "colour = 1")), vec!["colour"]),
         (format!("{head}{DATA}{}", step("f", "residuals = ")), vec!["m.toml"]),
-        (format!("{head}{DATA}[[steps]]\n[steps.diagnose]\nname = \"g\"\ndata = [\"uni\"]\nbase = \"neo-hookean\"\n"), vec!["diagnose", "C1 or N1"]),
     ];
     for (text, needles) in cases {
         let m = manifest(&s, "m.toml", &text);

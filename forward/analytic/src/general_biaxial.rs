@@ -6,6 +6,7 @@ use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
+use palpate_enrich::{richer_law, MaterialForm};
 use palpate_material::Law;
 
 /// Nominal stresses of a sheet stretched by `lambda1` and `lambda2` in its
@@ -113,12 +114,30 @@ impl ForwardModel for GeneralBiaxial {
 }
 
 impl Enrichable for GeneralBiaxial {
-    /// None: the paired layout is not a time history, so the wrappers that
-    /// act along a history (viscoelasticity) do not apply.
+    /// `material_form` only (when the law has a richer form): the paired
+    /// layout is not a time history, so the wrappers that act along a
+    /// history (viscoelasticity) do not apply, and its two stretches have no
+    /// one zero to offset.
     fn effects(&self) -> Vec<Effect> {
-        Vec::new()
+        if richer_law(&self.law).is_some() {
+            vec![Effect::MaterialForm]
+        } else {
+            Vec::new()
+        }
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        Err(not_applicable(effect, &self.name()))
+        match effect {
+            Effect::MaterialForm => {
+                let richer =
+                    richer_law(&self.law).ok_or_else(|| not_applicable(effect, &self.name()))?;
+                Ok(Box::new(MaterialForm::new(
+                    Box::new(GeneralBiaxial::new(richer.law)),
+                    richer.embed_law_params,
+                    self.law.to_string(),
+                    richer.space,
+                )))
+            }
+            _ => Err(not_applicable(effect, &self.name())),
+        }
     }
 }

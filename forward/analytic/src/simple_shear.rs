@@ -7,7 +7,7 @@ use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
-use palpate_enrich::{Viscoelastic, DEFAULT_PRONY_TERMS};
+use palpate_enrich::{richer_law, MaterialForm, Viscoelastic, DEFAULT_PRONY_TERMS};
 use palpate_material::{Law, Volumetric};
 
 /// Simple shear of amount `gamma` superposed on an axial stretch `lambda`
@@ -134,11 +134,28 @@ impl ForwardModel for SimpleShear {
 }
 
 impl Enrichable for SimpleShear {
+    /// `material_form` (the next richer law, when there is one) and
+    /// `viscoelasticity` (timed records).
     fn effects(&self) -> Vec<Effect> {
-        vec![Effect::Viscoelasticity]
+        let mut e = Vec::new();
+        if richer_law(&self.law).is_some() {
+            e.push(Effect::MaterialForm);
+        }
+        e.push(Effect::Viscoelasticity);
+        e
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
+            Effect::MaterialForm => {
+                let richer =
+                    richer_law(&self.law).ok_or_else(|| not_applicable(effect, &self.name()))?;
+                Ok(Box::new(MaterialForm::new(
+                    Box::new(SimpleShear::new(richer.law, self.axial_stretch)?),
+                    richer.embed_law_params,
+                    self.law.to_string(),
+                    richer.space,
+                )))
+            }
             Effect::Viscoelasticity => Ok(Box::new(Viscoelastic::new(
                 Box::new(self.clone()),
                 DEFAULT_PRONY_TERMS,

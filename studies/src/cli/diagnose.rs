@@ -3,7 +3,8 @@
 //! shrinks once that effect is added (GAP.md).
 
 use crate::calibration::{TestData, TestKind};
-use crate::models::{build, default_effects, gap_base, parse_effects};
+use crate::cli::calibrate::read_data;
+use crate::models::{build, default_effects, gap_base_for, parse_effects};
 use crate::output::{write_atomic, write_json};
 use crate::report::{gap_summary, gap_svg};
 use anyhow::Context;
@@ -11,39 +12,62 @@ use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
 use std::path::{Path, PathBuf};
 
-/// Diagnose the gap between a base model and a measured force record.
+/// Diagnose the sim-to-real gap of a record: where the misfit lies, which effect causes it, how far it shrinks.
 ///
-/// The base model (e.g. incompressible neo-Hookean C1 compression) is
-/// calibrated to the record; the misfit is located on the experiment's axis
-/// (time, or displacement for untimed records) against the noise estimated
-/// from the data; each candidate effect the model offers (material_form,
-/// viscoelasticity, zero_offset, compressibility, tool_compliance for C1;
-/// friction, boundary_condition, material_form, zero_offset for N1) is
-/// scored, refitted and cross-validated on held-out blocks; the verdict is
-/// the effect that earns its parameters, `none` when none does, and
-/// confounded effects are reported as such.
+/// The base model is calibrated to the record; the misfit is located on the
+/// experiment's axis (time, or the drive for untimed records) against the
+/// noise estimated from the data; each candidate effect is scored, refitted
+/// and cross-validated on held-out blocks; the verdict is the effect that
+/// earns its parameters, `none` when none does (or when what it explains is
+/// immaterial), and confounded effects are reported as such.
 ///
-/// Example: palpate diagnose --benchmark C1 --data record.csv --base neo-hookean --json gap.json
+/// Homogeneous records (no --benchmark): `--data TEST=FILE` with the test
+/// kinds and columns of `palpate calibrate` (uniaxial tension/compression,
+/// biaxial, planar, general biaxial, simple_shear; a time_s column makes the
+/// record timed; options in brackets: 'simple_shear[axial_stretch=0.9]=FILE').
+/// The base is the elastic analytic test of that kind with --law; the
+/// candidates offered by default:
+///   uniaxial, biaxial, planar   material_form, zero_offset (stretch offset),
+///                               viscoelasticity (timed records only),
+///                               tension_compression_asymmetry (only when the
+///                               stretches lie on both sides of 1)
+///   simple_shear                material_form, viscoelasticity (timed only)
+///   general_biaxial             material_form
+/// (material_form needs a law with a richer form: neo-hookean,
+/// reduced-polynomial:N<6, ogden:N.)
+///
+/// Benchmark force records (--benchmark C1 or N1, --data FILE with columns
+/// displacement_mm, force_N[, time_s]): C1 offers material_form,
+/// viscoelasticity, zero_offset, compressibility, tool_compliance; N1
+/// friction, boundary_condition (material_form, zero_offset on request). A
+/// bare `--data FILE` without --benchmark is read as a C1 record.
+///
+/// Examples:
+///   palpate diagnose --data uniaxial=brain.csv --law neo-hookean --json gap.json
+///   palpate diagnose --benchmark C1 --data record.csv --base neo-hookean
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
-    /// Benchmark the record comes from: C1 (analytic compression, seconds) or
-    /// N1 (FE needle indentation on the coarse mesh, frictionless needle,
-    /// bonded base; candidates friction, boundary_condition, material_form,
-    /// zero_offset; some 100 FE runs, a few minutes on 2 cores for a 10 mm record).
-    #[arg(long, default_value = "C1")]
-    pub benchmark: String,
-    /// The record: CSV with displacement_mm, force_N and (for rate effects) time_s.
+    /// Benchmark a force record comes from: C1 (analytic compression,
+    /// seconds) or N1 (FE needle indentation on the coarse mesh, frictionless
+    /// needle, bonded base; some 100 FE runs, a few minutes on 2 cores for a
+    /// 10 mm record). Leave out for homogeneous records (TEST=FILE).
     #[arg(long)]
-    pub data: PathBuf,
-    /// Base material law (neo-hookean, mooney-rivlin, reduced-polynomial:N, ...).
-    #[arg(long, default_value = "neo-hookean")]
+    pub benchmark: Option<String>,
+    /// The record: TEST=FILE or TEST[key=value,...]=FILE for a homogeneous
+    /// test (as `palpate calibrate --data`), or FILE with --benchmark (CSV
+    /// with displacement_mm, force_N and, for rate effects, time_s).
+    #[arg(long, value_name = "TEST=FILE")]
+    pub data: String,
+    /// Base material law (neo-hookean, mooney-rivlin, reduced-polynomial:N,
+    /// yeoh, arruda-boyce, ogden:N). `--law` is the same option.
+    #[arg(long, visible_alias = "law", default_value = "neo-hookean")]
     pub base: String,
-    /// Candidate effects, comma separated. Default: for C1 every effect the
-    /// model offers; for N1 the GAP.md N1 effects `friction` and
-    /// `boundary_condition` (add `material_form` and `zero_offset` here: on a
-    /// single force-depth curve friction and a stiffening law cannot be told
-    /// apart, and the report then says so).
+    /// Candidate effects, comma separated. Default: those listed above for
+    /// the record's kind (C1: every effect the model offers; N1: `friction`
+    /// and `boundary_condition`; add `material_form` and `zero_offset` here:
+    /// on a single force-depth curve friction and a stiffening law cannot be
+    /// told apart, and the report then says so).
     #[arg(long, value_delimiter = ',')]
     pub effects: Vec<String>,
     /// Family-wise significance level of the tests.
@@ -63,36 +87,57 @@ pub struct Args {
     pub plot: Option<PathBuf>,
 }
 
+/// Reads the record of `--data`: a C1 or N1 force record with
+/// `--benchmark` (or a bare FILE, read as C1), else a homogeneous record
+/// through [`read_data`], the reader of `palpate calibrate`.
+pub fn read_record(benchmark: Option<&str>, data: &str) -> anyhow::Result<TestData> {
+    let force_record = |test: TestKind, path: &str| TestData::read("record", test, Path::new(path));
+    match benchmark {
+        Some(b) => match TestKind::parse(b) {
+            Ok(t @ (TestKind::C1 | TestKind::N1)) => {
+                let path = data.split_once('=').filter(|(k, _)| k.eq_ignore_ascii_case(b));
+                force_record(t, path.map(|(_, p)| p).unwrap_or(data))
+            }
+            _ => anyhow::bail!(
+                "--benchmark {b}: the gap diagnosis takes a C1 or N1 force record; expected C1 or N1 (or leave --benchmark out and give --data TEST=FILE for a homogeneous record)"
+            ),
+        },
+        None if Path::new(data).is_file() => force_record(TestKind::C1, data),
+        None => {
+            let mut records = read_data(&[data.to_string()], None)?;
+            Ok(records.remove(0))
+        }
+    }
+}
+
 /// Diagnoses one record (shared with the manifest step).
-pub fn diagnose_file(
-    benchmark: &str,
+pub fn diagnose_record(
+    record: &TestData,
     base: &str,
-    data: &Path,
     options: &GapOptions,
 ) -> anyhow::Result<GapReport> {
     let law: Law = base
         .parse()
         .map_err(|e| anyhow::anyhow!("--base {base}: {e}"))?;
-    let test = match TestKind::parse(benchmark) {
-        Ok(t @ (TestKind::C1 | TestKind::N1)) => t,
-        _ => anyhow::bail!(
-            "--benchmark {benchmark}: the gap diagnosis takes a C1 or N1 record; expected C1 or N1"
-        ),
-    };
-    let spec = gap_base(test, law).with_context(|| format!("--benchmark {benchmark}"))?;
+    let spec = gap_base_for(record, law).with_context(|| format!("--data {}", record.file))?;
     let model = build(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
-    // C1 and N1 records share the columns displacement_mm, force_N[, time_s].
-    let record = TestData::read("record", TestKind::C1, data)?;
     let mut options = options.clone();
     if options.effects.is_none() {
-        options.effects = default_effects(&spec);
+        options.effects = default_effects(&spec, model.as_ref(), &record.loading);
     }
     if let Some(effects) = &options.effects {
         crate::models::check_effects(model.as_ref(), effects)
-            .map_err(|e| anyhow::anyhow!("--effects {e} (--benchmark {benchmark})"))?;
+            .map_err(|e| anyhow::anyhow!("--effects {e} ({} record)", record.name))?;
+        if effects.is_empty() {
+            anyhow::bail!(
+                "{}: {} offers no candidate effect this record can show; give --effects or a law with a richer form (neo-hookean, reduced-polynomial:N, ogden:N)",
+                record.file,
+                model.name()
+            );
+        }
     }
     diagnose(model.as_ref(), &record.loading, &record.observed, &options)
-        .with_context(|| format!("diagnosing {}", data.display()))
+        .with_context(|| format!("diagnosing {}", record.file))
 }
 
 /// Runs `palpate diagnose`.
@@ -112,15 +157,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         e => anyhow::anyhow!("{e}"),
     })?;
+    let record = read_record(args.benchmark.as_deref(), &args.data)?;
     crate::output::check_outputs(
-        &[&args.data],
+        &[Path::new(&record.file)],
         &crate::output::given(&[
             ("--json", &args.json),
             ("--report", &args.report),
             ("--plot", &args.plot),
         ]),
     )?;
-    let report = diagnose_file(&args.benchmark, &args.base, &args.data, &options)?;
+    let report = diagnose_record(&record, &args.base, &options)?;
     println!("{}", gap_summary(&report));
     if let Some(p) = &args.json {
         write_json(p, &report)?;
@@ -131,10 +177,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("wrote {}", p.display());
     }
     if let Some(p) = &args.plot {
-        write_atomic(
-            p,
-            gap_svg(&report, &args.data.display().to_string()).as_bytes(),
-        )?;
+        write_atomic(p, gap_svg(&report, &record.file).as_bytes())?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

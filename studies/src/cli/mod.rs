@@ -39,7 +39,7 @@ pub enum Command {
     Anova(anova::Args),
     /// Generate and run a designed experiment (factorial design) from a manifest.
     Doe(doe::Args),
-    /// Diagnose the sim-to-real gap: where the misfit lies, which effect causes it, how far it shrinks.
+    // The help of `diagnose` is its Args' doc comment (the candidates per test kind).
     Diagnose(diagnose::Args),
     /// Run a whole study described by one TOML manifest into a run folder.
     Run(run::Args),
