@@ -426,7 +426,17 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
             starts = starts.max(4);
             Some(viscous_start(&req, v)?)
         }
-        None => None,
+        // (only where the fit's parameters are the law's, in its order)
+        None => admissible_start(&req.law, &req.fixed)?.filter(|p| {
+            objective.space().names()
+                == req
+                    .law
+                    .params()
+                    .iter()
+                    .map(|s| s.name.clone())
+                    .collect::<Vec<_>>()
+                && p.len() == objective.space().len()
+        }),
     };
     let options = FitOptions {
         method: req.method,
@@ -501,6 +511,54 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
         predictions,
         fit: report,
     })
+}
+
+/// A start inside the law's domain when fixed values push the default one
+/// out of it (`--fix C01=-0.1` on Mooney-Rivlin: C10 + C01 > 0 needs
+/// C10 > 0.1 MPa, the default start is C10 = 1e-3): the free moduli (MPa,
+/// lower bound 0, or Ogden's mu_i) are raised by the fixed moduli's
+/// magnitude. `None`: the default start is admissible (or the law has no
+/// fixed value). An error names the fixed values when no such start exists.
+pub(crate) fn admissible_start(
+    law: &Law,
+    fixed: &[(String, f64)],
+) -> anyhow::Result<Option<Vec<f64>>> {
+    if fixed.is_empty() {
+        return Ok(None);
+    }
+    let specs = law.params();
+    let value = |s: &palpate_material::MaterialParam| {
+        fixed.iter().find(|(n, _)| n == &s.name).map(|(_, v)| *v)
+    };
+    let mut p: Vec<f64> = specs
+        .iter()
+        .map(|s| value(s).unwrap_or(s.initial))
+        .collect();
+    if law.check(&p).is_ok() {
+        return Ok(None);
+    }
+    let shift: f64 = specs
+        .iter()
+        .filter(|s| s.unit == "MPa")
+        .filter_map(value)
+        .map(f64::abs)
+        .sum();
+    for (k, s) in specs.iter().enumerate() {
+        let modulus = s.unit == "MPa" && (s.lower == 0.0 || s.name.starts_with("mu"));
+        if value(s).is_none() && modulus {
+            p[k] = s.initial.abs().max(1e-3) + shift;
+        }
+    }
+    match law.check(&p) {
+        Ok(()) => Ok(Some(p)),
+        Err(e) => {
+            let given: Vec<String> = fixed.iter().map(|(n, v)| format!("{n}={v}")).collect();
+            anyhow::bail!(
+                "fixed {}: no start of {law} with these values is admissible ({e}); free a parameter or change the fixed value",
+                given.join(" ")
+            )
+        }
+    }
 }
 
 /// The start of a viscoelastic fit: the law's parameters from an elastic

@@ -127,6 +127,14 @@ pub fn check_fixed(law: &Law, fixed: &[(String, f64)], option: &str) -> anyhow::
             all.join(" ")
         );
     }
+    // A fit must be able to start inside the law's domain with these values.
+    crate::calibration::admissible_start(law, fixed).map_err(|e| {
+        let all: Vec<String> = fixed
+            .iter()
+            .map(|(n, v)| format!("{option} {n}={}", fmt_value(*v)))
+            .collect();
+        anyhow::anyhow!("{}: {e}", all.join(" "))
+    })?;
     Ok(())
 }
 

@@ -574,3 +574,188 @@ fn a_run_folder_that_is_not_one_is_refused() {
     );
     assert_eq!(std::fs::read_to_string(s.path("good.csv")).unwrap(), UNI);
 }
+
+// ---------- R2: rolling depth, nodules, friction ----------
+
+/// The value appears in the message (any case: `NaN` for `nan`).
+#[track_caller]
+fn mentions(o: &Output, value: &str) {
+    let e = String::from_utf8_lossy(&o.stderr).to_lowercase();
+    assert!(e.contains(&value.to_lowercase()), "`{value}` not in: {e}");
+}
+
+fn r2(s: &Scratch, extra: &[&str]) -> Output {
+    let mut a = vec!["simulate", "--benchmark", "R2", "--error-estimate", "off"];
+    a.extend_from_slice(extra);
+    s.run(&a)
+}
+
+#[test]
+fn r2_options_are_checked_by_name_before_solving() {
+    let s = Scratch::new();
+    // A rolling depth of zero or less, not a number, or as deep as the wheel.
+    for rd in ["0", "-1", "nan", "inf", "8", "100"] {
+        let o = r2(&s, &["--rd", rd]);
+        refused(&o, &["--rd"]);
+        mentions(&o, rd);
+    }
+    let o = r2(&s, &[]);
+    refused(&o, &["--rd"]);
+    // Nodules outside the block, through its surface or bottom, overlapping,
+    // or not written as X:DEPTH.
+    for nodules in [
+        "200:15",
+        "-10:15",
+        "2:15",
+        "75:1",
+        "75:29",
+        "75:100",
+        "75:15,80:15",
+        "75",
+        "75:x",
+        "x:15",
+        "75:15,",
+        "75;15",
+        "",
+    ] {
+        let o = r2(&s, &["--rd", "6", "--nodules", nodules]);
+        refused(&o, &["--nodules"]);
+        if !nodules.is_empty() {
+            refused(&o, &[nodules]);
+        }
+    }
+    // Friction below zero or not a number.
+    for mu in ["-0.1", "-5", "nan", "inf"] {
+        let o = r2(&s, &["--rd", "6", "--friction", mu]);
+        refused(&o, &["--friction"]);
+        mentions(&o, mu);
+    }
+    // Meshes beyond what R2 offers, the nodule law and its parameters.
+    for (extra, needle) in [
+        (vec!["--mesh", "4"], "--mesh"),
+        (vec!["--mesh", "0"], "--mesh"),
+        (vec!["--nodule-law", "ogden:100"], "ogden:100"),
+        (vec!["--nodule-law", "rubber"], "rubber"),
+        (
+            vec!["--nodule-param", "mu=-1", "--nodule-param", "lambda_m=1.05"],
+            "--nodule-param mu=-1",
+        ),
+        (vec!["--nodule-param", "mu=1"], "missing --nodule-param"),
+        (vec!["--nodule-param", "C10=1"], "--nodule-param"),
+        (vec!["--step", "0"], "--step"),
+        (vec!["--step", "1e-300"], "--step"),
+    ] {
+        let mut a = vec!["--rd", "6"];
+        a.extend_from_slice(&extra);
+        refused(&r2(&s, &a), &[needle]);
+    }
+    // R2's own options on the other benchmarks.
+    for (bench, extra, needle) in [
+        ("C1", vec!["--rd", "6"], "--rd"),
+        ("N1", vec!["--nodules", "75:15"], "--nodules"),
+        ("C1", vec!["--nodule-law", "neo-hookean"], "--nodule-law"),
+        ("Q1", vec!["--nodule-param", "mu=1"], "--nodule-param"),
+    ] {
+        let mut a = extra.clone();
+        a.extend_from_slice(&["--param", "C10=0.0011"]);
+        refused(&simulate(&s, bench, &a), &[needle, "benchmark"]);
+    }
+}
+
+// ---------- priors and fixed values ----------
+
+#[test]
+fn priors_are_checked_by_name_and_value() {
+    let s = Scratch::new();
+    let u = format!("uniaxial={}", treloar("uniaxial.csv"));
+    for (prior, needle) in [
+        ("C10=normal:1,0", "positive"),
+        ("C10=normal:1,-1", "positive"),
+        ("C10=normal:nan,1", "finite"),
+        ("C10=uniform:2,1", "must exceed"),
+        ("C10=uniform:1,1", "must exceed"),
+        ("C10=uniform:0,inf", "finite"),
+        ("C10=uniform:-2,-1", "outside the range of C10"),
+        ("C10=lognormal", "2 numbers"),
+        ("C10=lognormal:1", "2 numbers"),
+        ("C10=halfnormal:inf", "finite"),
+        ("C10=halfnormal:1,2", "1 number"),
+        ("C10=halfnormal:0", "positive"),
+        ("C10=halfnormal:x", "not a number"),
+        ("C10=gamma:1,2", "gamma"),
+        ("C10=", "NAME=SPEC"),
+        ("=flat", "NAME=SPEC"),
+        ("C10", "NAME=SPEC"),
+        ("C99=flat", "C99"),
+        ("c10=flat", "c10"),
+    ] {
+        let o = s.run(&[
+            "sample",
+            "--law",
+            "neo-hookean",
+            "--data",
+            &u,
+            "--prior",
+            prior,
+        ]);
+        refused(&o, &[&format!("--prior {prior}"), needle]);
+    }
+    // A prior that excludes what the data say: named, with the fitted value.
+    let o = s.run(&[
+        "sample",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &u,
+        "--prior",
+        "C10=uniform:1,2",
+    ]);
+    refused(&o, &["C10 = ", "uniform:1,2", "widen the prior"]);
+}
+
+#[test]
+fn fixed_values_outside_the_laws_domain_name_the_option() {
+    let s = Scratch::new();
+    let u = format!("uniaxial={}", treloar("uniaxial.csv"));
+    for (law, fix, needle) in [
+        ("mooney-rivlin", "C10=-1", "--fix C10=-1"),
+        ("neo-hookean", "C10=0", "--fix C10=0"),
+        ("ogden:1", "alpha1=0", "--fix alpha1=0"),
+        ("ogden:1", "alpha1=25", "--fix alpha1=25"),
+        // mu1 alone < 0: the initial shear modulus cannot be positive.
+        ("ogden:1", "mu1=-1", "--fix mu1=-1"),
+        ("arruda-boyce", "lambda_m=1", "--fix lambda_m=1"),
+        ("arruda-boyce", "lambda_m=0.5", "--fix lambda_m=0.5"),
+        ("yeoh", "C20=1e300", "--fix C20=1e300"),
+    ] {
+        let o = s.run(&["calibrate", "--law", law, "--data", &u, "--fix", fix]);
+        refused(&o, &[needle]);
+        let e = String::from_utf8_lossy(&o.stderr);
+        assert!(!e.contains("NaN"), "{fix}: {e}");
+    }
+    // C01 < 0 is allowed while C10 + C01 > 0: the fit starts inside that
+    // domain (C10 above 0.1 MPa) instead of failing on a NaN at its start.
+    let brain = format!(
+        "uniaxial={}/../shared/data/real/brain_budday2017/cortex_compression_tension.csv",
+        env!("CARGO_MANIFEST_DIR").trim_end_matches("/studies")
+    );
+    for data in [&u, &brain] {
+        let json = s.path("fit.json").display().to_string();
+        let o = s.run(&[
+            "calibrate",
+            "--law",
+            "mooney-rivlin",
+            "--data",
+            data,
+            "--fix",
+            "C01=-0.1",
+            "--json",
+            &json,
+        ]);
+        accepted(&o);
+        let v: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+        let c10 = v["params"]["C10"]["value"].as_f64().unwrap();
+        assert!(c10 > 0.1, "C10 = {c10}: C10 + C01 must stay > 0");
+    }
+}

@@ -296,7 +296,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let mut priors = vec![Prior::Flat; space.len()];
     for p in &args.prior {
         let (name, spec) =
-            crate::cli::calibrate::split_pair(p, "NAME=SPEC, e.g. C10=lognormal:-7,1")?;
+            crate::cli::calibrate::split_pair(p, "NAME=SPEC, e.g. C10=lognormal:-7,1")
+                .map_err(|_| {
+                    anyhow::anyhow!(
+                        "--prior {p}: expected NAME=SPEC, e.g. C10=lognormal:-7,1 (SPEC: flat, uniform:L,U, normal:M,S, lognormal:MU,SIGMA or halfnormal:S)"
+                    )
+                })?;
         if args
             .prior
             .iter()
@@ -313,9 +318,21 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 space.names().join(", ")
             )
         })?;
-        priors[k] = spec
+        let prior: Prior = spec
             .parse()
             .map_err(|e| anyhow::anyhow!("--prior {p}: {e}"))?;
+        // The prior must give the parameter's own range some mass.
+        let (lo, hi) = prior.support();
+        let b = &space.params[k];
+        if !(lo.max(b.lower) < hi.min(b.upper)) {
+            anyhow::bail!(
+                "--prior {p}: the prior lives on [{lo}, {hi}], outside the range of {name}, ({}, {}) {}: no value of {name} would be possible",
+                b.lower,
+                b.upper,
+                b.unit
+            );
+        }
+        priors[k] = prior;
     }
     let mut post = Posterior::new(sets, priors)?;
     if let Some(fe) = &fe {

@@ -41,7 +41,7 @@ pub struct Args {
     #[arg(long, value_name = "RD")]
     pub rd: Option<f64>,
     /// R2: the nodules as X:DEPTH,... in mm (centre position along the block, centre depth below the surface), or none [default: 37.5:10,75:15,112.5:20]; 75:15 alone is R2-1.
-    #[arg(long, value_name = "X:DEPTH,...")]
+    #[arg(long, value_name = "X:DEPTH,...", allow_hyphen_values = true)]
     pub nodules: Option<String>,
     /// R2: the nodules' law [default: arruda-boyce with rubber-ab's mu=0.0734, lambda_m=1.01].
     #[arg(long)]

@@ -41,9 +41,27 @@ impl Scratch {
     }
 }
 
+/// With `BAD_INPUT_LOG=FILE` set, each verdict appends a line to FILE, so
+/// the suite's cases can be counted (docs/validation/reliability.md).
+#[track_caller]
+fn log_case(verdict: &str) {
+    if let Some(path) = std::env::var_os("BAD_INPUT_LOG") {
+        use std::io::Write;
+        let at = std::panic::Location::caller();
+        if let Ok(mut f) = std::fs::OpenOptions::new()
+            .create(true)
+            .append(true)
+            .open(path)
+        {
+            let _ = writeln!(f, "{verdict} {}:{}", at.file(), at.line());
+        }
+    }
+}
+
 /// Fails cleanly (non-zero exit, no panic) with every needle in stderr.
 #[track_caller]
 pub fn refused(o: &Output, needles: &[&str]) {
+    log_case("refused");
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success(), "exit 0 for bad input; stderr: {e}");
     assert_ne!(o.status.code(), None, "killed by a signal: {e}");
@@ -55,6 +73,7 @@ pub fn refused(o: &Output, needles: &[&str]) {
 
 #[track_caller]
 pub fn accepted(o: &Output) {
+    log_case("accepted");
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{e}");
 }

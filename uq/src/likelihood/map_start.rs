@@ -18,6 +18,17 @@ pub enum StartError {
     Fit(#[from] InverseError),
     #[error(transparent)]
     Laplace(#[from] McmcError),
+    /// The least-squares value of a parameter lies outside its prior's
+    /// support and the posterior mode sits on the prior's edge.
+    #[error("the least-squares fit gives {name} = {value:.4e}, outside the support [{lo}, {hi}] of its prior {prior}; the posterior piles up at the prior's edge ({laplace}): widen the prior to contain the data's value, or check its units")]
+    OutsidePrior {
+        name: String,
+        value: f64,
+        lo: f64,
+        hi: f64,
+        prior: String,
+        laplace: McmcError,
+    },
 }
 
 /// The least-squares fit, the Laplace approximation of the posterior and the
@@ -92,6 +103,17 @@ pub fn fit_and_laplace(post: &Posterior) -> Result<PosteriorStart, StartError> {
             None => p.value,
         })
         .collect();
+    // The fit ignores the priors: a value outside a prior's support (a
+    // uniform prior that excludes the least-squares value) starts just
+    // inside it, where the log-density is finite.
+    let mut outside = None;
+    for (k, (x, prior)) in theta.iter_mut().zip(post.priors()).enumerate() {
+        let y = prior.nearest_inside(*x);
+        if y != *x && outside.is_none() {
+            outside = Some((k, *x, *prior));
+        }
+        *x = y;
+    }
     for (s, d) in post.datasets().iter().enumerate() {
         let r = &report.sets[s].residuals;
         if let NoiseSd::Inferred(_) = d.noise.sd {
@@ -105,7 +127,21 @@ pub fn fit_and_laplace(post: &Posterior) -> Result<PosteriorStart, StartError> {
         }
     }
     let z0 = post.space().to_unbounded(&theta);
-    let lap = laplace(post, &z0)?;
+    let lap = match (laplace(post, &z0), outside) {
+        (Ok(l), _) => l,
+        (Err(e), Some((k, value, prior))) => {
+            let (lo, hi) = prior.support();
+            return Err(StartError::OutsidePrior {
+                name: post.space().params[k].name.clone(),
+                value,
+                lo,
+                hi,
+                prior: prior.to_string(),
+                laplace: e,
+            });
+        }
+        (Err(e), None) => return Err(e.into()),
+    };
     let d = lap.mode.len();
     let cov = nalgebra::DMatrix::from_fn(d, d, |i, j| lap.covariance[i][j]);
     let cholesky = cov.cholesky().map(|c| {

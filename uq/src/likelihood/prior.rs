@@ -74,23 +74,79 @@ impl Prior {
         !matches!(self, Prior::Flat)
     }
 
-    /// Checks the prior's own numbers.
-    pub fn validate(&self) -> Result<(), String> {
-        let ok = match *self {
-            Prior::Flat => true,
-            Prior::Uniform { lower, upper } => {
-                lower.is_finite() && upper.is_finite() && upper > lower
-            }
-            Prior::Normal { mean, sd } => mean.is_finite() && sd.is_finite() && sd > 0.0,
-            Prior::LogNormal { mu, sigma } => mu.is_finite() && sigma.is_finite() && sigma > 0.0,
-            Prior::HalfNormal { sd } => sd.is_finite() && sd > 0.0,
-        };
-        if ok {
-            Ok(())
+    /// The support `[lo, hi]` (`Flat` and `Normal`: the real line).
+    pub fn support(&self) -> (f64, f64) {
+        match *self {
+            Prior::Flat | Prior::Normal { .. } => (f64::NEG_INFINITY, f64::INFINITY),
+            Prior::Uniform { lower, upper } => (lower, upper),
+            Prior::LogNormal { .. } | Prior::HalfNormal { .. } => (0.0, f64::INFINITY),
+        }
+    }
+
+    /// `x` if the density is positive there, else the point a thousandth
+    /// of the support's width (or of |x|, at least 1e-12) inside its
+    /// nearest end.
+    pub fn nearest_inside(&self, x: f64) -> f64 {
+        let (lo, hi) = self.support();
+        let inside = self.log_density(x).is_finite();
+        if inside {
+            return x;
+        }
+        let w = if (hi - lo).is_finite() {
+            1e-3 * (hi - lo)
         } else {
-            Err(format!(
-                "invalid prior {self}: widths must be positive and finite"
-            ))
+            (1e-3 * x.abs()).max(1e-12)
+        };
+        if x <= lo {
+            lo + w
+        } else if x >= hi {
+            hi - w
+        } else {
+            x
+        }
+    }
+
+    /// Checks the prior's own numbers, saying which one is wrong.
+    pub fn validate(&self) -> Result<(), String> {
+        let finite = |name: &str, v: f64| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!(
+                    "invalid prior {self}: the {name} must be a finite number"
+                ))
+            }
+        };
+        let width = |name: &str, v: f64| {
+            finite(name, v)?;
+            if v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("invalid prior {self}: the {name} must be positive"))
+            }
+        };
+        match *self {
+            Prior::Flat => Ok(()),
+            Prior::Uniform { lower, upper } => {
+                finite("lower end", lower)?;
+                finite("upper end", upper)?;
+                if upper > lower {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "invalid prior {self}: the upper end must exceed the lower end (uniform:L,U with L < U)"
+                    ))
+                }
+            }
+            Prior::Normal { mean, sd } => {
+                finite("mean", mean)?;
+                width("standard deviation", sd)
+            }
+            Prior::LogNormal { mu, sigma } => {
+                finite("log-mean mu", mu)?;
+                width("log-standard deviation sigma", sigma)
+            }
+            Prior::HalfNormal { sd } => width("scale", sd),
         }
     }
 }
@@ -127,7 +183,8 @@ impl FromStr for Prior {
                 Ok(())
             } else {
                 Err(format!(
-                    "prior `{s}`: `{kind}` takes {n} numbers, got {}",
+                    "prior `{s}`: `{kind}` takes {n} number{}, got {}",
+                    if n == 1 { "" } else { "s" },
                     nums.len()
                 ))
             }
