@@ -324,7 +324,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         // The prior must give the parameter's own range some mass.
         let (lo, hi) = prior.support();
         let b = &space.params[k];
-        if !(lo.max(b.lower) < hi.min(b.upper)) {
+        if lo.max(b.lower) >= hi.min(b.upper) {
             anyhow::bail!(
                 "--prior {p}: the prior lives on [{lo}, {hi}], outside the range of {name}, ({}, {}) {}: no value of {name} would be possible",
                 b.lower,
