@@ -10,7 +10,8 @@
 //! rolled state at x for this contact, tests/r2_rolling.rs).
 //!
 //! `cargo run --release -p palpate-fe --example bench_r2 -- [--segments 2]
-//!  [--step 0.5] [--rd 6] [--x 37.5,56.25,75,112.5]`
+//!  [--step 0.5] [--rd 6] [--x 37.5,56.25,75,112.5|none]
+//!  [--from X0] [--to X1]` (`--from`/`--to`: a shorter pass, for profiling)
 
 use std::time::Instant;
 
@@ -23,6 +24,9 @@ mod cpu;
 use cpu::cpu_seconds;
 
 fn list(v: &str) -> Vec<f64> {
+    if v == "none" {
+        return Vec::new();
+    }
     v.split(',').map(|x| x.parse().expect("a number")).collect()
 }
 
@@ -31,7 +35,13 @@ fn main() {
     let mut step = 0.5;
     let mut rd = 6.0;
     let mut xs = vec![37.5, 56.25, 75.0, 112.5];
+    let mut from: Option<f64> = None;
+    let mut to: Option<f64> = None;
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let Some(k) = args.iter().position(|a| a == "--rd") {
+        rd = args[k + 1].parse().expect("mm");
+    }
+    let mut model = R2Rolling::new(Law::ArrudaBoyce, Law::ArrudaBoyce, rd);
     let mut it = args.iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().expect("a value after the option").clone();
@@ -40,11 +50,35 @@ fn main() {
             "--step" => step = value().parse().expect("mm"),
             "--rd" => rd = value().parse().expect("mm"),
             "--x" => xs = list(&value()),
+            "--penalty" => model.penalty = value().parse().expect("a factor"),
+            "--smoothing" => model.contact_smoothing = value().parse().expect("mm"),
+            "--max-update" => {
+                model.options.max_update = match value().as_str() {
+                    "none" => None,
+                    v => Some(v.parse().expect("mm")),
+                }
+            }
+            "--tol" => model.options.tolerance = value().parse().expect("a tolerance"),
+            "--max-step" => model.options.max_step = value().parse().expect("mm"),
+            "--first-step" => model.options.first_step = value().parse().expect("mm"),
+            "--symmetric" => model.options.symmetric = value().parse().expect("true|false"),
+            "--chord" => model.options.reuse_factorisation = value().parse().expect("true|false"),
+            "--augment" => {
+                model.pure_penalty = false;
+                model.options.max_augmentations = value().parse().expect("a count");
+            }
+            "--from" => from = Some(value().parse().expect("mm")),
+            "--to" => to = Some(value().parse().expect("mm")),
             other => panic!("unknown option {other}"),
         }
     }
     let theta = R2Rolling::BENCHMARK_PARAMS;
-    let model = R2Rolling::new(Law::ArrudaBoyce, Law::ArrudaBoyce, rd);
+    if let Some(x) = from {
+        model.press_x = x;
+    }
+    if let Some(x) = to {
+        model.roll_to = x;
+    }
     let positions = model.pass_positions(step);
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
     println!(
@@ -56,10 +90,28 @@ fn main() {
         model.h()
     );
     let (c0, t0) = (cpu_seconds(false), Instant::now());
-    let (pass, _) = model
+    let (pass, last) = model
         .rolled_pass(&theta, &positions, segments, None)
         .unwrap_or_else(|e| panic!("the pass failed: {e}"));
     let (wall, cpu) = (t0.elapsed().as_secs_f64(), cpu_seconds(false) - c0);
+    if let Some(sys) = &last {
+        let s = sys.stats;
+        println!(
+            "last segment: {} increments, {} Newton iterations ({:.2} per increment), {} factorisations, {} chord steps, {} cuts, assembly {:.1} s, solve {:.1} s, {} equations",
+            s.increments,
+            s.iterations,
+            s.iterations as f64 / s.increments.max(1) as f64,
+            s.factorisations,
+            s.chord_steps,
+            s.cuts,
+            s.assembly_seconds,
+            s.solve_seconds,
+            sys.equations()
+        );
+    }
+    if let (Some(f), Some(x)) = (pass.last(), positions.last()) {
+        println!("force at x = {x} mm: {:.5} N, force_x {:+.5} N", f[0], f[1]);
+    }
     let load = std::fs::read_to_string("/proc/loadavg").unwrap_or_default();
     println!(
         "| pass | wall s | CPU s (user+sys) | target |\n|---|---|---|---|\n| {} positions | {wall:.1} | {cpu:.1} | 30 s wall on 2 cores: {} |",

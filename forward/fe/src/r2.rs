@@ -194,6 +194,10 @@ impl R2Rolling {
                 max_augmentations: 0,
                 max_update: Some(0.3),
                 tolerance: 1e-7,
+                // hyperelastic plane stress without pressure unknowns and
+                // frictionless contact: a symmetric tangent (`options()`
+                // turns it off with friction)
+                symmetric: true,
                 ..SolverOptions::default()
             },
         }
@@ -474,7 +478,11 @@ impl Setup for R2Rolling {
         self.bulk
     }
     fn options(&self) -> SolverOptions {
-        self.options
+        SolverOptions {
+            // Coulomb friction makes the contact tangent unsymmetric
+            symmetric: self.options.symmetric && self.friction == 0.0,
+            ..self.options
+        }
     }
     fn build(&self) -> Result<System, FeError> {
         self.check()?;

@@ -4,12 +4,17 @@
 //! and reused for every numeric factorisation.
 
 use faer::dyn_stack::{MemBuffer, MemStack};
+use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
+use faer::sparse::linalg::cholesky::{
+    factorize_symbolic_cholesky, CholeskySymbolicParams, LdltRef, SymbolicCholesky,
+    SymmetricOrdering,
+};
 use faer::sparse::linalg::lu::{
     factorize_symbolic_lu, LuRef, LuSymbolicParams, NumericLu, SymbolicLu,
 };
 use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
-use faer::{Conj, Par};
+use faer::{Conj, Par, Side};
 
 use crate::FeError;
 
@@ -108,6 +113,24 @@ pub struct SparseLu {
     pub factorisations: usize,
     /// Whether `numeric` holds valid factors.
     factored: bool,
+    /// The symmetric factorisation, when enabled ([`SparseLu::set_symmetric`]).
+    ldlt: Option<Ldlt>,
+    /// Which factors the last factorisation left: `true` the LDL^T ones.
+    ldlt_factored: bool,
+    /// Symmetric factorisations that met a zero pivot and fell back to LU.
+    pub ldlt_fallbacks: usize,
+}
+
+/// A sparse LDL^T factorisation (faer's supernodal Cholesky without
+/// pivoting: fill-reducing AMD ordering computed once), for tangents that are
+/// symmetric (hyperelastic bodies, frictionless contact). About half the
+/// work of the LU with partial pivoting; no pivoting, so a zero pivot is an
+/// error and the caller falls back to the LU.
+struct Ldlt {
+    symbolic: SymbolicCholesky<usize>,
+    l_values: Vec<f64>,
+    factor_scratch: MemBuffer,
+    solve_scratch: MemBuffer,
 }
 
 impl SparseLu {
@@ -142,7 +165,47 @@ impl SparseLu {
             solve_scratch,
             factorisations: 0,
             factored: false,
+            ldlt: None,
+            ldlt_factored: false,
+            ldlt_fallbacks: 0,
         })
+    }
+
+    /// Uses a symmetric LDL^T factorisation (the lower triangle of the
+    /// matrix) instead of the LU from now on (`true`), or the LU again
+    /// (`false`). Only for matrices that are symmetric: the upper triangle
+    /// is not read. A factorisation that meets a zero pivot falls back to
+    /// the LU (counted in [`SparseLu::ldlt_fallbacks`]).
+    pub fn set_symmetric(&mut self, symmetric: bool) -> Result<(), FeError> {
+        if !symmetric {
+            self.ldlt = None;
+            self.ldlt_factored = false;
+            self.factored = false;
+            return Ok(());
+        }
+        if self.ldlt.is_some() {
+            return Ok(());
+        }
+        let symbolic = factorize_symbolic_cholesky(
+            self.symbolic_mat.as_ref(),
+            Side::Lower,
+            SymmetricOrdering::Amd,
+            CholeskySymbolicParams::default(),
+        )
+        .map_err(|e| FeError::Factorisation {
+            reason: format!("symbolic LDL^T analysis: {e:?}"),
+        })?;
+        let factor_scratch = MemBuffer::new(
+            symbolic.factorize_numeric_ldlt_scratch::<f64>(Par::Seq, Default::default()),
+        );
+        let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+        self.ldlt = Some(Ldlt {
+            l_values: vec![0.0; symbolic.len_val()],
+            symbolic,
+            factor_scratch,
+            solve_scratch,
+        });
+        Ok(())
     }
 
     /// Factorises the matrix with values `values` (in pattern order) and
@@ -156,7 +219,30 @@ impl SparseLu {
     /// are kept for [`SparseLu::solve_factored`].
     pub fn factorize(&mut self, values: &[f64]) -> Result<(), FeError> {
         self.factored = false;
+        self.ldlt_factored = false;
         let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), values);
+        if let Some(l) = self.ldlt.as_mut() {
+            let ok = l
+                .symbolic
+                .factorize_numeric_ldlt(
+                    &mut l.l_values,
+                    mat,
+                    Side::Lower,
+                    LdltRegularization::default(),
+                    Par::Seq,
+                    MemStack::new(&mut l.factor_scratch),
+                    Default::default(),
+                )
+                .is_ok()
+                && l.l_values.iter().all(|v| v.is_finite());
+            if ok {
+                self.factorisations += 1;
+                self.factored = true;
+                self.ldlt_factored = true;
+                return Ok(());
+            }
+            self.ldlt_fallbacks += 1;
+        }
         self.symbolic_lu
             .factorize_numeric_lu(
                 &mut self.numeric,
@@ -181,12 +267,21 @@ impl SparseLu {
                 reason: "no factorisation to solve with".into(),
             });
         }
-        LuRef::new_unchecked(&self.symbolic_lu, &self.numeric).solve_in_place_with_conj(
-            Conj::No,
-            faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
-            Par::Seq,
-            MemStack::new(&mut self.solve_scratch),
-        );
+        match self.ldlt.as_mut() {
+            Some(l) if self.ldlt_factored => LdltRef::new(&l.symbolic, &l.l_values)
+                .solve_in_place_with_conj(
+                    Conj::No,
+                    faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
+                    Par::Seq,
+                    MemStack::new(&mut l.solve_scratch),
+                ),
+            _ => LuRef::new_unchecked(&self.symbolic_lu, &self.numeric).solve_in_place_with_conj(
+                Conj::No,
+                faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
+                Par::Seq,
+                MemStack::new(&mut self.solve_scratch),
+            ),
+        }
         if rhs.iter().any(|v| !v.is_finite()) {
             return Err(FeError::Factorisation {
                 reason: "singular tangent (non-finite solution)".into(),
@@ -240,5 +335,57 @@ mod tests {
             }
         }
         assert_eq!(lu.factorisations, 2);
+    }
+
+    #[test]
+    fn the_symmetric_factorisation_solves_what_the_lu_solves_and_falls_back_on_a_zero_pivot() {
+        // a symmetric tridiagonal (indefinite) system through 2-node "elements"
+        let n = 40;
+        let eqs: Vec<Vec<usize>> = (0..n - 1).map(|i| vec![i, i + 1]).collect();
+        let p = Pattern::new(n, &eqs);
+        let mut vals = vec![0.0; p.nnz()];
+        for i in 0..n {
+            let d = if i % 7 == 3 {
+                -3.0
+            } else {
+                4.0 + i as f64 * 0.1
+            };
+            vals[p.slot(i, i).unwrap()] = d;
+            if i + 1 < n {
+                vals[p.slot(i, i + 1).unwrap()] = 1.0 + 0.01 * i as f64;
+                vals[p.slot(i + 1, i).unwrap()] = 1.0 + 0.01 * i as f64;
+            }
+        }
+        let rhs: Vec<f64> = (0..n).map(|i| (i as f64).sin()).collect();
+        let mut lu = SparseLu::new(&p).unwrap();
+        let mut x_lu = rhs.clone();
+        lu.solve(&vals, &mut x_lu).unwrap();
+        lu.set_symmetric(true).unwrap();
+        let mut x_ldlt = rhs.clone();
+        lu.solve(&vals, &mut x_ldlt).unwrap();
+        assert_eq!(lu.ldlt_fallbacks, 0);
+        for i in 0..n {
+            assert!(
+                (x_lu[i] - x_ldlt[i]).abs() < 1e-12,
+                "{i}: {} vs {}",
+                x_lu[i],
+                x_ldlt[i]
+            );
+        }
+        // a zero leading pivot in every ordering: [[0, 1], [1, 0]] blocks
+        let eqs2 = vec![vec![0, 1]];
+        let p2 = Pattern::new(2, &eqs2);
+        let mut v2 = vec![0.0; p2.nnz()];
+        v2[p2.slot(0, 1).unwrap()] = 1.0;
+        v2[p2.slot(1, 0).unwrap()] = 1.0;
+        let mut lu2 = SparseLu::new(&p2).unwrap();
+        lu2.set_symmetric(true).unwrap();
+        let mut b = vec![2.0, 3.0];
+        lu2.solve(&v2, &mut b).unwrap();
+        assert_eq!(lu2.ldlt_fallbacks, 1);
+        assert!(
+            (b[0] - 3.0).abs() < 1e-14 && (b[1] - 2.0).abs() < 1e-14,
+            "{b:?}"
+        );
     }
 }

@@ -33,6 +33,12 @@ pub struct SolverOptions {
     /// try the next step with the same factorisation and keep it when it
     /// cuts the residual fourfold (otherwise refactorise).
     pub reuse_factorisation: bool,
+    /// The tangent is symmetric (hyperelastic bodies without owned
+    /// pressure unknowns, frictionless contact): factorise it by sparse
+    /// LDL^T (half the work of the LU), falling back to the LU on a zero
+    /// pivot. Default `false`. A model must set it only when every
+    /// contribution's tangent is symmetric: the upper triangle is not read.
+    pub symmetric: bool,
     /// For timed histories: the largest time increment (s). `None`: time
     /// does not limit increments (rate-independent materials: a hold at
     /// constant drive costs no increment, and `dt` still reaches the
@@ -58,6 +64,7 @@ impl Default for SolverOptions {
             max_augmentations: 20,
             stagnation_tolerance: 1e-4,
             reuse_factorisation: true,
+            symmetric: false,
             max_time_step: None,
             max_update: None,
         }
@@ -377,9 +384,13 @@ impl System {
     /// backtracking line search).
     pub(crate) fn newton(&mut self, target: &Target, opts: &SolverOptions) -> Result<(), FeError> {
         self.prescribe(target);
+        self.lu.set_symmetric(opts.symmetric)?;
         let mut a = self.assemble(target, true)?;
         let mut du = vec![0.0; self.dofs.equations];
         let mut chord = false;
+        // whether `values` holds the tangent at the current state (the
+        // line search assembles residuals only after its first trial)
+        let mut have_tangent = true;
         for it in 0..=opts.max_iterations {
             let small_step = it > 0
                 && du.iter().fold(0.0f64, |m: f64, v: &f64| m.max(v.abs()))
@@ -406,14 +417,19 @@ impl System {
                 match self.assemble(target, false) {
                     Ok(t) if t.norm <= 0.25 * norm0 => {
                         a = t;
+                        have_tangent = false;
                         self.stats.chord_steps += 1;
                         continue;
                     }
                     _ => {
                         self.u.clone_from(&u0);
                         a = self.assemble(target, true)?;
+                        have_tangent = true;
                     }
                 }
+            }
+            if !have_tangent {
+                a = self.assemble(target, true)?;
             }
             du.iter_mut().zip(&self.residual).for_each(|(d, r)| *d = -r);
             let values = std::mem::take(&mut self.values);
@@ -436,10 +452,15 @@ impl System {
             let mut accepted = None;
             // Armijo backtracking by halves: alpha = 1, 1/2, ..., 1/16, where
             // the step is taken whatever the residual; 1/32 is tried only
-            // when the assembly at 1/16 fails (an inverted element).
+            // when the assembly at 1/16 fails (an inverted element). The
+            // full step is assembled with its tangent (it is usually
+            // accepted); shorter ones with the residual only, the tangent
+            // then assembled at the accepted state when the next iteration
+            // needs it (the same iterates, fewer tangent assemblies).
             for _ in 0..6 {
                 self.apply(&du, alpha, &u0);
-                match self.assemble(target, true) {
+                have_tangent = alpha == 1.0;
+                match self.assemble(target, have_tangent) {
                     Ok(t) if t.norm <= (1.0 - 1e-4 * alpha) * a.norm || alpha <= 1.0 / 16.0 => {
                         accepted = Some(t);
                         break;
