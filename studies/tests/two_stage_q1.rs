@@ -131,3 +131,22 @@ fn stages_are_parsed_and_checked() {
     let e = TwoStageOptions::parse_stages("elastic,viscous").unwrap_err();
     assert!(e.to_string().contains("unknown stage `viscous`"), "{e}");
 }
+
+/// The study manifest parses and validates (the record exists, the options hold).
+#[test]
+fn the_study_manifest_is_valid() {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("two-stage-q1.toml");
+    let m = palpate_studies::manifest::Manifest::read(&path).unwrap();
+    m.validate(&path).unwrap();
+    let mut bad = std::fs::read_to_string(&path).unwrap();
+    bad = bad.replace("time_step = 1.0", "time_step = 0.0");
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bad.toml");
+    std::fs::write(&p, bad).unwrap();
+    let m = palpate_studies::manifest::Manifest::read(&p).unwrap();
+    let e = m.validate(&p).unwrap_err().to_string();
+    assert!(
+        e.contains("steps[0].two_stage (\"q1-liver\").time_step = 0"),
+        "{e}"
+    );
+}
