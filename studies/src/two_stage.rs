@@ -483,8 +483,8 @@ pub fn identify(
                 ));
                 let (report, wall) =
                     lm_fit(&objective, theta[..n_law].to_vec(), options, options.lm)?;
-                for k in 0..n_law {
-                    theta[k] = report.parameters[k].value;
+                for (t, e) in theta[..n_law].iter_mut().zip(&report.parameters) {
+                    *t = e.value;
                 }
                 let mut result = stage_result(stage, &objective, report, wall, theta.clone());
                 let t0 = Instant::now();

@@ -259,7 +259,7 @@ fn read_depths(path: &Path) -> anyhow::Result<(Vec<f64>, Vec<f64>)> {
         };
         let t = num(it, "time_s")?;
         if let Some(&p) = time.last() {
-            if !(t >= p) {
+            if t < p {
                 bail!(
                     "{}: line {}: time_s {t} goes back (previous {p})",
                     path.display(),
