@@ -20,3 +20,4 @@ pub mod report;
 pub mod run_folder;
 pub mod runner;
 pub mod surrogate;
+pub mod two_stage;

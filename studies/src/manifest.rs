@@ -240,6 +240,7 @@ pub enum Step {
     Diagnose(DiagnoseStep),
     Predict(PredictStep),
     Anova(AnovaStep),
+    TwoStage(crate::two_stage::TwoStageStep),
 }
 
 pub use crate::anova_step::AnovaStep;
@@ -383,6 +384,11 @@ impl Manifest {
             match step {
                 Step::Predict(p) => p.validate(self, i, &where_.to_string())?,
                 Step::Anova(a) => a.validate(self, i, &where_.to_string(), dir)?,
+                Step::TwoStage(t) => t.validate(
+                    &where_.to_string(),
+                    &format!("steps[{i}].two_stage (\"{}\")", t.name),
+                    dir,
+                )?,
                 Step::Calibrate(c) => {
                     let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
                     for (field, list) in [
@@ -530,6 +536,7 @@ impl Step {
             Step::Diagnose(d) => &d.name,
             Step::Predict(p) => &p.name,
             Step::Anova(a) => &a.name,
+            Step::TwoStage(t) => &t.name,
         }
     }
 
@@ -540,6 +547,7 @@ impl Step {
             Step::Diagnose(_) => "diagnose",
             Step::Predict(_) => "predict",
             Step::Anova(_) => "anova",
+            Step::TwoStage(_) => "two_stage",
         }
     }
 }

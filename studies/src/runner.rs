@@ -55,6 +55,11 @@ pub enum StepResult {
         runs: Vec<serde_json::Value>,
         comparisons: Vec<serde_json::Value>,
     },
+    /// [`crate::two_stage`]: the staged inverse FE identification of a Q1 record.
+    TwoStage {
+        name: String,
+        result: serde_json::Value,
+    },
     /// [`crate::anova_step`]: the runs, our analysis and the published one.
     Anova {
         name: String,
@@ -173,6 +178,7 @@ pub fn run_study_with(
         .map(|d| dir.join(&d.file))
         .chain(manifest.steps.iter().filter_map(|s| match s {
             Step::Anova(a) => a.published.as_ref().map(|p| dir.join(p)),
+            Step::TwoStage(t) => Some(dir.join(&t.record)),
             _ => None,
         }))
         .collect();
@@ -217,6 +223,10 @@ pub fn run_study_with(
             }
             Step::Anova(a) => {
                 let r = crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?;
+                results.steps.push(r);
+            }
+            Step::TwoStage(t) => {
+                let r = crate::two_stage::run_two_stage(&run, t, &mut report)?;
                 results.steps.push(r);
             }
         }
@@ -279,7 +289,7 @@ pub(crate) struct Run<'a> {
 impl Run<'_> {
     /// A unit's record: from the cache when its inputs are unchanged, else
     /// computed and cached at once (so a kill after it keeps it).
-    fn unit<T, K>(
+    pub(crate) fn unit<T, K>(
         &self,
         label: &str,
         inputs: &K,

@@ -857,3 +857,128 @@ fn a_diagnose_step_with_an_effect_the_model_lacks_is_refused() {
     );
     accepted(&s.run(&["run", "--check", &m]));
 }
+
+// ---------- Q1 two-stage identification and the real-time surrogate (issue 13) ----------
+
+#[test]
+fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
+    let s = Scratch::new();
+    let build = |prony: &str, depth: &str| {
+        s.run(&[
+            "surrogate",
+            "build",
+            "--benchmark",
+            "Q1",
+            "--law",
+            "neo-hookean",
+            "--param",
+            "C10=0.0016",
+            "--prony",
+            prony,
+            "--depth-max",
+            depth,
+            "--out",
+            &s.path("rt.json").display().to_string(),
+        ])
+    };
+    // Prony weights summing to 1 or more, a zero or negative time constant
+    refused(
+        &build("g1=0.6,tau1=1,g2=0.4,tau2=10", "1"),
+        &["--prony g1=0.6,tau1=1,g2=0.4,tau2=10", "sum to 1"],
+    );
+    refused(&build("g1=0.3,tau1=0", "1"), &["--prony", "tau1"]);
+    refused(&build("g1=0.3,tau1=-2", "1"), &["--prony", "tau1"]);
+    refused(&build("g1=0.3,tau1=1", "0"), &["--depth-max 0"]);
+    assert!(!s.path("rt.json").exists());
+    // a hold shorter than one step of the ramp
+    let o = s.run(&[
+        "simulate",
+        "--benchmark",
+        "Q1",
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.0016",
+        "--prony",
+        "g1=0.3,tau1=0.5",
+        "--depth",
+        "1",
+        "--hold",
+        "1e-6",
+        "--error-estimate",
+        "off",
+    ]);
+    refused(&o, &["--hold 0.000001", "shorter than one step"]);
+    // a history that leaves the surrogate's range: row and range named
+    let curve =
+        palpate_uq::surrogate::MonotoneCubic::new(vec![0.0, 0.5, 1.0], vec![0.0, 0.01, 0.03])
+            .unwrap();
+    let rt = palpate_uq::surrogate::RealTimeSurrogate::new("test".into(), curve, vec![(0.3, 0.5)])
+        .unwrap();
+    let js = s.file("rt.json", &rt.to_json());
+    let ok = s.file("ok.csv", "time_s,displacement_mm\n0.001,0.1\n0.002,0.2\n");
+    accepted(&s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &ok]));
+    let deep = s.file("deep.csv", "time_s,displacement_mm\n0.001,0.5\n0.002,1.5\n");
+    let o = s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &deep]);
+    refused(
+        &o,
+        &[
+            "deep.csv: row 3",
+            "depth 1.5 mm is outside the surrogate's trained range [0, 1] mm",
+        ],
+    );
+    let back = s.file("back.csv", "time_s,displacement_mm\n0.002,0.5\n0.001,0.5\n");
+    let o = s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &back]);
+    refused(&o, &["back.csv: line 3", "goes back"]);
+    let not = s.file("not.json", "{\"a\": 1}");
+    let o = s.run(&["surrogate", "query", "--surrogate", &not, "--csv", &ok]);
+    refused(&o, &["--surrogate", "not a real-time surrogate"]);
+    // the staged identification: a record without a hold, unknown stages
+    let ramp = s.file(
+        "ramp.csv",
+        "time_s,displacement_mm,force_N\n0.1,0.1,0.001\n0.2,0.2,0.002\n0.3,0.3,0.003\n",
+    );
+    let q1 = |data: &str, stages: &str| {
+        s.run(&[
+            "calibrate",
+            "--benchmark",
+            "Q1",
+            "--law",
+            "neo-hookean",
+            "--data",
+            data,
+            "--stages",
+            stages,
+        ])
+    };
+    refused(
+        &q1(&ramp, "elastic,relaxation"),
+        &["ramp.csv", "a hold after it"],
+    );
+    let rec = crate::two_stage_record();
+    refused(
+        &q1(&rec, "elastic,viscous"),
+        &["--stages", "unknown stage `viscous`"],
+    );
+    refused(
+        &q1(&rec, "relaxation,elastic"),
+        &["--stages", "order elastic,relaxation"],
+    );
+    let o = s.run(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &ramp,
+        "--stages",
+        "elastic",
+    ]);
+    refused(&o, &["--stages", "--benchmark Q1"]);
+}
+
+fn two_stage_record() -> String {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/data/two-stage-q1/record.csv")
+        .display()
+        .to_string()
+}

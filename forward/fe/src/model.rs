@@ -81,6 +81,12 @@ pub(crate) trait Setup: Send + Sync {
     fn prony(&self) -> Option<&Prony> {
         None
     }
+    /// The Prony series of a run with the parameters after the law's
+    /// (`extra`): the fixed [`Setup::prony`] unless the model takes its
+    /// Prony terms as parameters ([`crate::Q1Punch::with_prony_parameters`]).
+    fn prony_for(&self, _extra: &[f64]) -> Result<Option<Prony>, FeError> {
+        Ok(self.prony().cloned())
+    }
     fn build(&self) -> Result<System, FeError>;
     /// Sets what depends on the parameters before a run: the materials,
     /// contact penalties (scaled by the shear modulus `mu`) and the
@@ -201,20 +207,21 @@ fn simulate_with(
     let mat = LawMaterial::new(*law, theta[..n_law].to_vec()).map_err(to_forward)?;
     let mu = law.shear_modulus(&theta[..n_law]);
     let mut opts = setup.options();
-    let point: Arc<dyn PointMaterial> = match setup.prony() {
-        None => Arc::new(mat),
-        Some(prony) => {
-            if loading.time.is_none() {
-                return Err(ForwardError::InvalidLoading(
-                    "a viscoelastic material needs the time of each sample".into(),
-                ));
+    let point: Arc<dyn PointMaterial> =
+        match setup.prony_for(&theta[n_law..]).map_err(to_forward)? {
+            None => Arc::new(mat),
+            Some(prony) => {
+                if loading.time.is_none() {
+                    return Err(ForwardError::InvalidLoading(
+                        "a viscoelastic material needs the time of each sample".into(),
+                    ));
+                }
+                if opts.max_time_step.is_none() {
+                    opts.max_time_step = Some(0.1 * prony.shortest_time());
+                }
+                Arc::new(Viscoelastic::new(mat, prony))
             }
-            if opts.max_time_step.is_none() {
-                opts.max_time_step = Some(0.1 * prony.shortest_time());
-            }
-            Arc::new(Viscoelastic::new(mat, prony.clone()))
-        }
-    };
+        };
     let material = RegionMaterial {
         material: point,
         volumetric: setup.bulk().volumetric(mu),

@@ -16,7 +16,9 @@
 //! (`0.2 / level` mm) in a 3 x 3 mm zone that holds the punch edge, growing
 //! by `1 + 0.2 / level` beyond ([`Q1Punch::grading`]).
 
-use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace};
+use palpate_core::{
+    Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole, ParamSpace, ParamSpec,
+};
 use palpate_material::Law;
 
 use crate::body::{RegionMaterial, SolidBody};
@@ -64,6 +66,8 @@ pub struct Q1Punch {
     pub prony: Option<Prony>,
     pub options: SolverOptions,
     space: ParamSpace,
+    /// Number of Prony terms taken from the parameters (0: `prony` fixed).
+    prony_parameters: usize,
 }
 
 impl Q1Punch {
@@ -91,7 +95,50 @@ impl Q1Punch {
                 max_augmentations: 0,
                 ..SolverOptions::default()
             },
+            prony_parameters: 0,
         }
+    }
+
+    /// The model with `terms` Prony terms as parameters after the law's:
+    /// `g1, tau1_s, g2, tau2_s, ...` (the names, bounds, roles and starts of
+    /// the force-level wrapper `palpate_enrich::Viscoelastic`: g_i in [0, 1],
+    /// start 0.1; tau_i > 0, start 1 s, 10 s, ...), replacing `prony`. A
+    /// parameter vector whose weights sum to 1 or more, or with a time
+    /// constant <= 0, is refused by the run ([`Prony::new`]), so an
+    /// estimator's trial step there fails rather than being clamped.
+    ///
+    /// Fits should set `options.max_time_step` (the default, a tenth of the
+    /// shortest relaxation time, moves with the parameters and would make
+    /// the time discretisation, hence the objective, jump with them).
+    pub fn with_prony_parameters(mut self, terms: usize) -> Self {
+        let mut own = Vec::with_capacity(2 * terms);
+        for i in 1..=terms {
+            own.push(
+                ParamSpec::new(format!("g{i}"), "1", 0.0, 1.0, 0.1)
+                    .with_role(ParamRole::RelaxationWeight { term: i }),
+            );
+            own.push(
+                ParamSpec::new(
+                    format!("tau{i}_s"),
+                    "s",
+                    0.0,
+                    f64::INFINITY,
+                    10f64.powi(i as i32 - 1),
+                )
+                .with_role(ParamRole::TimeConstant { term: i }),
+            );
+        }
+        self.space = law_space(&self.law).extended(&own);
+        self.prony_parameters = terms;
+        if terms > 0 {
+            self.prony = None;
+        }
+        self
+    }
+
+    /// Number of Prony terms taken from the parameters.
+    pub fn prony_parameters(&self) -> usize {
+        self.prony_parameters
     }
 
     /// The punch.
@@ -222,6 +269,17 @@ impl Setup for Q1Punch {
     fn prony(&self) -> Option<&Prony> {
         self.prony.as_ref()
     }
+    fn prony_for(&self, extra: &[f64]) -> Result<Option<Prony>, FeError> {
+        if self.prony_parameters == 0 {
+            return Ok(self.prony.clone());
+        }
+        let terms = extra
+            .chunks_exact(2)
+            .take(self.prony_parameters)
+            .map(|c| (c[0], c[1]))
+            .collect();
+        Prony::new(terms).map(Some)
+    }
     fn build(&self) -> Result<System, FeError> {
         self.check()?;
         let mesh = self.build_mesh()?;
@@ -294,6 +352,9 @@ impl ForwardModel for Q1Punch {
         );
         if let Some(p) = &self.prony {
             name += &format!(", Prony {p}");
+        }
+        if self.prony_parameters > 0 {
+            name += &format!(", {} Prony terms as parameters", self.prony_parameters);
         }
         name
     }

@@ -74,6 +74,27 @@ pub struct Args {
     /// Draw the data against the fit (SVG).
     #[arg(long, value_name = "OUT.svg")]
     pub plot: Option<PathBuf>,
+    /// --benchmark Q1 (a ramp-and-hold record, columns time_s,displacement_mm,force_N):
+    /// the stages of the inverse FE identification, `elastic,relaxation`
+    /// (the law on the ramp with an elastic model, then the Prony terms with
+    /// the law held), followed by a joint polish (docs/guide.md).
+    #[arg(long, value_name = "LIST")]
+    pub stages: Option<String>,
+    /// --benchmark Q1: Prony terms (default 2).
+    #[arg(long, value_name = "N")]
+    pub prony_terms: Option<usize>,
+    /// --benchmark Q1: element size under the punch of the fits' mesh, mm (default 0.3).
+    #[arg(long, value_name = "MM")]
+    pub fit_mesh: Option<f64>,
+    /// --benchmark Q1: time step of the viscoelastic FE runs, s (default 1).
+    #[arg(long, value_name = "S")]
+    pub time_step: Option<f64>,
+    /// --benchmark Q1: also fit every parameter at once from the default start (comparison).
+    #[arg(long)]
+    pub compare: bool,
+    /// --benchmark Q1: profile-likelihood intervals of the polished parameters.
+    #[arg(long)]
+    pub profile: bool,
 }
 
 /// Splits `NAME=VALUE` (or `NAME=PATH`).
@@ -168,6 +189,26 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .law
         .parse()
         .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    if args
+        .benchmark
+        .as_deref()
+        .is_some_and(|b| b.eq_ignore_ascii_case("q1"))
+    {
+        return run_q1(&args, law);
+    }
+    for (given, name) in [
+        (args.stages.is_some(), "--stages"),
+        (args.prony_terms.is_some(), "--prony-terms"),
+        (args.fit_mesh.is_some(), "--fit-mesh"),
+        (args.time_step.is_some(), "--time-step"),
+        (args.compare, "--compare"),
+        (args.profile, "--profile"),
+    ] {
+        anyhow::ensure!(
+            !given,
+            "{name}: an option of --benchmark Q1 (the staged inverse FE identification)"
+        );
+    }
     let residual: ResidualKind = args
         .residual
         .parse()
@@ -216,6 +257,67 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     if let Some(p) = &args.plot {
         write_atomic(p, fit_plot(&result).to_svg().as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// `palpate calibrate --benchmark Q1`: the staged inverse FE identification
+/// ([`crate::two_stage`]).
+fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
+    use crate::two_stage::{identify, report, Q1Record, TwoStageOptions};
+    anyhow::ensure!(
+        args.data.len() == 1,
+        "--benchmark Q1: give one record (--data FILE), got {}",
+        args.data.len()
+    );
+    for (given, name) in [
+        (args.viscoelastic.is_some(), "--viscoelastic"),
+        (!args.fix.is_empty(), "--fix"),
+        (args.plot.is_some(), "--plot"),
+    ] {
+        anyhow::ensure!(!given, "{name}: not an option of --benchmark Q1");
+    }
+    anyhow::ensure!(
+        args.residual == "absolute" && args.estimator == "lm",
+        "--benchmark Q1 fits by Levenberg-Marquardt on absolute residuals (--residual absolute, --estimator lm)"
+    );
+    let mut o = TwoStageOptions::new(law);
+    if let Some(s) = &args.stages {
+        o.stages = TwoStageOptions::parse_stages(s)?;
+    }
+    if let Some(n) = args.prony_terms {
+        anyhow::ensure!((1..=4).contains(&n), "--prony-terms {n}: give 1 to 4 terms");
+        o.terms = n;
+    }
+    if let Some(h) = args.fit_mesh {
+        anyhow::ensure!(
+            h.is_finite() && (0.02..=1.0).contains(&h),
+            "--fit-mesh {h}: the element size under the punch must lie in 0.02..1 mm"
+        );
+        o.h_fine = h;
+    }
+    if let Some(dt) = args.time_step {
+        anyhow::ensure!(
+            dt.is_finite() && dt > 0.0,
+            "--time-step {dt}: must be a positive number of seconds"
+        );
+        o.max_time_step = dt;
+    }
+    o.one_stage = args.compare;
+    o.profile = args.profile;
+    let path = args.data[0]
+        .split_once('=')
+        .filter(|(t, _)| t.eq_ignore_ascii_case("q1"))
+        .map_or(args.data[0].as_str(), |(_, p)| p);
+    let outputs = crate::output::given(&[("--json", &args.json)]);
+    crate::output::check_outputs(&[Path::new(path)], &outputs)?;
+    let record = Q1Record::read(Path::new(path))?;
+    let say = |s: &str| eprintln!("{s}");
+    let result = identify(&record, &o, &say)?;
+    print!("{}", report(&result, None));
+    if let Some(p) = &args.json {
+        write_json(p, &result)?;
         eprintln!("wrote {}", p.display());
     }
     Ok(())

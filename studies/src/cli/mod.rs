@@ -12,6 +12,7 @@ pub mod sample;
 pub mod sample_fe;
 pub mod simulate;
 pub mod simulate_r2;
+pub mod surrogate;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify
 /// their uncertainty and diagnose the gap between simulation and measurement.
@@ -43,6 +44,8 @@ pub enum Command {
     Diagnose(diagnose::Args),
     /// Run a whole study described by one TOML manifest into a run folder.
     Run(run::Args),
+    /// Build (from FE runs) or query the real-time force surrogate of Q1 or N1.
+    Surrogate(surrogate::Args),
 }
 
 /// The command line with a negative number after an option joined to it
@@ -85,5 +88,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Doe(a) => doe::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Run(a) => run::run(a),
+        Command::Surrogate(a) => surrogate::run(a),
     }
 }

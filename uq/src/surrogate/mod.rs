@@ -53,11 +53,13 @@
 pub mod design;
 pub mod gp;
 pub mod model;
+pub mod realtime;
 
 pub use design::{halton_design, ParamBox};
 pub use model::{
     FailedRun, Surrogate, SurrogateOptions, SurrogateRequest, Validation, SURROGATE_FORMAT,
 };
+pub use realtime::{MonotoneCubic, RangeError, RealTimeSurrogate};
 
 use thiserror::Error;
 

@@ -1,0 +1,277 @@
+//! `palpate surrogate build|query`: the real-time surrogate of the Q1 (or
+//! N1) force response (`palpate_uq::surrogate::realtime`): built once from
+//! FE runs (an elastic ramp for the force curve, random held-out histories
+//! for its error table) with a progress bar, stored as a JSON file, queried
+//! on a CSV of depths.
+
+use crate::limits::Progress;
+use crate::output::{check_outputs, given, write_atomic};
+use anyhow::{anyhow, bail, Context};
+use palpate_core::ForwardModel;
+use palpate_fe::{N1Needle, Prony, Q1Punch};
+use palpate_material::Law;
+use palpate_uq::surrogate::realtime::{RealTimeRequest, RealTimeSurrogate};
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+/// Build or query a real-time force surrogate.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    #[command(subcommand)]
+    pub command: Sub,
+}
+
+/// The surrogate subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum Sub {
+    /// Build from FE runs and store it.
+    Build(BuildArgs),
+    /// Answer a CSV of time_s,displacement_mm sample by sample.
+    Query(QueryArgs),
+}
+
+/// Example: palpate surrogate build --benchmark Q1 --law neo-hookean --param C10=0.0016
+///   --prony g1=0.3,tau1=0.5,g2=0.2,tau2=10 --depth-max 1 --out q1-rt.json
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct BuildArgs {
+    /// Q1 (flat punch) or N1 (needle, friction 0.8).
+    #[arg(long)]
+    pub benchmark: String,
+    #[arg(long)]
+    pub law: String,
+    /// A law parameter, e.g. --param C10=0.0016 (MPa); repeat for each.
+    #[arg(long = "param", value_name = "NAME=VALUE")]
+    pub params: Vec<String>,
+    /// The material's Prony series g1=..,tau1=..,...
+    #[arg(long)]
+    pub prony: String,
+    /// The deepest depth it answers for (mm); Q1 stalls near 2 mm (punch-edge crease).
+    #[arg(long, value_name = "MM")]
+    pub depth_max: f64,
+    /// Mesh level of the FE runs (default 1).
+    #[arg(long, default_value_t = 1)]
+    pub mesh: usize,
+    /// Held-out random histories run by FE for the error table (default 4).
+    #[arg(long, default_value_t = 4)]
+    pub holdout: usize,
+    /// Segments (ramps, holds, unloadings) per held-out history (default 6).
+    #[arg(long, default_value_t = 6)]
+    pub segments: usize,
+    /// Where to store the surrogate (JSON).
+    #[arg(long, value_name = "OUT.json")]
+    pub out: PathBuf,
+}
+
+/// Example: palpate surrogate query --surrogate q1-rt.json --csv depths.csv --out forces.csv
+#[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
+pub struct QueryArgs {
+    #[arg(long, value_name = "FILE.json")]
+    pub surrogate: PathBuf,
+    /// Columns time_s,displacement_mm (header line; # comments).
+    #[arg(long, value_name = "FILE.csv")]
+    pub csv: PathBuf,
+    /// Output CSV time_s,displacement_mm,force_N (default: standard output).
+    #[arg(long, value_name = "OUT.csv")]
+    pub out: Option<PathBuf>,
+}
+
+/// Runs `palpate surrogate`.
+pub fn run(args: Args) -> anyhow::Result<()> {
+    match args.command {
+        Sub::Build(a) => build(a),
+        Sub::Query(a) => query(a),
+    }
+}
+
+fn build(a: BuildArgs) -> anyhow::Result<()> {
+    let law: Law = a.law.parse().map_err(|e| anyhow!("--law {}: {e}", a.law))?;
+    let theta = super::simulate::parse_params(&law, &a.params)?;
+    let prony: Prony = a
+        .prony
+        .parse()
+        .map_err(|e| anyhow!("--prony {}: {e}", a.prony))?;
+    if !(a.depth_max > 0.0 && a.depth_max.is_finite() && a.depth_max <= 20.0) {
+        bail!(
+            "--depth-max {}: give a depth in mm, > 0 and <= 20",
+            a.depth_max
+        );
+    }
+    if !(1..=6).contains(&a.mesh) {
+        bail!("--mesh {}: give a level 1..6", a.mesh);
+    }
+    if !(1..=64).contains(&a.holdout) || !(1..=50).contains(&a.segments) {
+        bail!(
+            "--holdout {} / --segments {}: give 1..64 histories of 1..50 segments",
+            a.holdout,
+            a.segments
+        );
+    }
+    check_outputs(&[], &given(&[("--out", &Some(a.out.clone()))]))?;
+    let (elastic, visco): (Box<dyn ForwardModel>, Box<dyn ForwardModel>) =
+        match a.benchmark.to_ascii_uppercase().as_str() {
+            "Q1" => {
+                let mut e = Q1Punch::new(law);
+                e.level = a.mesh;
+                let mut v = e.clone();
+                v.prony = Some(prony.clone());
+                (Box::new(e), Box::new(v))
+            }
+            "N1" => {
+                let mut e = N1Needle::new(law);
+                e.mesh.level = a.mesh;
+                let mut v = e.clone();
+                v.prony = Some(prony.clone());
+                (Box::new(e), Box::new(v))
+            }
+            b => bail!("--benchmark {b}: the real-time surrogate is built for Q1 or N1"),
+        };
+    let extra = |m: &dyn ForwardModel| -> Vec<f64> {
+        let mut t = theta.clone();
+        t.extend(m.space().params[theta.len()..].iter().map(|p| p.initial));
+        t
+    };
+    let (te, tv) = (extra(elastic.as_ref()), extra(visco.as_ref()));
+    let req = RealTimeRequest {
+        elastic: elastic.as_ref(),
+        elastic_theta: &te,
+        viscoelastic: visco.as_ref(),
+        viscoelastic_theta: &tv,
+        prony: prony.terms().to_vec(),
+        depth_max: a.depth_max,
+        knots: 20,
+        validation_histories: a.holdout,
+        segments: a.segments,
+    };
+    let total = (1 + a.holdout) as u64;
+    let bar = Progress::new(
+        total,
+        "real-time surrogate",
+        "{msg} [{bar:40}] {pos}/{len} FE runs ({elapsed}, eta {eta})",
+    );
+    let tick = |_d: usize, _t: usize| bar.inc(1);
+    let built = RealTimeSurrogate::build(&req, Some(&tick));
+    bar.finish();
+    let s = built.map_err(|e| anyhow!("building the surrogate of {}: {e}", visco.name()))?;
+    write_atomic(&a.out, s.to_json().as_bytes())?;
+    println!("{}", error_table(&s));
+    eprintln!(
+        "built from {} FE runs in {:.1} s, stored in {}",
+        s.fe_runs,
+        s.build_time_s,
+        a.out.display()
+    );
+    Ok(())
+}
+
+/// The held-out error table (Markdown).
+pub fn error_table(s: &RealTimeSurrogate) -> String {
+    let mut r = String::from(
+        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak |\n|---|---|---|---|---|\n",
+    );
+    for h in &s.validation {
+        let _ = writeln!(
+            r,
+            "| {} | {} | {:.4e} | {:.3e} | {:.2} % |",
+            h.history,
+            h.samples,
+            h.peak_force_n,
+            h.max_abs_error_n,
+            100.0 * h.max_relative_error
+        );
+    }
+    r
+}
+
+fn query(a: QueryArgs) -> anyhow::Result<()> {
+    let outputs = given(&[("--out", &a.out)]);
+    check_outputs(&[a.surrogate.as_path(), a.csv.as_path()], &outputs)?;
+    let text = std::fs::read_to_string(&a.surrogate)
+        .with_context(|| format!("--surrogate {}", a.surrogate.display()))?;
+    let mut s = RealTimeSurrogate::from_json(&text).map_err(|e| {
+        anyhow!(
+            "--surrogate {}: not a real-time surrogate: {e}",
+            a.surrogate.display()
+        )
+    })?;
+    let (time, depth) = read_depths(&a.csv)?;
+    let mut out = String::from("time_s,displacement_mm,force_N\n");
+    let mut prev = 0.0;
+    for (k, (&t, &d)) in time.iter().zip(&depth).enumerate() {
+        let f = s
+            .force(d, t - prev)
+            .map_err(|e| anyhow!("{}: row {} (time_s {t}): {e}", a.csv.display(), k + 2))?;
+        prev = t;
+        let _ = writeln!(out, "{t},{d},{f:.8e}");
+    }
+    match &a.out {
+        Some(p) => {
+            write_atomic(p, out.as_bytes())?;
+            eprintln!("wrote {}", p.display());
+        }
+        None => print!("{out}"),
+    }
+    Ok(())
+}
+
+/// Reads `time_s,displacement_mm`; errors name the file and line.
+fn read_depths(path: &Path) -> anyhow::Result<(Vec<f64>, Vec<f64>)> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("--csv {}", path.display()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty() && !l.trim_start().starts_with('#'));
+    let (_, header) = lines.next().ok_or_else(|| {
+        anyhow!(
+            "{}: empty; expected a header time_s,displacement_mm",
+            path.display()
+        )
+    })?;
+    let cols: Vec<&str> = header
+        .trim_start_matches('\u{feff}')
+        .split(',')
+        .map(str::trim)
+        .collect();
+    let it = cols.iter().position(|c| *c == "time_s");
+    let id = cols.iter().position(|c| *c == "displacement_mm");
+    let (Some(it), Some(id)) = (it, id) else {
+        bail!(
+            "{}: the header must name time_s and displacement_mm (found {header})",
+            path.display()
+        );
+    };
+    let (mut time, mut depth) = (Vec::new(), Vec::new());
+    for (i, l) in lines {
+        let f: Vec<&str> = l.split(',').map(str::trim).collect();
+        let num = |j: usize, name: &str| -> anyhow::Result<f64> {
+            f.get(j)
+                .and_then(|v| v.parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    anyhow!(
+                        "{}: line {}: {name} is not a finite number",
+                        path.display(),
+                        i + 1
+                    )
+                })
+        };
+        let t = num(it, "time_s")?;
+        if let Some(&p) = time.last() {
+            if t < p {
+                bail!(
+                    "{}: line {}: time_s {t} goes back (previous {p})",
+                    path.display(),
+                    i + 1
+                );
+            }
+        }
+        time.push(t);
+        depth.push(num(id, "displacement_mm")?);
+    }
+    if time.is_empty() {
+        bail!("{}: no rows after the header", path.display());
+    }
+    Ok((time, depth))
+}

@@ -1,0 +1,881 @@
+//! The two-stage identification of a quasi-linear viscoelastic material by
+//! inverse finite elements on a Q1 ramp-and-hold record (BENCHMARKS.md Q1;
+//! issue 13, the third source study): Levenberg-Marquardt on the FE model
+//! (`palpate_fe::Q1Punch`), in stages,
+//!
+//! 1. `elastic`: the law's parameters of an *elastic* FE model fitted to the
+//!    ramp of the record (the samples up to the first reaching of the
+//!    deepest point), quasi-static: no time steps, no hold;
+//! 2. `relaxation`: the Prony terms `g_i, tau_i` of the viscoelastic FE model
+//!    (`Q1Punch::with_prony_parameters`, Prony series on the isochoric second
+//!    Piola-Kirchhoff stress) fitted to the whole record with the law's
+//!    parameters held at the stage-1 values;
+//! 3. `polish`: every parameter together, from the stage-2 point;
+//!
+//! and, for comparison, the one-stage fit of every parameter from the
+//! default start. Each stage reports iterations, FE runs (objective
+//! evaluations, each one FE run of the record), wall time, the estimates
+//! with their standard errors (`palpate_inverse::statistics`), and the
+//! polish also 95 % profile-likelihood intervals ([`profile`]).
+//!
+//! Why stage 1 on the ramp: the ramp (0.5 s) is the part of the record
+//! nearest the instantaneous response (`G(0) = 1`), its shape against depth
+//! is the elastic nonlinearity, and its elastic FE runs are the cheapest
+//! (the ramp samples only, no time integration). The relaxation during the
+//! ramp lowers the ramp force (by `sum g_i (1 - tau_i / t_r (1 - e^{-t_r /
+//! tau_i}))` at its end: 11 % for g = 0.3 / 0.2, tau = 0.5 / 10 s), so
+//! stage 1 underestimates the instantaneous modulus by a few per cent and
+//! stage 2 compensates with its weights; the joint polish removes both
+//! biases from a start close to the optimum. The long-time (end-of-hold)
+//! force alone could not serve: it is `g_inf` times the elastic force, so it
+//! confounds the modulus with the weights.
+//!
+//! FE runs are kept cheap: the stage fits run on the model's mesh (coarse by
+//! default) while records come from a finer one; the Jacobian's columns are
+//! computed in parallel (rayon, one FE evaluator per thread, kept between
+//! calls: `palpate_inverse::jacobian_unbounded`); differences are forward
+//! ([`TwoStageOptions::fd`]); the time step is fixed (`max_time_step`), so
+//! the discretisation does not move with `tau_i`.
+
+use palpate_core::{Drive, ForwardModel, Loading};
+use palpate_fe::mesh::Grading;
+use palpate_fe::Q1Punch;
+use palpate_inverse::{
+    fit, DataSet, FdOptions, FitOptions, FitReport, LmOptions, Method, Objective, ResidualKind,
+};
+use palpate_material::Law;
+use serde::Serialize;
+use std::sync::Arc;
+use std::time::Instant;
+
+/// The chi-square(1) 95 % quantile: the profile-likelihood threshold
+/// (Venzon & Moolgavkar 1988), as `palpate_uq::gap`'s profiles.
+pub const CHI2_1_95: f64 = 3.841_458_820_694_124;
+
+/// The stages `--stages` can name.
+pub const STAGES: [&str; 2] = ["elastic", "relaxation"];
+
+/// How to run the identification.
+#[derive(Debug, Clone)]
+pub struct TwoStageOptions {
+    pub law: Law,
+    /// Prony terms.
+    pub terms: usize,
+    /// Element size under the punch of the fits' mesh (mm), growing by
+    /// `1 + h_fine` beyond the 3 mm fine zone.
+    pub h_fine: f64,
+    /// Time step of the viscoelastic runs (s), fixed for every parameter.
+    pub max_time_step: f64,
+    /// Stages in order (`elastic`, `relaxation`); the polish follows.
+    pub stages: Vec<String>,
+    /// Also fit every parameter at once from the default start.
+    pub one_stage: bool,
+    /// Profile-likelihood intervals of the polished parameters.
+    pub profile: bool,
+    pub lm: LmOptions,
+    pub fd: FdOptions,
+}
+
+impl TwoStageOptions {
+    /// Defaults: two terms, 0.3 mm elements under the punch (3 s CPU a run
+    /// to 1 mm and a 60 s hold; the force is 1.2 % above the 0.2 mm mesh's
+    /// at 1.5 mm), time step 1 s, both stages, the
+    /// one-stage comparison and the profiles; LM until the SSE changes by
+    /// less than 1e-4 of itself or the step by less than 1e-4 of the
+    /// parameters (a change of `SSE / sigma^2` by 1e-4 (n - p), under 0.01
+    /// for a hundred samples: far inside the 3.84 of a 95 % interval, so
+    /// the estimates are converged well within their standard errors), at
+    /// most 20 iterations;
+    /// forward differences of relative step 1e-4 in parallel.
+    pub fn new(law: Law) -> Self {
+        TwoStageOptions {
+            law,
+            terms: 2,
+            h_fine: 0.3,
+            max_time_step: 1.0,
+            stages: STAGES.iter().map(|s| s.to_string()).collect(),
+            one_stage: true,
+            profile: true,
+            lm: LmOptions {
+                ftol: 1e-4,
+                xtol: 1e-4,
+                gtol: 1e-8,
+                max_iterations: 20,
+                ..LmOptions::default()
+            },
+            fd: FdOptions {
+                relative_step: 1e-4,
+                central: false,
+                parallel: true,
+            },
+        }
+    }
+
+    /// Parses `--stages elastic,relaxation` (the only order: the relaxation
+    /// stage needs the elastic estimate; `relaxation` alone starts the
+    /// elastic part at the law's default).
+    pub fn parse_stages(text: &str) -> anyhow::Result<Vec<String>> {
+        let stages: Vec<String> = text
+            .split(',')
+            .map(|s| s.trim().to_ascii_lowercase())
+            .filter(|s| !s.is_empty())
+            .collect();
+        anyhow::ensure!(
+            !stages.is_empty(),
+            "--stages `{text}`: give elastic,relaxation (or one of them)"
+        );
+        for s in &stages {
+            anyhow::ensure!(
+                STAGES.contains(&s.as_str()),
+                "--stages `{text}`: unknown stage `{s}`; expected {}",
+                STAGES.join(", ")
+            );
+        }
+        anyhow::ensure!(
+            stages.len() == 1 || stages == ["elastic", "relaxation"],
+            "--stages `{text}`: the stages run in the order elastic,relaxation, each once"
+        );
+        Ok(stages)
+    }
+
+    /// The elastic FE model of the fits.
+    pub fn elastic_model(&self) -> Q1Punch {
+        let mut m = Q1Punch::new(self.law);
+        m.grading = Some(Grading {
+            h_fine: self.h_fine,
+            fine_length: 3.0,
+            growth: 1.0 + self.h_fine,
+        });
+        m
+    }
+
+    /// The viscoelastic FE model of the fits (law, then `g_i, tau_i_s`).
+    pub fn viscoelastic_model(&self) -> Q1Punch {
+        let mut m = self.elastic_model().with_prony_parameters(self.terms);
+        m.options.max_time_step = Some(self.max_time_step);
+        m
+    }
+}
+
+/// A Q1 record: depth and force against time.
+#[derive(Debug, Clone)]
+pub struct Q1Record {
+    pub name: String,
+    pub time: Vec<f64>,
+    pub depth: Vec<f64>,
+    pub force: Vec<f64>,
+}
+
+impl Q1Record {
+    /// Checks the record: at least 3 samples, times increasing, depths
+    /// finite and >= 0, a ramp (some depth > 0) followed by a hold.
+    pub fn new(
+        name: &str,
+        time: Vec<f64>,
+        depth: Vec<f64>,
+        force: Vec<f64>,
+    ) -> anyhow::Result<Q1Record> {
+        anyhow::ensure!(
+            time.len() == depth.len() && depth.len() == force.len() && time.len() >= 3,
+            "{name}: a Q1 record needs time_s, displacement_mm and force_N on at least 3 rows"
+        );
+        for k in 1..time.len() {
+            anyhow::ensure!(
+                time[k] > time[k - 1],
+                "{name}: row {}: time_s {} does not increase (previous {})",
+                k + 1,
+                time[k],
+                time[k - 1]
+            );
+        }
+        let r = Q1Record {
+            name: name.into(),
+            time,
+            depth,
+            force,
+        };
+        let k = r.ramp_end();
+        anyhow::ensure!(
+            r.depth[k] > 0.0 && k + 1 < r.depth.len(),
+            "{name}: a Q1 record is a ramp to a depth > 0 and a hold after it (deepest point at row {} of {})",
+            k + 1,
+            r.depth.len()
+        );
+        Ok(r)
+    }
+
+    /// Reads a record file (`time_s,displacement_mm,force_N`, as `palpate
+    /// simulate --benchmark Q1 --csv` writes).
+    pub fn read(path: &std::path::Path) -> anyhow::Result<Q1Record> {
+        let d = crate::calibration::TestData::read("Q1", crate::calibration::TestKind::N1, path)?;
+        let time = d.loading.time.clone().ok_or_else(|| {
+            anyhow::anyhow!(
+                "{}: a Q1 record is a timed ramp-and-hold: it needs a time_s column",
+                path.display()
+            )
+        })?;
+        Q1Record::new(
+            &path.display().to_string(),
+            time,
+            d.loading.drive.clone(),
+            d.observed,
+        )
+    }
+
+    /// Index of the first sample at the deepest point (the end of the ramp).
+    pub fn ramp_end(&self) -> usize {
+        let max = self.depth.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        self.depth.iter().position(|&d| d == max).unwrap_or(0)
+    }
+
+    /// The whole record's loading (timed).
+    pub fn loading(&self) -> Loading {
+        Loading::timed(Drive::DisplacementMm, self.time.clone(), self.depth.clone())
+    }
+
+    /// The ramp as a quasi-static loading and its forces.
+    pub fn ramp(&self) -> (Loading, Vec<f64>) {
+        let k = self.ramp_end();
+        (
+            Loading::quasi_static(Drive::DisplacementMm, self.depth[..=k].to_vec()),
+            self.force[..=k].to_vec(),
+        )
+    }
+}
+
+/// One stage's result.
+#[derive(Debug, Clone, Serialize)]
+pub struct StageResult {
+    /// `elastic`, `relaxation`, `polish` or `one-stage`.
+    pub stage: String,
+    /// Free parameters.
+    pub free: Vec<String>,
+    /// Samples fitted.
+    pub samples: usize,
+    pub iterations: u64,
+    /// FE runs (objective evaluations, finite-difference ones included).
+    pub fe_runs: usize,
+    pub wall_s: f64,
+    pub converged: bool,
+    pub termination: String,
+    /// Every parameter of the viscoelastic model at the end of the stage
+    /// (held ones at their values), in the model's order.
+    pub theta: Vec<f64>,
+    /// Stage 1: the factor on the moduli from the force-level QLV
+    /// correction of the ramp ([`ramp_correction`]), when made.
+    pub correction: Option<f64>,
+    pub fit: FitReport,
+}
+
+/// A 95 % profile-likelihood interval: `min over the others SSE(x) / sigma^2`
+/// within [`CHI2_1_95`] of its minimum. Each side is evaluated at
+/// `estimate -/+ 2 SE` (the other parameters refitted by LM from the
+/// optimum) and the crossing interpolated linearly in the signed root
+/// `sqrt(delta chi2)` from the optimum (exact for a quadratic profile); a
+/// side whose first point stays below the threshold is tried at 4 SE, and
+/// is `None` (not bounded) if it still does, or if the point leaves the
+/// parameter's bounds or fails.
+#[derive(Debug, Clone, Serialize)]
+pub struct Profile {
+    pub param: String,
+    pub estimate: f64,
+    pub standard_error: Option<f64>,
+    pub lower: Option<f64>,
+    pub upper: Option<f64>,
+    /// (value, delta chi2) evaluated.
+    pub points: Vec<(f64, f64)>,
+    pub fe_runs: usize,
+}
+
+/// The whole identification.
+#[derive(Debug, Clone, Serialize)]
+pub struct TwoStageResult {
+    pub record: String,
+    pub model: String,
+    pub names: Vec<String>,
+    pub stages: Vec<StageResult>,
+    pub profiles: Vec<Profile>,
+    pub one_stage: Option<StageResult>,
+    /// Totals of the staged route (stages, polish, without profiles).
+    pub staged_fe_runs: usize,
+    pub staged_wall_s: f64,
+}
+
+/// Progress of the stages (the CLI prints it).
+pub type Say<'a> = &'a (dyn Fn(&str) + Sync);
+
+fn lm_fit(
+    objective: &Objective,
+    start: Vec<f64>,
+    options: &TwoStageOptions,
+    lm: LmOptions,
+) -> anyhow::Result<(FitReport, f64)> {
+    let t0 = Instant::now();
+    let report = fit(
+        objective,
+        &FitOptions {
+            method: Method::LevenbergMarquardt(lm),
+            fd: options.fd,
+            start: Some(start),
+            ..FitOptions::default()
+        },
+    )?;
+    Ok((report, t0.elapsed().as_secs_f64()))
+}
+
+fn stage_result(
+    stage: &str,
+    objective: &Objective,
+    report: FitReport,
+    wall_s: f64,
+    theta: Vec<f64>,
+) -> StageResult {
+    StageResult {
+        stage: stage.into(),
+        free: objective.free_names(),
+        samples: objective.n_residuals(),
+        iterations: report.iterations,
+        fe_runs: report.evaluations,
+        wall_s,
+        converged: report.converged,
+        termination: report.termination.to_string(),
+        theta,
+        correction: None,
+        fit: report,
+    }
+}
+
+/// The elastic force curve of stage 1 scaled by the parameter `s`, at the
+/// samples of the record: `s F_e(k)` (the ramp's elastic FE predictions,
+/// then the end-of-ramp value through the hold). The base of the
+/// force-level QLV of [`ramp_correction`].
+struct ScaledCurve {
+    fe: Vec<f64>,
+    space: palpate_core::ParamSpace,
+}
+
+impl ForwardModel for ScaledCurve {
+    fn name(&self) -> String {
+        "scaled elastic force curve of stage 1".into()
+    }
+    fn space(&self) -> &palpate_core::ParamSpace {
+        &self.space
+    }
+    fn observable(&self) -> palpate_core::Observable {
+        palpate_core::Observable::ForceN
+    }
+    fn evaluator(&self) -> Box<dyn palpate_core::Evaluator + '_> {
+        Box::new(ScaledEvaluator(self))
+    }
+}
+
+struct ScaledEvaluator<'a>(&'a ScaledCurve);
+
+impl palpate_core::Evaluator for ScaledEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), palpate_core::ForwardError> {
+        if out.len() != self.0.fe.len() || loading.len() != out.len() {
+            return Err(palpate_core::ForwardError::InvalidLoading(
+                "the scaled curve answers only for its record".into(),
+            ));
+        }
+        for (o, f) in out.iter_mut().zip(&self.0.fe) {
+            *o = theta[0] * f;
+        }
+        Ok(())
+    }
+}
+
+/// The relaxation during the ramp lowers the ramp force, so stage 1's
+/// elastic fit underestimates the instantaneous moduli. Force-level QLV
+/// (`palpate_enrich::Viscoelastic`, Fung's QLV on the force: exact for the
+/// punch in the linear range by the correspondence principle) of the stage-1
+/// elastic curve `s F_e(t)` is fitted to the whole record by LM in
+/// `s, g_i, tau_i` from `s = 1` and the default Prony start; it costs no FE
+/// run (the curve is stage 1's). Returns `s` (the factor on the moduli:
+/// the force is proportional to them for a law with one modulus, e.g.
+/// neo-Hookean, under exact incompressibility) and the Prony terms,
+/// increasing in tau, as the start of stage 2. `None` when the record is
+/// not a ramp then a hold at constant depth, or the fit fails.
+pub fn ramp_correction(
+    record: &Q1Record,
+    fe_ramp: &[f64],
+    terms: usize,
+) -> Option<(f64, Vec<f64>)> {
+    let k = record.ramp_end();
+    if fe_ramp.len() != k + 1 || record.depth[k..].iter().any(|&d| d != record.depth[k]) {
+        return None;
+    }
+    let mut fe = fe_ramp.to_vec();
+    fe.resize(record.depth.len(), fe_ramp[k]);
+    let base = ScaledCurve {
+        fe,
+        space: palpate_core::ParamSpace::new(vec![palpate_core::ParamSpec::new(
+            "scale",
+            "1",
+            0.0,
+            f64::INFINITY,
+            1.0,
+        )]),
+    };
+    let qlv = palpate_enrich::Viscoelastic::new(Box::new(base), terms);
+    let set = DataSet::new(
+        "ramp correction",
+        Arc::new(qlv),
+        record.loading(),
+        record.force.clone(),
+    );
+    let objective = Objective::new(vec![set], ResidualKind::Absolute, &[]).ok()?;
+    let report = fit(&objective, &FitOptions::default()).ok()?;
+    let theta: Vec<f64> = report.parameters.iter().map(|p| p.value).collect();
+    let mut pairs: Vec<(f64, f64)> = (0..terms)
+        .map(|i| (theta[1 + 2 * i], theta[2 + 2 * i]))
+        .collect();
+    pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
+    let sum: f64 = pairs.iter().map(|p| p.0).sum();
+    (report.converged && sum < 1.0 && theta[0] > 0.0).then(|| {
+        (
+            theta[0],
+            pairs.into_iter().flat_map(|(g, t)| [g, t]).collect(),
+        )
+    })
+}
+
+/// Runs the stages, the polish, the profiles and the one-stage comparison
+/// on `record`.
+pub fn identify(
+    record: &Q1Record,
+    options: &TwoStageOptions,
+    say: Say<'_>,
+) -> anyhow::Result<TwoStageResult> {
+    let visco: Arc<dyn ForwardModel> = Arc::new(options.viscoelastic_model());
+    let elastic: Arc<dyn ForwardModel> = Arc::new(options.elastic_model());
+    let space = visco.space().clone();
+    let names = space.names();
+    let n_law = elastic.space().len();
+    let mut theta: Vec<f64> = space.params.iter().map(|p| p.initial).collect();
+    let full = DataSet::new(
+        &record.name,
+        visco.clone(),
+        record.loading(),
+        record.force.clone(),
+    );
+    let mut stages = Vec::new();
+    for stage in &options.stages {
+        match stage.as_str() {
+            "elastic" => {
+                let (loading, observed) = record.ramp();
+                let set = DataSet::new(
+                    format!("{} (ramp)", record.name),
+                    elastic.clone(),
+                    loading,
+                    observed,
+                );
+                let objective = Objective::new(vec![set], ResidualKind::Absolute, &[])?;
+                say(&format!(
+                    "stage 1 (elastic): {} on the ramp ({} samples), elastic FE",
+                    objective.free_names().join(", "),
+                    objective.n_residuals()
+                ));
+                let (report, wall) =
+                    lm_fit(&objective, theta[..n_law].to_vec(), options, options.lm)?;
+                for (t, e) in theta[..n_law].iter_mut().zip(&report.parameters) {
+                    *t = e.value;
+                }
+                let mut result = stage_result(stage, &objective, report, wall, theta.clone());
+                let t0 = Instant::now();
+                if let Some((scale, prony)) =
+                    ramp_correction(record, &result.fit.sets[0].predicted, options.terms)
+                {
+                    for (k, p) in space.params[..n_law].iter().enumerate() {
+                        if p.is_modulus() {
+                            theta[k] *= scale;
+                        }
+                    }
+                    theta[n_law..].copy_from_slice(&prony);
+                    result.correction = Some(scale);
+                    result.theta = theta.clone();
+                    say(&format!(
+                        "  force-level QLV correction of the ramp (no FE run): moduli x {scale:.4}, Prony start {prony:.4?}"
+                    ));
+                }
+                result.wall_s += t0.elapsed().as_secs_f64();
+                stages.push(result);
+            }
+            _ => {
+                let fixed: Vec<(String, f64)> =
+                    (0..n_law).map(|k| (names[k].clone(), theta[k])).collect();
+                let objective = Objective::new(vec![full.clone()], ResidualKind::Absolute, &fixed)?;
+                say(&format!(
+                    "stage 2 (relaxation): {} on the whole record ({} samples), the law held",
+                    objective.free_names().join(", "),
+                    objective.n_residuals()
+                ));
+                let (report, wall) = lm_fit(&objective, theta.clone(), options, options.lm)?;
+                theta = report.parameters.iter().map(|p| p.value).collect();
+                stages.push(stage_result(stage, &objective, report, wall, theta.clone()));
+            }
+        }
+        let s = stages.last().expect("a stage");
+        say(&format!(
+            "  {} iterations, {} FE runs, {:.1} s",
+            s.iterations, s.fe_runs, s.wall_s
+        ));
+    }
+    let objective = Objective::new(vec![full.clone()], ResidualKind::Absolute, &[])?;
+    say("polish: every parameter on the whole record");
+    let (report, wall) = lm_fit(&objective, theta.clone(), options, options.lm)?;
+    theta = report.parameters.iter().map(|p| p.value).collect();
+    stages.push(stage_result(
+        "polish",
+        &objective,
+        report,
+        wall,
+        theta.clone(),
+    ));
+    let polish = stages.last().expect("the polish").clone();
+    say(&format!(
+        "  {} iterations, {} FE runs, {:.1} s",
+        polish.iterations, polish.fe_runs, polish.wall_s
+    ));
+    let staged_fe_runs = stages.iter().map(|s| s.fe_runs).sum();
+    let staged_wall_s = stages.iter().map(|s| s.wall_s).sum();
+    let profiles = if options.profile {
+        say("profile-likelihood intervals of the polished parameters");
+        profiles(&full, &polish, options)
+    } else {
+        Vec::new()
+    };
+    let one_stage = if options.one_stage {
+        say("one-stage comparison: every parameter from the default start");
+        let start: Vec<f64> = space.params.iter().map(|p| p.initial).collect();
+        let (report, wall) = lm_fit(&objective, start, options, options.lm)?;
+        let th = report.parameters.iter().map(|p| p.value).collect();
+        let s = stage_result("one-stage", &objective, report, wall, th);
+        say(&format!(
+            "  {} iterations, {} FE runs, {:.1} s",
+            s.iterations, s.fe_runs, s.wall_s
+        ));
+        Some(s)
+    } else {
+        None
+    };
+    Ok(TwoStageResult {
+        record: record.name.clone(),
+        model: visco.name(),
+        names,
+        stages,
+        profiles,
+        one_stage,
+        staged_fe_runs,
+        staged_wall_s,
+    })
+}
+
+/// The profile of each free parameter of the polish ([`Profile`]).
+fn profiles(set: &DataSet, polish: &StageResult, options: &TwoStageOptions) -> Vec<Profile> {
+    let report = &polish.fit;
+    let n = report.n_residuals as f64;
+    let p = report.free.len() as f64;
+    let sigma2 = report.sse / (n - p).max(1.0);
+    let mut lm = options.lm;
+    lm.max_iterations = 5;
+    report
+        .parameters
+        .iter()
+        .filter(|e| !e.fixed)
+        .map(|e| {
+            let mut prof = Profile {
+                param: e.name.clone(),
+                estimate: e.value,
+                standard_error: e.standard_error,
+                lower: None,
+                upper: None,
+                points: Vec::new(),
+                fe_runs: 0,
+            };
+            let Some(se) = e.standard_error.filter(|s| *s > 0.0) else {
+                return prof;
+            };
+            for side in [-1.0, 1.0] {
+                let mut end = None;
+                for m in [2.0, 4.0] {
+                    let x = e.value + side * m * se;
+                    if !(x > e.lower && x < e.upper) {
+                        break;
+                    }
+                    let Ok(objective) = Objective::new(
+                        vec![set.clone()],
+                        ResidualKind::Absolute,
+                        &[(e.name.clone(), x)],
+                    ) else {
+                        break;
+                    };
+                    let mut start = polish.theta.clone();
+                    let k = report
+                        .parameters
+                        .iter()
+                        .position(|q| q.name == e.name)
+                        .expect("a parameter of the fit");
+                    start[k] = x;
+                    let Ok((r, _)) = lm_fit(&objective, start, options, lm) else {
+                        break;
+                    };
+                    prof.fe_runs += r.evaluations;
+                    let d = ((r.sse - report.sse) / sigma2).max(0.0);
+                    prof.points.push((x, d));
+                    if d >= CHI2_1_95 {
+                        // linear in sqrt(delta chi2) from 0 at the estimate
+                        end = Some(e.value + side * m * se * (CHI2_1_95 / d).sqrt());
+                        break;
+                    }
+                }
+                if side < 0.0 {
+                    prof.lower = end;
+                } else {
+                    prof.upper = end;
+                }
+            }
+            prof
+        })
+        .collect()
+}
+
+/// The result as a Markdown report: one row per stage, the estimates with
+/// standard errors and profile intervals, and, given the truth, the errors.
+pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
+    use std::fmt::Write;
+    let mut r = String::new();
+    let _ = writeln!(r, "record `{}`, model {}\n", result.record, result.model);
+    let _ = writeln!(
+        r,
+        "| route | free | samples | LM iterations | FE runs | wall (s) | converged | RMS (N) | {} |",
+        result.names.join(" | ")
+    );
+    let _ = writeln!(r, "|{}", "---|".repeat(8 + result.names.len()));
+    let row = |r: &mut String, s: &StageResult| {
+        let _ = writeln!(
+            r,
+            "| {} | {} | {} | {} | {} | {:.1} | {} | {:.3e} | {} |",
+            s.stage,
+            s.free.join(", "),
+            s.samples,
+            s.iterations,
+            s.fe_runs,
+            s.wall_s,
+            if s.converged {
+                "yes"
+            } else {
+                s.termination.as_str()
+            },
+            s.fit.rms,
+            s.theta
+                .iter()
+                .map(|v| format!("{v:.5}"))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+    };
+    for s in &result.stages {
+        row(&mut r, s);
+    }
+    let _ = writeln!(
+        r,
+        "| two-stage total | | | {} | {} | {:.1} | | | |",
+        result.stages.iter().map(|s| s.iterations).sum::<u64>(),
+        result.staged_fe_runs,
+        result.staged_wall_s
+    );
+    if let Some(s) = &result.one_stage {
+        row(&mut r, s);
+    }
+    if let Some(t) = truth {
+        let _ = writeln!(
+            r,
+            "| truth | | | | | | | | {} |",
+            t.iter()
+                .map(|v| format!("{v:.5}"))
+                .collect::<Vec<_>>()
+                .join(" | ")
+        );
+    }
+    let polish = result.stages.last().expect("the polish");
+    let _ =
+        writeln!(
+        r,
+        "\n| parameter | estimate | standard error | 95 % profile interval | profile FE runs |{}",
+        if truth.is_some() { " truth | error / SE |" } else { "" }
+    );
+    let _ = writeln!(
+        r,
+        "|---|---|---|---|---|{}",
+        if truth.is_some() { "---|---|" } else { "" }
+    );
+    for (k, e) in polish.fit.parameters.iter().enumerate() {
+        let prof = result.profiles.iter().find(|p| p.param == e.name);
+        let side = |v: Option<f64>, what: &str| match v {
+            Some(x) => format!("{x:.5}"),
+            None => format!("not bounded {what}"),
+        };
+        let interval = prof.map_or("-".into(), |p| {
+            format!("[{}, {}]", side(p.lower, "below"), side(p.upper, "above"))
+        });
+        let _ = write!(
+            r,
+            "| {} | {:.5} | {} | {} | {} |",
+            e.name,
+            e.value,
+            e.standard_error.map_or("-".into(), |s| format!("{s:.2e}")),
+            interval,
+            prof.map_or(0, |p| p.fe_runs)
+        );
+        if let Some(t) = truth {
+            let _ = write!(
+                r,
+                " {:.5} | {} |",
+                t[k],
+                e.standard_error
+                    .map_or("-".into(), |s| format!("{:.2}", (e.value - t[k]) / s))
+            );
+        }
+        let _ = writeln!(r);
+    }
+    r
+}
+
+/// A study step (`[[steps]] two_stage = {...}` in a manifest): the staged
+/// identification of one Q1 record, cached as a unit of the run folder.
+#[derive(Debug, Clone, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TwoStageStep {
+    pub name: String,
+    /// The record (`time_s,displacement_mm,force_N`), relative to the manifest.
+    pub record: String,
+    pub law: String,
+    /// `elastic,relaxation` (default).
+    #[serde(default)]
+    pub stages: Option<String>,
+    #[serde(default)]
+    pub prony_terms: Option<usize>,
+    /// Element size under the punch of the fits' mesh (mm, default 0.3).
+    #[serde(default)]
+    pub fit_mesh: Option<f64>,
+    /// Time step of the viscoelastic runs (s, default 1).
+    #[serde(default)]
+    pub time_step: Option<f64>,
+    /// The one-stage comparison (default true).
+    #[serde(default)]
+    pub compare: Option<bool>,
+    /// Profile-likelihood intervals (default true).
+    #[serde(default)]
+    pub profile: Option<bool>,
+    /// The true parameters, in the model's order, when the record is synthetic.
+    #[serde(default)]
+    pub truth: Option<Vec<f64>>,
+}
+
+impl TwoStageStep {
+    /// The options; errors name the field.
+    pub fn options(&self) -> anyhow::Result<TwoStageOptions> {
+        let law: Law = self
+            .law
+            .parse()
+            .map_err(|e| anyhow::anyhow!("law = {:?}: {e}", self.law))?;
+        let mut o = TwoStageOptions::new(law);
+        if let Some(s) = &self.stages {
+            o.stages =
+                TwoStageOptions::parse_stages(s).map_err(|e| anyhow::anyhow!("stages: {e}"))?;
+        }
+        if let Some(n) = self.prony_terms {
+            anyhow::ensure!((1..=4).contains(&n), "prony_terms = {n}: give 1 to 4");
+            o.terms = n;
+        }
+        if let Some(h) = self.fit_mesh {
+            anyhow::ensure!(
+                h.is_finite() && (0.02..=1.0).contains(&h),
+                "fit_mesh = {h}: the element size under the punch must lie in 0.02..1 mm"
+            );
+            o.h_fine = h;
+        }
+        if let Some(dt) = self.time_step {
+            anyhow::ensure!(
+                dt.is_finite() && dt > 0.0,
+                "time_step = {dt}: must be > 0 s"
+            );
+            o.max_time_step = dt;
+        }
+        o.one_stage = self.compare.unwrap_or(true);
+        o.profile = self.profile.unwrap_or(true);
+        if let Some(t) = &self.truth {
+            let n = o.viscoelastic_model().space().len();
+            anyhow::ensure!(
+                t.len() == n,
+                "truth: {} values for the {n} parameters of the model",
+                t.len()
+            );
+        }
+        Ok(o)
+    }
+
+    /// Checks the step before any run (the manifest's validation).
+    pub fn validate(&self, where_: &str, at: &str, dir: &std::path::Path) -> anyhow::Result<()> {
+        self.options()
+            .map_err(|e| anyhow::anyhow!("{where_}: {at}.{e}"))?;
+        let f = dir.join(&self.record);
+        anyhow::ensure!(
+            f.is_file(),
+            "{where_}: {at}.record: no such file {}",
+            f.display()
+        );
+        Ok(())
+    }
+}
+
+/// A finished step as cached: the result as JSON and its report.
+#[derive(Debug, Clone, Serialize, serde::Deserialize)]
+pub(crate) struct TwoStageUnit {
+    pub result: serde_json::Value,
+    pub report: String,
+}
+
+/// Runs the step (cached under the record's bytes and the options).
+pub(crate) fn run_two_stage(
+    run: &crate::runner::Run<'_>,
+    step: &TwoStageStep,
+    report_md: &mut String,
+) -> anyhow::Result<crate::runner::StepResult> {
+    use std::fmt::Write;
+    let path = run.manifest_dir.join(&step.record);
+    let bytes = std::fs::read(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let options = step.options()?;
+    let inputs = (
+        "two_stage",
+        format!("{step:?}"),
+        bytes,
+        crate::surrogate::code_version(),
+    );
+    let label = format!("{}: two-stage identification of {}", step.name, step.record);
+    let unit: TwoStageUnit = run.unit(&label, &inputs, || {
+        let mut record = Q1Record::read(&path)?;
+        record.name = step.record.clone();
+        let say = |s: &str| eprintln!("{s}");
+        let result = identify(&record, &options, &say)?;
+        Ok(TwoStageUnit {
+            report: report(&result, step.truth.as_deref()),
+            result: serde_json::to_value(&result)?,
+        })
+    })?;
+    let _ = writeln!(
+        report_md,
+        "## {} (two-stage inverse FE, Q1)\n\n{}",
+        step.name, unit.report
+    );
+    Ok(crate::runner::StepResult::TwoStage {
+        name: step.name.clone(),
+        result: unit.result,
+    })
+}
