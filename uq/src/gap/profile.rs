@@ -53,6 +53,10 @@ impl ProfileInterval {
     }
 }
 
+/// One side of a profile walk: its points (value, delta chi2) and where it
+/// crossed the threshold.
+type Side = (Vec<(f64, f64)>, Option<f64>);
+
 /// Minimum SSE with parameter `j` fixed at `x`.
 #[allow(clippy::too_many_arguments)]
 fn profile_sse(
@@ -129,7 +133,7 @@ pub(crate) fn profile_interval(
     };
     // The two sides are independent walks: run in parallel (for an expensive
     // model each point is a solve).
-    let sides: Vec<(Vec<(f64, f64)>, Option<f64>)> = [-1.0f64, 1.0]
+    let sides: Vec<Side> = [-1.0f64, 1.0]
         .par_iter()
         .map(|dir| {
             let mut points = Vec::new();
