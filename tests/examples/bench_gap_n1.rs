@@ -38,7 +38,10 @@ impl Evaluator for CountedEval<'_> {
         loading: &Loading,
         out: &mut [f64],
     ) -> Result<(), ForwardError> {
-        RUNS.fetch_add(1, Ordering::Relaxed);
+        let k = RUNS.fetch_add(1, Ordering::Relaxed);
+        if std::env::var_os("GAP_TRACE").is_some() {
+            eprintln!("solve {k}: {theta:?}");
+        }
         self.0.predict_into(theta, loading, out)
     }
 }
@@ -129,23 +132,44 @@ fn main() {
     base.friction = 0.0;
     base.mesh = MeshDensity::COARSE;
     let base = Counted(Arc::new(base));
-    let options = GapOptions {
-        effects: Some(effects.clone()),
-        ..GapOptions::default()
-    };
-    let (wall, cpu) = (Instant::now(), cpu_seconds());
-    let r = diagnose(&base, &loading, &f, &options).expect("diagnosis");
-    let (wall, cpu) = (wall.elapsed().as_secs_f64(), cpu_seconds() - cpu);
     let names: Vec<&str> = effects.iter().map(|e| e.name()).collect();
-    println!("| record | candidates | verdict | FE runs | wall s | CPU s (user+sys) | threads |");
-    println!("|---|---|---|---|---|---|---|");
+    // `--no-cache-too`: also the diagnosis without the prediction cache
+    // (what the cache and the homogeneity shortcut save).
+    let caches: &[bool] = if args.iter().any(|a| a == "--no-cache-too") {
+        &[false, true]
+    } else {
+        &[true]
+    };
+    let mut rows = Vec::new();
+    let mut last = None;
+    for &cache in caches {
+        let options = GapOptions {
+            effects: Some(effects.clone()),
+            cache,
+            ..GapOptions::default()
+        };
+        RUNS.store(0, Ordering::Relaxed);
+        let (wall, cpu) = (Instant::now(), cpu_seconds());
+        let r = diagnose(&base, &loading, &f, &options).expect("diagnosis");
+        let (wall, cpu) = (wall.elapsed().as_secs_f64(), cpu_seconds() - cpu);
+        rows.push(format!(
+            "| N1 10 mm, 41 samples, friction 0.5 | {} | {} | {} | {} | {wall:.1} | {cpu:.1} | {} |",
+            names.join(", "),
+            if cache { "yes" } else { "no" },
+            r.verdict,
+            RUNS.load(Ordering::Relaxed),
+            rayon::current_num_threads()
+        ));
+        last = Some(r);
+    }
+    let r = last.expect("one run");
     println!(
-        "| N1 10 mm, 41 samples, friction 0.5 | {} | {} | {} | {wall:.1} | {cpu:.1} | {} |",
-        names.join(", "),
-        r.verdict,
-        RUNS.load(Ordering::Relaxed),
-        rayon::current_num_threads()
+        "| record | candidates | cache | verdict | FE runs | wall s | CPU s (user+sys) | threads |"
     );
+    println!("|---|---|---|---|---|---|---|---|");
+    for row in rows {
+        println!("{row}");
+    }
     for e in &r.ranking {
         println!(
             "  {}: misfit {:.3e} -> {:.3e}, held-out {:.3e} -> {:.3e}, params {:?}",

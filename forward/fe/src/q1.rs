@@ -376,4 +376,31 @@ impl ForwardModel for Q1Punch {
     fn expensive(&self) -> bool {
         true
     }
+    fn as_enrichable(&self) -> Option<&dyn palpate_core::Enrichable> {
+        Some(self)
+    }
+}
+
+/// Effects of the elastic Q1 model: `viscoelasticity` (a one-term Prony
+/// series with its weight and time constant as parameters,
+/// [`crate::q1_viscous::Q1Viscous`]).
+impl palpate_core::Enrichable for Q1Punch {
+    fn effects(&self) -> Vec<palpate_core::Effect> {
+        if self.prony.is_none() {
+            vec![palpate_core::Effect::Viscoelasticity]
+        } else {
+            Vec::new()
+        }
+    }
+    fn enrich(&self, effect: palpate_core::Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        match effect {
+            palpate_core::Effect::Viscoelasticity if self.prony.is_none() => {
+                Ok(Box::new(crate::q1_viscous::Q1Viscous::new(self.clone())))
+            }
+            _ => Err(ForwardError::InvalidConfig {
+                field: "effect".into(),
+                reason: format!("`{effect}` does not apply to {}", self.name()),
+            }),
+        }
+    }
 }

@@ -7,6 +7,7 @@
 use super::assess::{assess, Assessed, Context};
 use super::base::fit_base;
 use super::crossval::Folds;
+use super::memo::Memo;
 use super::noise::difference_noise_sd;
 use super::rank::rank;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport};
@@ -32,6 +33,16 @@ pub fn diagnose(
     options: &GapOptions,
 ) -> Result<GapReport, GapError> {
     options.validate()?;
+    // An expensive model's predictions are cached for the whole diagnosis
+    // (repeats and, when the model is homogeneous in its moduli, whole rays;
+    // see `memo`).
+    let memo;
+    let base: &dyn ForwardModel = if base.expensive() && options.cache {
+        memo = Memo::borrowed(base);
+        &memo
+    } else {
+        base
+    };
     let n = observed.len();
     if n != loading.len() {
         return Err(GapError::LengthMismatch {

@@ -28,6 +28,7 @@ mod crossval;
 mod diagnose;
 mod error;
 mod fit;
+mod memo;
 pub mod noise;
 mod options;
 pub mod profile;

@@ -41,6 +41,11 @@ pub struct GapOptions {
     /// verdict stays `none`. Default 0.4: a model error of 0.4 noise SD
     /// raises the RMS prediction error by under 8 % (sqrt(1 + 0.4^2) = 1.077).
     pub materiality: f64,
+    /// Cache an expensive model's predictions for the whole diagnosis, and
+    /// serve whole rays of moduli from one solve when the model is measured
+    /// to be homogeneous in them (`gap::memo`). Default true; false only to
+    /// measure what the cache saves.
+    pub cache: bool,
 }
 
 /// How the record is cut into the folds of the cross-validation.
@@ -98,6 +103,7 @@ impl Default for GapOptions {
             cross_validation: CrossValidation::Auto,
             fold_layout: FoldLayout::Stratified,
             materiality: 0.4,
+            cache: true,
         }
     }
 }

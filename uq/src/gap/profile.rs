@@ -6,6 +6,7 @@
 use super::fit::{fit_from_starts, interior, scale_moduli};
 use super::structure::chi2_isf;
 use palpate_core::{ForwardModel, Loading};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
@@ -51,6 +52,10 @@ impl ProfileInterval {
         self.lower.is_some() && self.upper.is_some()
     }
 }
+
+/// One side of a profile walk: its points (value, delta chi2) and where it
+/// crossed the threshold.
+type Side = (Vec<(f64, f64)>, Option<f64>);
 
 /// Minimum SSE with parameter `j` fixed at `x`.
 #[allow(clippy::too_many_arguments)]
@@ -102,8 +107,10 @@ fn profile_sse(
 /// (SSE `sse_min`, noise `sigma`). Walks away from the estimate in the
 /// parameter's unbounded coordinate (log, logit or identity; ParamSpec) by
 /// steps 0.125, 0.25, 0.5, ... until the profile crosses the threshold,
-/// the bound is reached or 8 steps are made, and interpolates the crossing
-/// linearly in sqrt(delta chi2) (exact for a quadratic profile).
+/// the bound is reached (for an expensive model: within 1 % of the range
+/// from it) or 8 steps are made, and interpolates the crossing linearly in
+/// sqrt(delta chi2) (exact for a quadratic profile). The two sides are
+/// walked in parallel.
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn profile_interval(
     model: &Arc<dyn ForwardModel>,
@@ -124,35 +131,53 @@ pub(crate) fn profile_interval(
     } else {
         1.0
     };
-    let mut points = Vec::new();
-    let mut ends = [None, None];
-    for (side, dir) in [-1.0f64, 1.0].iter().enumerate() {
-        let mut last = (x0, 0.0f64);
-        let mut dz = 0.125 * unit;
-        for _ in 0..8 {
-            let x = spec.from_unbounded(z0 + dir * dz);
-            if !x.is_finite() || x == last.0 || x <= spec.lower || x >= spec.upper {
-                break;
-            }
-            let Some(sse) = profile_sse(model, loading, observed, theta, j, x, expensive) else {
-                break;
-            };
-            let d = ((sse - sse_min) / (sigma * sigma)).max(0.0);
-            points.push((x, d));
-            if d >= threshold {
-                let (s0, s1) = (last.1.sqrt(), d.sqrt());
-                let t = if s1 > s0 {
-                    (threshold.sqrt() - s0) / (s1 - s0)
-                } else {
-                    1.0
+    // The two sides are independent walks: run in parallel (for an expensive
+    // model each point is a solve).
+    let sides: Vec<Side> = [-1.0f64, 1.0]
+        .par_iter()
+        .map(|dir| {
+            let mut points = Vec::new();
+            let mut last = (x0, 0.0f64);
+            let mut dz = 0.125 * unit;
+            for _ in 0..8 {
+                let x = spec.from_unbounded(z0 + dir * dz);
+                if !x.is_finite() || x == last.0 || x <= spec.lower || x >= spec.upper {
+                    break;
+                }
+                // an expensive model within 1 % of the range from a finite
+                // bound: the bound is reached (the side is not bounded by
+                // the data); further doublings only creep closer to it, a
+                // solve each
+                let range = spec.upper - spec.lower;
+                let near_bound = expensive
+                    && range.is_finite()
+                    && ((x - spec.lower) < 0.01 * range || (spec.upper - x) < 0.01 * range);
+                if near_bound && !points.is_empty() {
+                    break;
+                }
+                let Some(sse) = profile_sse(model, loading, observed, theta, j, x, expensive)
+                else {
+                    break;
                 };
-                ends[side] = Some(last.0 + t * (x - last.0));
-                break;
+                let d = ((sse - sse_min) / (sigma * sigma)).max(0.0);
+                points.push((x, d));
+                if d >= threshold {
+                    let (s0, s1) = (last.1.sqrt(), d.sqrt());
+                    let t = if s1 > s0 {
+                        (threshold.sqrt() - s0) / (s1 - s0)
+                    } else {
+                        1.0
+                    };
+                    return (points, Some(last.0 + t * (x - last.0)));
+                }
+                last = (x, d);
+                dz *= 2.0;
             }
-            last = (x, d);
-            dz *= 2.0;
-        }
-    }
+            (points, None)
+        })
+        .collect();
+    let ends = [sides[0].1, sides[1].1];
+    let mut points: Vec<(f64, f64)> = sides.into_iter().flat_map(|(p, _)| p).collect();
     points.sort_by(|a, b| a.0.total_cmp(&b.0));
     ProfileInterval {
         param: spec.name.clone(),
