@@ -10,6 +10,7 @@ pub mod checks;
 pub mod cli;
 pub mod columns;
 pub mod limits;
+pub mod localize;
 pub mod manifest;
 pub mod models;
 pub mod output;

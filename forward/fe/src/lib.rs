@@ -51,6 +51,7 @@ pub mod n3;
 pub mod q1;
 pub mod quadrature;
 pub mod r2;
+pub mod r2_scan;
 pub mod shape;
 pub mod sparse;
 pub mod stepper;

@@ -7,6 +7,7 @@ pub mod anova;
 pub mod calibrate;
 pub mod diagnose;
 pub mod doe;
+pub mod localize;
 pub mod run;
 pub mod sample;
 pub mod sample_fe;
@@ -43,6 +44,8 @@ pub enum Command {
     Diagnose(diagnose::Args),
     /// Run a whole study described by one TOML manifest into a run folder.
     Run(run::Args),
+    /// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record.
+    Localize(localize::Args),
 }
 
 /// The command line with a negative number after an option joined to it
@@ -85,5 +88,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Doe(a) => doe::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Run(a) => run::run(a),
+        Command::Localize(a) => localize::run(a),
     }
 }
