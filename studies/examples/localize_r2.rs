@@ -37,6 +37,8 @@ fn main() -> anyhow::Result<()> {
     let mut noise = 0.01;
     let mut cache = default_cache_dir();
     let mut plot: Option<PathBuf> = None;
+    let mut which = "r2".to_string();
+    let mut record_only = false;
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -49,6 +51,8 @@ fn main() -> anyhow::Result<()> {
             "--noise" => noise = v().parse()?,
             "--cache" => cache = PathBuf::from(v()),
             "--plot" => plot = Some(PathBuf::from(v())),
+            "--record" => which = v(),
+            "--record-only" => record_only = true,
             o => anyhow::bail!("unknown option {o}"),
         }
     }
@@ -62,36 +66,22 @@ fn main() -> anyhow::Result<()> {
             .join(" ")
     );
 
-    // 1. the model
-    let setup = LocSetup::r2(rd);
-    let t0 = Instant::now();
-    let model = LocModel::load_or_build(&setup, &cache)?;
-    let v = model.scan.validation();
-    println!(
-        "model: {} ({}) in {:.1} s; scan surrogate {} FE scans built in {:.1} s wall / {} CPU, nodule-free pass {:.1} s wall",
-        model.scan_status.as_ref().map_or("-", |s| s.word()),
-        model.scan_status.as_ref().map_or(String::new(), |s| s.path().display().to_string()),
-        t0.elapsed().as_secs_f64(),
-        model.scan.fe_runs,
-        model.scan.build_time_s,
-        model.scan.build_cpu_s.map_or("?".into(), |c| format!("{c:.1} s")),
-        model.baseline.time_s
-    );
-    println!(
-        "surrogate held-out error: max {:.3e}, RMS {:.3e} of the peak force; max abs {:.4} N",
-        v.max_relative_error,
-        v.rms_relative_error,
-        v.max_abs_error.first().copied().unwrap_or(0.0)
-    );
-
     // 2. the finer-mesh FE record
     let mut fe = R2Rolling::new(Law::ArrudaBoyce, Law::ArrudaBoyce, rd);
     fe.element_size = Some(h_record);
+    if which == "r2-1" {
+        // R2-1's nodule 75:15, rolled over 75 +- 30 mm only (cheaper)
+        fe = fe.with_nodules(vec![Nodule {
+            x: 75.0,
+            depth: 15.0,
+        }]);
+        fe.press_x = 45.0;
+        fe.roll_to = 105.0;
+    } else {
+        anyhow::ensure!(which == "r2", "--record r2|r2-1, got {which}");
+    }
     let positions = fe.pass_positions(step_record);
-    let truth: Vec<(f64, f64)> = Nodule::r2_default()
-        .iter()
-        .map(|n| (n.x, n.depth))
-        .collect();
+    let truth: Vec<(f64, f64)> = fe.nodules.iter().map(|n| (n.x, n.depth)).collect();
     let desc = format!("{:?}; positions {:?}", fe, positions);
     let t1 = Instant::now();
     let (force, status): (Vec<f64>, _) = load_or_compute("r2-record", &desc, &cache, || {
@@ -116,6 +106,31 @@ fn main() -> anyhow::Result<()> {
         positions.len(),
         t1.elapsed().as_secs_f64()
     );
+    if record_only {
+        return Ok(());
+    }
+    // 1. the model (after the record: `--record-only` stops there)
+    let setup = LocSetup::r2(rd);
+    let t0 = Instant::now();
+    let model = LocModel::load_or_build(&setup, &cache)?;
+    let v = model.scan.validation();
+    println!(
+        "model: {} ({}) in {:.1} s; scan surrogate {} FE scans built in {:.1} s wall / {} CPU, nodule-free pass {:.1} s wall",
+        model.scan_status.as_ref().map_or("-", |s| s.word()),
+        model.scan_status.as_ref().map_or(String::new(), |s| s.path().display().to_string()),
+        t0.elapsed().as_secs_f64(),
+        model.scan.fe_runs,
+        model.scan.build_time_s,
+        model.scan.build_cpu_s.map_or("?".into(), |c| format!("{c:.1} s")),
+        model.baseline.time_s
+    );
+    println!(
+        "surrogate held-out error: max {:.3e}, RMS {:.3e} of the peak force; max abs {:.4} N",
+        v.max_relative_error,
+        v.rms_relative_error,
+        v.max_abs_error.first().copied().unwrap_or(0.0)
+    );
+
     let (pred, _) = model.predict(&positions, &truth, 1.0)?;
     let peak = force.iter().cloned().fold(0.0, f64::max);
     let (k, worst) = pred

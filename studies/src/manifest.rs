@@ -240,9 +240,11 @@ pub enum Step {
     Diagnose(DiagnoseStep),
     Predict(PredictStep),
     Anova(AnovaStep),
+    Localize(LocalizeStep),
 }
 
 pub use crate::anova_step::AnovaStep;
+pub use crate::localize_step::LocalizeStep;
 pub use crate::predict_step::PredictStep;
 
 /// Fit every model to every group of data sets, with every residual kind.
@@ -383,6 +385,7 @@ impl Manifest {
             match step {
                 Step::Predict(p) => p.validate(self, i, &where_.to_string())?,
                 Step::Anova(a) => a.validate(self, i, &where_.to_string(), dir)?,
+                Step::Localize(l) => l.validate(self, i, &where_.to_string())?,
                 Step::Calibrate(c) => {
                     let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
                     for (field, list) in [
@@ -530,6 +533,7 @@ impl Step {
             Step::Diagnose(d) => &d.name,
             Step::Predict(p) => &p.name,
             Step::Anova(a) => &a.name,
+            Step::Localize(l) => &l.name,
         }
     }
 
@@ -540,6 +544,7 @@ impl Step {
             Step::Diagnose(_) => "diagnose",
             Step::Predict(_) => "predict",
             Step::Anova(_) => "anova",
+            Step::Localize(_) => "localize",
         }
     }
 }

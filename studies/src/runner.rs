@@ -62,6 +62,11 @@ pub enum StepResult {
         analysis: serde_json::Value,
         published: Option<serde_json::Value>,
     },
+    /// [`crate::localize_step`]: per RD, the localisation and the peak-force table.
+    Localize {
+        name: String,
+        results: Vec<serde_json::Value>,
+    },
 }
 
 /// A finished fit as cached: its results entry, its report rows and its plot.
@@ -217,6 +222,10 @@ pub fn run_study_with(
             }
             Step::Anova(a) => {
                 let r = crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?;
+                results.steps.push(r);
+            }
+            Step::Localize(l) => {
+                let r = crate::localize_step::run_localize(&run, l, &mut report)?;
                 results.steps.push(r);
             }
         }

@@ -44,10 +44,10 @@ pub struct Args {
     /// Surrogate cache folder (default: $PALPATE_CACHE or ~/.cache/palpate/surrogates).
     #[arg(long)]
     pub cache: Option<PathBuf>,
-    /// Training FE scans of the surrogate (default 8).
+    /// Training FE scans of the surrogate (default 6).
     #[arg(long)]
     pub design: Option<usize>,
-    /// Held-out FE scans (default 3).
+    /// Held-out FE scans (default 2).
     #[arg(long)]
     pub holdout: Option<usize>,
     /// Random seed of the sampler.
@@ -112,7 +112,12 @@ pub fn run(a: Args) -> anyhow::Result<()> {
 
 fn option_value(field: &str, a: &Args) -> String {
     match field {
-        "--design" => format!("{:?}/{:?}", a.design, a.holdout),
+        "--rd" => a.rd.to_string(),
+        "--design" => format!(
+            "{}/--holdout {}",
+            a.design.unwrap_or(6),
+            a.holdout.unwrap_or(2)
+        ),
         _ => String::new(),
     }
 }
