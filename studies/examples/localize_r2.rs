@@ -2,7 +2,8 @@
 //!
 //! `cargo run --release -p palpate-studies --example localize_r2 -- --rd 6
 //!  [--records 50] [--h-record 1.5] [--step-record 1] [--noise 0.01]
-//!  [--cache DIR] [--plot OUT.svg]`
+//!  [--cache DIR] [--plot OUT.svg] [--record r2|r2-1] [--record-only]
+//!  [--predict-r2-at X,X,..]`
 //!
 //! 1. Builds (or loads from the cache) the localisation model of RD: the
 //!    FE scan surrogate (h = 2 mm) and the nodule-free pass; prints the
@@ -39,6 +40,9 @@ fn main() -> anyhow::Result<()> {
     let mut plot: Option<PathBuf> = None;
     let mut which = "r2".to_string();
     let mut record_only = false;
+    // positions where the model of R2's three nodules is printed (to set
+    // beside FE presses of forward/fe/examples/r2_paper_tables.rs)
+    let mut predict_at: Vec<f64> = Vec::new();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -53,6 +57,9 @@ fn main() -> anyhow::Result<()> {
             "--plot" => plot = Some(PathBuf::from(v())),
             "--record" => which = v(),
             "--record-only" => record_only = true,
+            "--predict-r2-at" => {
+                predict_at = v().split(',').map(|x| x.parse().expect("mm")).collect()
+            }
             o => anyhow::bail!("unknown option {o}"),
         }
     }
@@ -113,6 +120,20 @@ fn main() -> anyhow::Result<()> {
     let setup = LocSetup::r2(rd);
     let t0 = Instant::now();
     let model = LocModel::load_or_build(&setup, &cache)?;
+    if !predict_at.is_empty() {
+        let r2: Vec<(f64, f64)> = Nodule::r2_default()
+            .iter()
+            .map(|n| (n.x, n.depth))
+            .collect();
+        let (p, var) = model.predict(&predict_at, &r2, 1.0)?;
+        for ((x, f), v) in predict_at.iter().zip(&p).zip(&var) {
+            println!(
+                "model of R2 (3 nodules) at x = {x} mm: {f:.5} N (surrogate error SD {:.5} N); F0 {:.5} N",
+                v.sqrt(),
+                model.baseline_at(*x)
+            );
+        }
+    }
     let v = model.scan.validation();
     println!(
         "model: {} ({}) in {:.1} s; scan surrogate {} FE scans built in {:.1} s wall / {} CPU, nodule-free pass {:.1} s wall",
@@ -170,6 +191,9 @@ fn main() -> anyhow::Result<()> {
         );
     }
 
+    if records == 0 {
+        return Ok(());
+    }
     // 3. noisy records
     let sd = noise * peak;
     let n = truth.len();

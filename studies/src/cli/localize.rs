@@ -215,7 +215,7 @@ pub fn plot_svg(
     truth: Option<&[(f64, f64)]>,
 ) -> String {
     let mut main = Plot::new(
-        &format!("R2 record and fit, RD {} mm", model.rd),
+        format!("R2 record and fit, RD {} mm", model.rd),
         "wheel position x (mm)",
         "force (N)",
     )
@@ -250,7 +250,7 @@ pub fn plot_svg(
         let px: Vec<f64> = flat_x.iter().step_by(stride).copied().collect();
         let pd: Vec<f64> = flat_d.iter().step_by(stride).copied().collect();
         let mut p = Plot::new(
-            &format!(
+            format!(
                 "nodule {} posterior{}",
                 j + 1,
                 if run.result.nodules[j].identifiable {

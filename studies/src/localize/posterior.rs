@@ -149,6 +149,7 @@ impl Bounds {
     }
 }
 
+#[allow(clippy::too_many_arguments)] // scratch buffers passed in: no allocation per evaluation
 fn log_likelihood(
     model: &LocModel,
     x: &[f64],

@@ -43,7 +43,7 @@ impl Record {
                     x[i]
                 );
             }
-            if i > 0 && !(x[i] > x[i - 1]) {
+            if i > 0 && x[i].partial_cmp(&x[i - 1]) != Some(std::cmp::Ordering::Greater) {
                 anyhow::bail!(
                     "{file}:{line}: position_mm {} does not increase (previous row {} mm): the record must follow the wheel along the path",
                     x[i],
