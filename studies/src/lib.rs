@@ -10,6 +10,8 @@ pub mod checks;
 pub mod cli;
 pub mod columns;
 pub mod limits;
+pub mod localize;
+pub mod localize_step;
 pub mod manifest;
 pub mod models;
 pub mod output;

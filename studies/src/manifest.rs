@@ -241,9 +241,11 @@ pub enum Step {
     Predict(PredictStep),
     Anova(AnovaStep),
     TwoStage(crate::two_stage::TwoStageStep),
+    Localize(LocalizeStep),
 }
 
 pub use crate::anova_step::AnovaStep;
+pub use crate::localize_step::LocalizeStep;
 pub use crate::predict_step::PredictStep;
 
 /// Fit every model to every group of data sets, with every residual kind.
@@ -389,6 +391,7 @@ impl Manifest {
                     &format!("steps[{i}].two_stage (\"{}\")", t.name),
                     dir,
                 )?,
+                Step::Localize(l) => l.validate(self, i, &where_.to_string())?,
                 Step::Calibrate(c) => {
                     let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
                     for (field, list) in [
@@ -537,6 +540,7 @@ impl Step {
             Step::Predict(p) => &p.name,
             Step::Anova(a) => &a.name,
             Step::TwoStage(t) => &t.name,
+            Step::Localize(l) => &l.name,
         }
     }
 
@@ -548,6 +552,7 @@ impl Step {
             Step::Predict(_) => "predict",
             Step::Anova(_) => "anova",
             Step::TwoStage(_) => "two_stage",
+            Step::Localize(_) => "localize",
         }
     }
 }

@@ -67,6 +67,11 @@ pub enum StepResult {
         analysis: serde_json::Value,
         published: Option<serde_json::Value>,
     },
+    /// [`crate::localize_step`]: per RD, the localisation and the peak-force table.
+    Localize {
+        name: String,
+        results: Vec<serde_json::Value>,
+    },
 }
 
 /// A finished fit as cached: its results entry, its report rows and its plot.
@@ -227,6 +232,10 @@ pub fn run_study_with(
             }
             Step::TwoStage(t) => {
                 let r = crate::two_stage::run_two_stage(&run, t, &mut report)?;
+                results.steps.push(r);
+            }
+            Step::Localize(l) => {
+                let r = crate::localize_step::run_localize(&run, l, &mut report)?;
                 results.steps.push(r);
             }
         }

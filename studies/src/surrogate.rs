@@ -67,9 +67,21 @@ pub fn default_cache_dir() -> PathBuf {
 /// the running executable, so that any rebuild of the code (a changed
 /// element, solver tolerance or mesh generator) invalidates the cache rather
 /// than reusing answers of other code. Computed once per process.
+///
+/// `$PALPATE_CODE_VERSION`, when set, replaces the executable's hash: the
+/// user vouches that the finite-element code is the same, so that binaries
+/// of one commit (the `palpate` CLI and a release bench/example) share the
+/// surrogates in a cache instead of each training its own.
 pub fn code_version() -> &'static str {
     static V: OnceLock<String> = OnceLock::new();
     V.get_or_init(|| {
+        if let Some(v) = std::env::var_os("PALPATE_CODE_VERSION").filter(|v| !v.is_empty()) {
+            return format!(
+                "palpate {} code {}",
+                env!("CARGO_PKG_VERSION"),
+                v.to_string_lossy()
+            );
+        }
         let exe = std::env::current_exe()
             .ok()
             .and_then(|p| std::fs::read(p).ok())
@@ -136,4 +148,38 @@ pub fn load_or_build(
         built.map_err(|e| anyhow::anyhow!("building the surrogate of {}: {e}", model.name()))?;
     write_atomic(&path, s.to_json().as_bytes())?;
     Ok((s, CacheStatus::Built(path)))
+}
+
+/// Loads `<cache>/<kind>-<key>.json`, key the SHA-256 of `description` and
+/// the code version, or computes the value and stores it there (atomically):
+/// the same cache and invalidation as [`load_or_build`], for the FE results
+/// a surrogate needs beside its design runs (e.g. the nodule-free R2 pass
+/// that `palpate localize` adds the nodules' excess to).
+pub fn load_or_compute<T: serde::Serialize + serde::de::DeserializeOwned>(
+    kind: &str,
+    description: &str,
+    cache: &Path,
+    compute: impl FnOnce() -> anyhow::Result<T>,
+) -> anyhow::Result<(T, CacheStatus)> {
+    let text = format!("{kind}; {description}; {}", code_version());
+    let key: String = Sha256::digest(text.as_bytes())
+        .iter()
+        .map(|b| format!("{b:02x}"))
+        .collect();
+    let path = cache.join(format!("{kind}-{key}.json"));
+    if path.exists() {
+        match std::fs::read_to_string(&path)
+            .map_err(|e| e.to_string())
+            .and_then(|t| serde_json::from_str::<T>(&t).map_err(|e| e.to_string()))
+        {
+            Ok(v) => return Ok((v, CacheStatus::Hit(path))),
+            Err(e) => eprintln!(
+                "warning: cannot read the cached {kind} {}: {e}; recomputing",
+                path.display()
+            ),
+        }
+    }
+    let v = compute()?;
+    write_atomic(&path, serde_json::to_string(&v)?.as_bytes())?;
+    Ok((v, CacheStatus::Built(path)))
 }

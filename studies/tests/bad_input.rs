@@ -982,3 +982,107 @@ fn two_stage_record() -> String {
         .display()
         .to_string()
 }
+
+// ---------- R2 localisation and the R2 geometry ----------
+
+/// `palpate localize`: RD not positive or deeper than the wheel allows,
+/// no nodule, records outside the rolled path, not increasing, without the
+/// columns: refused before any FE run, naming the option or file:line.
+#[test]
+fn localize_refuses_bad_rd_nodules_and_records() {
+    let s = Scratch::new();
+    let good = s.file(
+        "rec.csv",
+        "position_mm,force_N\n10,9\n11,9\n12,9\n13,9\n14,9\n",
+    );
+    let run = |rd: &str, data: &str, extra: &[&str]| {
+        let mut a = vec!["localize", "--benchmark", "R2", "--rd", rd, "--data", data];
+        a.extend_from_slice(extra);
+        let cache = s.path("cache");
+        let cache = cache.to_str().unwrap().to_string();
+        a.extend_from_slice(&["--cache", &cache]);
+        s.run(&a)
+    };
+    for rd in ["0", "-1", "8", "12", "nan"] {
+        refused(&run(rd, &good, &[]), &["rd"]);
+    }
+    refused(&run("6", &good, &["--nodules", "0"]), &["--nodules 0"]);
+    let outside = s.file(
+        "out.csv",
+        "position_mm,force_N\n10,9\n11,9\n12,9\n13,9\n150,9\n",
+    );
+    refused(
+        &run("6", &outside, &[]),
+        &["out.csv:6", "150", "outside the rolled path"],
+    );
+    let before = s.file(
+        "before.csv",
+        "position_mm,force_N\n5,9\n11,9\n12,9\n13,9\n14,9\n",
+    );
+    refused(&run("6", &before, &[]), &["before.csv:2", "outside"]);
+    let back = s.file(
+        "back.csv",
+        "position_mm,force_N\n10,9\n11,9\n12,9\n12,9\n14,9\n",
+    );
+    refused(&run("6", &back, &[]), &["back.csv:5", "does not increase"]);
+    let cols = s.file("cols.csv", "x_mm,force_N\n10,9\n11,9\n12,9\n13,9\n14,9\n");
+    refused(&run("6", &cols, &[]), &["cols.csv", "position_mm"]);
+    refused(
+        &run("6", &s.path("missing.csv").display().to_string(), &[]),
+        &["missing.csv"],
+    );
+    assert!(!s.path("cache").exists(), "no FE run, no cache entry");
+}
+
+/// `palpate simulate --benchmark R2`: a nodule outside the block or
+/// overlapping another, RD not positive or too deep: refused up front.
+#[test]
+fn r2_geometry_is_checked_before_the_fe_run() {
+    let s = Scratch::new();
+    let r2 = |extra: &[&str]| {
+        let mut a = vec!["simulate", "--benchmark", "R2", "--error-estimate", "off"];
+        a.extend_from_slice(extra);
+        s.run(&a)
+    };
+    refused(
+        &r2(&["--rd", "3", "--nodules", "75:2"]),
+        &["nodule", "depth"],
+    );
+    refused(
+        &r2(&["--rd", "3", "--nodules", "200:15"]),
+        &["nodule", "200"],
+    );
+    refused(
+        &r2(&["--rd", "3", "--nodules", "75:15,80:15"]),
+        &["overlaps"],
+    );
+    refused(&r2(&["--rd", "0"]), &["rd"]);
+    refused(&r2(&["--rd", "9"]), &["rd", "deeper"]);
+}
+
+/// `[steps.localize]`: a bad RD or nodule list is refused by `run --check`,
+/// naming the manifest field.
+#[test]
+fn localize_step_fields_are_checked() {
+    let s = Scratch::new();
+    let step = |body: &str| {
+        format!("[study]\nname = \"t\"\n\n[[steps]]\n[steps.localize]\nname = \"r2\"\n{body}\n")
+    };
+    for (body, needles) in [
+        (
+            "rds = [3, 9]",
+            vec!["steps[0].localize", "rds: 9", "deeper"],
+        ),
+        ("rds = [0]", vec!["rds: 0"]),
+        ("rds = []", vec!["rds = []"]),
+        (
+            "rds = [3]\nnodules = \"37.5:10,40:15\"",
+            vec!["nodules", "overlaps"],
+        ),
+        ("rds = [3]\nnodules = \"75:29\"", vec!["nodules", "depth"]),
+        ("rds = [3]\nnoise = -1", vec!["noise = -1"]),
+    ] {
+        let m = s.file("m.toml", &step(body));
+        refused(&s.run(&["run", "--check", &m]), &needles);
+    }
+}

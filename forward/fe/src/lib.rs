@@ -52,6 +52,7 @@ pub mod q1;
 pub mod q1_viscous;
 pub mod quadrature;
 pub mod r2;
+pub mod r2_scan;
 pub mod shape;
 pub mod sparse;
 pub mod stepper;

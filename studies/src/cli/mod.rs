@@ -7,6 +7,7 @@ pub mod anova;
 pub mod calibrate;
 pub mod diagnose;
 pub mod doe;
+pub mod localize;
 pub mod run;
 pub mod sample;
 pub mod sample_fe;
@@ -46,6 +47,8 @@ pub enum Command {
     Run(run::Args),
     /// Build (from FE runs) or query the real-time force surrogate of Q1 or N1.
     Surrogate(surrogate::Args),
+    /// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record.
+    Localize(localize::Args),
 }
 
 /// The command line with a negative number after an option joined to it
@@ -89,5 +92,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Diagnose(a) => diagnose::run(a),
         Command::Run(a) => run::run(a),
         Command::Surrogate(a) => surrogate::run(a),
+        Command::Localize(a) => localize::run(a),
     }
 }

@@ -1,0 +1,272 @@
+//! `palpate localize --benchmark R2 --rd RD --data RECORD.csv`: the
+//! posterior of each nodule's position and depth from a rolled force
+//! record (`crate::localize`), on a surrogate of the FE model trained once
+//! per RD and cached on disk.
+
+use std::path::PathBuf;
+
+use clap::Parser;
+
+use crate::localize::posterior::{localize, LocOptions, LocRun};
+use crate::localize::record::Record;
+use crate::localize::{LocModel, LocSetup};
+use crate::output::{check_outputs, given, write_atomic, write_json};
+use crate::plot::{grid_svg, Plot, Series};
+use crate::surrogate::default_cache_dir;
+
+/// Locate nodules (position x and depth, with 94 % credible intervals) from an R2 rolled force record, by MCMC on a cached FE surrogate.
+#[derive(Debug, Parser)]
+pub struct Args {
+    /// The benchmark (R2: the rolled block of BENCHMARKS.md).
+    #[arg(long, value_parser = ["R2", "r2"])]
+    pub benchmark: String,
+    /// Rolling depth of the record (mm); one surrogate per RD.
+    #[arg(long, value_name = "RD")]
+    pub rd: f64,
+    /// The record: CSV with position_mm,force_N (as `palpate simulate --benchmark R2 --csv` writes).
+    #[arg(long, value_name = "RECORD.csv")]
+    pub data: PathBuf,
+    /// Number of nodules to locate.
+    #[arg(long, default_value_t = 3)]
+    pub nodules: usize,
+    /// Write the result as JSON.
+    #[arg(long, value_name = "OUT.json")]
+    pub json: Option<PathBuf>,
+    /// Plot the record, the fit and the nodules' posteriors (SVG).
+    #[arg(long, value_name = "OUT.svg")]
+    pub plot: Option<PathBuf>,
+    /// Write a Markdown report.
+    #[arg(long, value_name = "OUT.md")]
+    pub report: Option<PathBuf>,
+    /// Write the posterior draws (CSV).
+    #[arg(long, value_name = "OUT.csv")]
+    pub draws: Option<PathBuf>,
+    /// Surrogate cache folder (default: $PALPATE_CACHE or ~/.cache/palpate/surrogates).
+    #[arg(long)]
+    pub cache: Option<PathBuf>,
+    /// Training FE scans of the surrogate (default 6).
+    #[arg(long)]
+    pub design: Option<usize>,
+    /// Held-out FE scans (default 2).
+    #[arg(long)]
+    pub holdout: Option<usize>,
+    /// Random seed of the sampler.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+}
+
+/// Runs `palpate localize`.
+pub fn run(a: Args) -> anyhow::Result<()> {
+    let mut setup = LocSetup::r2(a.rd);
+    if let Some(n) = a.design {
+        setup.training = n;
+    }
+    if let Some(n) = a.holdout {
+        setup.holdout = n;
+    }
+    setup
+        .check()
+        .map_err(|(f, r)| anyhow::anyhow!("{f} {}: {r}", option_value(&f, &a)))?;
+    anyhow::ensure!(
+        a.nodules >= 1 && a.nodules <= 8,
+        "--nodules {}: give 1 to 8 nodules",
+        a.nodules
+    );
+    check_outputs(
+        &[a.data.as_path()],
+        &given(&[
+            ("--json", &a.json),
+            ("--plot", &a.plot),
+            ("--report", &a.report),
+            ("--draws", &a.draws),
+        ]),
+    )?;
+    let path = (setup.template.press_x, setup.template.roll_to);
+    let record = Record::read(&a.data, path)?;
+    let cache = a.cache.clone().unwrap_or_else(default_cache_dir);
+    let t0 = std::time::Instant::now();
+    let model = LocModel::load_or_build(&setup, &cache)?;
+    report_model(&model, t0.elapsed().as_secs_f64());
+    let opts = LocOptions {
+        nodules: a.nodules,
+        seed: a.seed,
+        ..Default::default()
+    };
+    let run = localize(&model, &record.positions, &record.force, &opts, None)?;
+    let text = summary_text(&model, &record, &run);
+    print!("{text}");
+    if let Some(p) = &a.json {
+        write_json(p, &run.result)?;
+    }
+    if let Some(p) = &a.draws {
+        write_atomic(p, run.chains.to_csv(&run.names).as_bytes())?;
+    }
+    if let Some(p) = &a.plot {
+        write_atomic(p, plot_svg(&model, &record, &run, None).as_bytes())?;
+    }
+    if let Some(p) = &a.report {
+        write_atomic(p, report_md(&model, &record, &run).as_bytes())?;
+    }
+    Ok(())
+}
+
+fn option_value(field: &str, a: &Args) -> String {
+    match field {
+        "--rd" => a.rd.to_string(),
+        "--design" => format!(
+            "{}/--holdout {}",
+            a.design.unwrap_or(6),
+            a.holdout.unwrap_or(2)
+        ),
+        _ => String::new(),
+    }
+}
+
+/// Prints where the surrogate came from and its error (stderr).
+pub fn report_model(model: &LocModel, elapsed: f64) {
+    let v = model.scan.validation();
+    if let Some(s) = &model.scan_status {
+        eprintln!(
+            "R2 scan surrogate ({}, {}): {} FE scans, built in {:.1} s wall{}; ready in {elapsed:.1} s",
+            s.word(),
+            s.path().display(),
+            model.scan.fe_runs,
+            model.scan.build_time_s,
+            model
+                .scan
+                .build_cpu_s
+                .map(|c| format!(" ({c:.1} s CPU)"))
+                .unwrap_or_default()
+        );
+    }
+    eprintln!(
+        "surrogate error on {} held-out FE scans: max {:.3e}, RMS {:.3e} of the peak force ({} basis vectors); added to the likelihood as a variance",
+        v.points,
+        v.max_relative_error,
+        v.rms_relative_error,
+        model.scan.basis_size()
+    );
+}
+
+fn fmt_iv(i: &crate::localize::posterior::Interval) -> String {
+    format!(
+        "{:.2} +- {:.2} [{:.2}, {:.2}]",
+        i.mean, i.sd, i.hdi_3, i.hdi_97
+    )
+}
+
+/// The table printed on stdout.
+pub fn summary_text(model: &LocModel, record: &Record, run: &LocRun) -> String {
+    let r = &run.result;
+    let mut s = format!(
+        "# R2 localisation, RD {} mm, {} ({} positions), {} nodule(s)\n",
+        model.rd,
+        record.file.display(),
+        record.positions.len(),
+        r.nodules.len()
+    );
+    s.push_str(
+        "nodule | x mm: mean +- sd [94 % HDI] | depth mm: mean +- sd [94 % HDI] | identifiable\n",
+    );
+    for (k, n) in r.nodules.iter().enumerate() {
+        s.push_str(&format!(
+            "{} | {} | {} | {}\n",
+            k + 1,
+            fmt_iv(&n.x_mm),
+            fmt_iv(&n.depth_mm),
+            if n.identifiable { "yes" } else { "NI" }
+        ));
+    }
+    s.push_str(&format!(
+        "modulus scale {}; noise SD {:.4} N; surrogate {} FE runs, max rel. error {:.2e}\nR-hat max {:.4}, bulk ESS min {:.0}{}; posterior in {:.2} s ({} log-density evaluations)\n",
+        fmt_iv(&run.scale),
+        r.noise_sd,
+        r.surrogate.fe_runs,
+        r.surrogate.max_rel_error,
+        r.rhat_max,
+        r.ess_bulk_min,
+        if run.converged { "" } else { " (NOT converged at the draw cap)" },
+        run.wall_s,
+        run.evaluations
+    ));
+    s
+}
+
+/// The Markdown report.
+pub fn report_md(model: &LocModel, record: &Record, run: &LocRun) -> String {
+    let mut s = String::from("# R2 tumour localisation\n\n");
+    s.push_str(&format!(
+        "Record `{}`, RD {} mm. Model: F(p) = s [F0(p) + sum_n E(|p - x_n|; d_n)] on a surrogate of the FE scan of one nodule (studies/src/localize); depth box {:?} mm.\n\n```\n{}```\n",
+        record.file.display(),
+        model.rd,
+        model.depth_box,
+        summary_text(model, record, run)
+    ));
+    s
+}
+
+/// Force against position with the fit and the nodules (posterior means,
+/// with their 94 % x intervals), plus one cell per nodule with its (x,
+/// depth) draws.
+pub fn plot_svg(
+    model: &LocModel,
+    record: &Record,
+    run: &LocRun,
+    truth: Option<&[(f64, f64)]>,
+) -> String {
+    let mut main = Plot::new(
+        format!("R2 record and fit, RD {} mm", model.rd),
+        "wheel position x (mm)",
+        "force (N)",
+    )
+    .with(Series::markers("record", &record.positions, &record.force))
+    .with(Series::line(
+        "posterior-mean fit",
+        &record.positions,
+        &run.fit,
+    ));
+    let lo = record.force.iter().cloned().fold(f64::INFINITY, f64::min);
+    let xs: Vec<f64> = run.result.nodules.iter().map(|n| n.x_mm.mean).collect();
+    main = main.with(Series::markers(
+        "nodules (posterior mean x)",
+        &xs,
+        &vec![lo; xs.len()],
+    ));
+    for n in &run.result.nodules {
+        main = main.with(Series::line("", &[n.x_mm.hdi_3, n.x_mm.hdi_97], &[lo, lo]));
+    }
+    if let Some(t) = truth {
+        let tx: Vec<f64> = t.iter().map(|p| p.0).collect();
+        main = main.with(Series::markers("true x", &tx, &vec![lo; tx.len()]));
+    }
+    let mut cells = vec![Some(main)];
+    let n = run.result.nodules.len();
+    for j in 0..n {
+        let xd = run.chains.param(2 * j);
+        let dd = run.chains.param(2 * j + 1);
+        let flat_x: Vec<f64> = xd.iter().flatten().copied().collect();
+        let flat_d: Vec<f64> = dd.iter().flatten().copied().collect();
+        let stride = (flat_x.len() / 600).max(1);
+        let px: Vec<f64> = flat_x.iter().step_by(stride).copied().collect();
+        let pd: Vec<f64> = flat_d.iter().step_by(stride).copied().collect();
+        let mut p = Plot::new(
+            format!(
+                "nodule {} posterior{}",
+                j + 1,
+                if run.result.nodules[j].identifiable {
+                    ""
+                } else {
+                    " (depth NI)"
+                }
+            ),
+            "x (mm)",
+            "depth (mm)",
+        )
+        .with(Series::markers("draws", &px, &pd));
+        if let Some(t) = truth.and_then(|t| t.get(j)) {
+            p = p.with(Series::markers("truth", &[t.0], &[t.1]));
+        }
+        cells.push(Some(p));
+    }
+    grid_svg(&cells, 2, "R2 localisation")
+}

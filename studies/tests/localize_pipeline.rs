@@ -1,0 +1,166 @@
+//! The R2 localisation pipeline (studies/src/localize) on a stand-in for the
+//! FE scan, cheap enough for `cargo test`: an analytic excess
+//! E(o; d) = A(d) exp(-o^2 / 2 w(d)^2) over a flat F0 = 9 N, with
+//! A(d) = 6 ((18 - d)/12)^2 for d < 18 and 0 deeper (a nodule below 18 mm
+//! is invisible), w(d) = 3 + 0.4 d. The surrogate is palpate's one
+//! (`Surrogate::build` on this model, 10 + 3 runs), the model and sampler
+//! the ones `palpate localize` uses. The full FE accuracy and coverage are
+//! measured by `examples/localize_r2.rs` (release).
+//!
+//! * two visible nodules are found within 1 mm in x and 0.5 mm in depth,
+//!   identifiable, the truth within 4 posterior SDs;
+//! * an invisible (deep) nodule's depth is `identifiable: false` (NI),
+//!   while the visible one beside it stays identifiable;
+//! * the JSON has exactly the keys of issue 11.
+
+use palpate_core::{
+    Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+};
+use palpate_studies::localize::posterior::{localize, LocOptions};
+use palpate_studies::localize::{Baseline, LocModel, LocSetup};
+use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+const F0: f64 = 9.0;
+
+fn excess(o: f64, d: f64) -> f64 {
+    let a = 6.0 * ((18.0 - d).max(0.0) / 12.0).powi(2);
+    let w = 3.0 + 0.4 * d;
+    a * (-o * o / (2.0 * w * w)).exp()
+}
+
+struct Scan(ParamSpace);
+struct Eval;
+impl Evaluator for Eval {
+    fn predict_into(&mut self, t: &[f64], l: &Loading, o: &mut [f64]) -> Result<(), ForwardError> {
+        for (o, x) in o.iter_mut().zip(&l.drive) {
+            *o = F0 + excess(*x, t[0]);
+        }
+        Ok(())
+    }
+}
+impl ForwardModel for Scan {
+    fn name(&self) -> String {
+        "analytic nodule scan".into()
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.0
+    }
+    fn observable(&self) -> Observable {
+        Observable::ForceN
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(Eval)
+    }
+}
+
+fn model() -> LocModel {
+    let setup = LocSetup::r2(6.0);
+    let scan = Scan(ParamSpace::new(vec![ParamSpec::new(
+        "depth", "mm", 6.0, 24.0, 15.0,
+    )]));
+    let loading = Loading::quasi_static(Drive::PositionMm, setup.offsets());
+    let req = SurrogateRequest {
+        model: &scan,
+        loading: &loading,
+        bounds: ParamBox::new(scan.space(), &[6.0], &[24.0]).unwrap(),
+        options: SurrogateOptions {
+            training_runs: 16,
+            validation_runs: 4,
+            basis_tolerance: 1e-5,
+        },
+        description: "test".into(),
+    };
+    let s = Surrogate::build(&req, None).unwrap();
+    let baseline = Baseline {
+        centre: setup.centre(),
+        step: setup.step,
+        force: vec![F0; 40],
+        time_s: 0.0,
+    };
+    LocModel::from_parts(&setup, s, baseline, None, None).unwrap()
+}
+
+fn record(nodules: &[(f64, f64)], seed: u64) -> (Vec<f64>, Vec<f64>) {
+    let x: Vec<f64> = (0..=130).map(|k| 10.0 + k as f64).collect();
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let noise = Normal::new(0.0, 0.01 * F0).unwrap();
+    let y = x
+        .iter()
+        .map(|&p| {
+            F0 + nodules
+                .iter()
+                .map(|&(xn, d)| excess(p - xn, d))
+                .sum::<f64>()
+                + noise.sample(&mut rng)
+        })
+        .collect();
+    (x, y)
+}
+
+fn opts(n: usize) -> LocOptions {
+    LocOptions {
+        nodules: n,
+        seed: 3,
+        tune: 400,
+        draws: 400,
+        max_draws: 800,
+    }
+}
+
+#[test]
+fn visible_nodules_are_located_within_the_targets() {
+    let m = model();
+    assert!(m.scan.validation().max_relative_error < 2e-3);
+    let truth = [(45.0, 10.0), (100.0, 14.0)];
+    let (x, y) = record(&truth, 21);
+    let run = localize(&m, &x, &y, &opts(2), None).unwrap();
+    for (e, &(tx, td)) in run.result.nodules.iter().zip(&truth) {
+        assert!(e.identifiable, "{e:?}");
+        assert!((e.x_mm.mean - tx).abs() < 1.0, "{e:?} vs {tx}");
+        assert!((e.depth_mm.mean - td).abs() < 0.5, "{e:?} vs {td}");
+        // calibrated intervals: the truth within 4 posterior SDs (the 94 %
+        // coverage itself is counted over 50 records by the example)
+        assert!((e.x_mm.mean - tx).abs() < 4.0 * e.x_mm.sd, "{e:?}");
+        assert!((e.depth_mm.mean - td).abs() < 4.0 * e.depth_mm.sd, "{e:?}");
+    }
+    assert!(
+        (run.result.noise_sd - 0.09).abs() < 0.03,
+        "{}",
+        run.result.noise_sd
+    );
+    assert!(run.result.rhat_max < 1.2, "{}", run.result.rhat_max);
+    let json = serde_json::to_value(&run.result).unwrap();
+    let keys: Vec<&String> = json.as_object().unwrap().keys().collect();
+    assert_eq!(
+        keys,
+        [
+            "nodules",
+            "noise_sd",
+            "surrogate",
+            "rhat_max",
+            "ess_bulk_min"
+        ]
+    );
+    let n0 = &json["nodules"][0];
+    for k in ["mean", "sd", "hdi_3", "hdi_97"] {
+        assert!(n0["x_mm"][k].is_f64() && n0["depth_mm"][k].is_f64());
+    }
+    assert!(n0["identifiable"].is_boolean());
+    assert!(json["surrogate"]["fe_runs"].is_u64() && json["surrogate"]["max_rel_error"].is_f64());
+}
+
+#[test]
+fn an_invisible_deep_nodule_is_not_identifiable() {
+    let m = model();
+    let truth = [(45.0, 9.0), (100.0, 21.0)];
+    let (x, y) = record(&truth, 12);
+    let run = localize(&m, &x, &y, &opts(2), None).unwrap();
+    // labels follow x order: the invisible nodule may sit on either side
+    let n = &run.result.nodules;
+    let seen: Vec<_> = n.iter().filter(|e| e.identifiable).collect();
+    assert_eq!(seen.len(), 1, "{n:?}");
+    assert!((seen[0].x_mm.mean - 45.0).abs() < 1.0, "{n:?}");
+    assert!((seen[0].depth_mm.mean - 9.0).abs() < 0.5, "{n:?}");
+}
