@@ -33,7 +33,7 @@ integral evaluated exactly for piecewise-linear histories:
 Residuals r_i = w s_i (f_i - y_i): absolute s = 1, relative s = 1/y (y != 0),
 normalised s = 1/sqrt(sum_set y^2); w the record's weight. SSE = sum r^2.
 Solver: least_squares(method='trf', bounds as palpate-material's Law::params
-(C10 >= 0, Ogden alpha in (-20, 20), g in [0, 1], tau > 0), x_scale='jac',
+(C10 >= 0, Ogden alpha in (-50, 50) = OGDEN_ALPHA_BOUND, g in [0, 1], tau > 0), x_scale='jac',
 ftol = xtol = gtol = 1e-15) from deterministic starts; the best SSE is kept.
 
 Usage: python3 docs/validation/real_data_scipy.py
@@ -47,6 +47,7 @@ from scipy.optimize import least_squares
 HERE = os.path.dirname(os.path.abspath(__file__))
 REAL = os.path.join(HERE, "..", "..", "..", "shared", "data", "real")
 INF = np.inf
+ALPHA = 50.0  # palpate_material::OGDEN_ALPHA_BOUND
 
 
 # ---------------------------------------------------------------- reading
@@ -109,8 +110,8 @@ def law_spec(law):
         names, lo, hi = [], [], []
         for i in range(1, n + 1):
             names += [f"mu{i}", f"alpha{i}"]
-            lo += [-INF, -20]
-            hi += [INF, 20]
+            lo += [-INF, -ALPHA]
+            hi += [INF, ALPHA]
         return names, lo, hi
     raise ValueError(law)
 

@@ -36,6 +36,7 @@ DATA = os.path.join(HERE, "..", "..", "..", "shared", "data", "treloar")
 MODES = {"uniaxial": "uniaxial.csv", "equibiaxial": "biaxial.csv", "planar": "pure_shear.csv"}
 AB = [0.5, 1 / 20, 11 / 1050, 19 / 7000, 519 / 673750]
 INF = np.inf
+ALPHA = 50.0  # palpate_material::OGDEN_ALPHA_BOUND
 
 
 def read(mode):
@@ -118,7 +119,7 @@ def ogden_starts():
 
 
 LAWS["ogden3"] = (["mu1", "alpha1", "mu2", "alpha2", "mu3", "alpha3"],
-                  [-INF, -20, -INF, -20, -INF, -20], [INF, 20, INF, 20, INF, 20], ogden_starts())
+                  [-INF, -ALPHA] * 3, [INF, ALPHA] * 3, ogden_starts())
 
 
 def fit(law, modes, residual):

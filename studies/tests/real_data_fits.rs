@@ -5,8 +5,10 @@
 //! shear alone and on an axial stretch with kPa override and weights, QLV and
 //! finite-strain viscoelastic VHB records), single and joint fits, absolute
 //! and normalised residuals. Both sides run the same starting points and keep
-//! the best SSE (ours also from `calibrate`'s optimum); SSE agrees to 1e-4, parameters where our report calls the
-//! fit identifiable and no parameter sits on a bound. The product path
+//! the best SSE (ours also from `calibrate`'s optimum); SSE agrees to 1e-4,
+//! parameters where our report calls the fit identifiable and no parameter
+//! sits on a bound (Ogden exponents in plain shear by magnitude: the
+//! response is even in alpha there). The product path
 //! (`calibrate`, its own starts) is held to 1 % of the scipy SSE.
 //!
 //! `REAL_TABLE=1 cargo test -p palpate-studies --test real_data_fits -- --nocapture`
@@ -226,7 +228,20 @@ fn check(prefix: &str) {
                     .map(|(n, v)| (n.clone(), v.as_f64().unwrap()))
                     .collect(),
             );
+            // Plain simple shear: principal stretches (l, 1, 1/l), so a
+            // one-term Ogden response is even in alpha and either side may
+            // land on +alpha or -alpha with the same SSE: compare |alpha|.
+            let even_in_alpha = case["data"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .all(|d| d.as_str().unwrap().starts_with("simple_shear="));
             for ((name, got), (_, v)) in ours.iter().zip(&theirs) {
+                let (got, v) = if even_in_alpha && name.starts_with("alpha") {
+                    (&got.abs(), &v.abs())
+                } else {
+                    (got, v)
+                };
                 assert!(
                     (got - v).abs() <= 1e-3 * v.abs().max(1e-12),
                     "{id}: {name} = {got} vs scipy {v}"

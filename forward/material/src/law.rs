@@ -81,6 +81,14 @@ impl MaterialParam {
     }
 }
 
+/// Bound on every Ogden exponent: `alpha_i` in `(-OGDEN_ALPHA_BOUND, OGDEN_ALPHA_BOUND)`.
+///
+/// A box for the estimators, not a material limit. 50 leaves the one-term fits of brain tissue
+/// (optima at alpha -17.5 to -25.9, Budday et al. 2017 data, `docs/validation/real-data.md`)
+/// interior; where an exponent is not identifiable (Treloar uniaxial Ogden-3, a term with
+/// mu -> 0) the fit ends on this bound and the report says so.
+pub const OGDEN_ALPHA_BOUND: f64 = 50.0;
+
 /// Starting exponents of the Ogden terms: alternating signs of growing magnitude, so that the terms differ.
 const OGDEN_INITIAL_ALPHA: [f64; 6] = [2.0, -2.0, 4.0, -4.0, 6.0, -6.0];
 
@@ -104,7 +112,7 @@ impl Law {
     /// The parameters, in the order the evaluation functions expect them.
     ///
     /// Moduli that must be positive have lower bound 0; higher-order polynomial coefficients and
-    /// `C01` may be negative; `lambda_m` in (1, 100); Ogden `alpha_i` in (-20, 20), `mu_i` of either sign.
+    /// `C01` may be negative; `lambda_m` in (1, 100); Ogden `alpha_i` in (-[`OGDEN_ALPHA_BOUND`], [`OGDEN_ALPHA_BOUND`]) = (-50, 50), `mu_i` of either sign.
     pub fn params(&self) -> Vec<MaterialParam> {
         let inf = f64::INFINITY;
         match *self {
@@ -134,7 +142,13 @@ impl Law {
                         .unwrap_or(2.0 + i as f64);
                     [
                         MaterialParam::new(format!("mu{i}"), "MPa", -inf, inf, 2e-3 / n as f64),
-                        MaterialParam::new(format!("alpha{i}"), "1", -20.0, 20.0, alpha),
+                        MaterialParam::new(
+                            format!("alpha{i}"),
+                            "1",
+                            -OGDEN_ALPHA_BOUND,
+                            OGDEN_ALPHA_BOUND,
+                            alpha,
+                        ),
                     ]
                 })
                 .collect(),

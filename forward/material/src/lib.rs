@@ -31,5 +31,5 @@ pub mod volumetric;
 pub use error::MaterialError;
 pub use invariants::InvariantDerivs;
 pub use kinematics::{PrincipalDerivs, StressTangent};
-pub use law::{Law, MaterialParam};
+pub use law::{Law, MaterialParam, OGDEN_ALPHA_BOUND};
 pub use volumetric::Volumetric;
