@@ -82,8 +82,9 @@ fn stress_columns(
             name.as_str() == **b || (name.starts_with(**b) && name[b.len()..].starts_with('_'))
         }) {
             anyhow::bail!(
-                "{}: column `{name}`: a stress needs its unit in the name: `{b}_MPa`, `{b}_kPa` or `{b}_Pa`",
+                "{}:{}: column `{name}`: a stress needs its unit in the name: `{b}_MPa`, `{b}_kPa` or `{b}_Pa`",
                 table.file.display(),
+                table.header_line,
             );
         }
     }
@@ -155,8 +156,9 @@ fn stretch_from(table: &Table, suffix: &str, alt: &[&str]) -> anyhow::Result<(St
     }
     let Some(first) = found.first().cloned() else {
         anyhow::bail!(
-            "{}: no deformation column: expected `stretch{suffix}`, `strain{suffix}` or `true_strain{suffix}`{} (header has: {})",
+            "{}:{}: no deformation column: expected `stretch{suffix}`, `strain{suffix}` or `true_strain{suffix}`{} (header has: {})",
             table.file.display(),
+            table.header_line,
             if alt.is_empty() { String::new() } else { format!(" or `{}`", alt.join("`, `")) },
             table.names.join(",")
         );
@@ -199,8 +201,9 @@ fn nominal_stress(
     }
     let Some(first) = found.first().cloned() else {
         anyhow::bail!(
-            "{}: no stress column: expected {expected} (header has: {})",
+            "{}:{}: no stress column: expected {expected} (header has: {})",
             table.file.display(),
+            table.header_line,
             table.names.join(",")
         );
     };
@@ -219,8 +222,9 @@ fn nominal_stress(
 fn refuse(table: &Table, names: &[&str], why: &str) -> anyhow::Result<()> {
     if let Some(n) = table.names.iter().find(|n| names.contains(&n.as_str())) {
         anyhow::bail!(
-            "{}: column `{n}`: {why} (header has: {})",
+            "{}:{}: column `{n}`: {why} (header has: {})",
             table.file.display(),
+            table.header_line,
             table.names.join(",")
         );
     }
@@ -259,8 +263,9 @@ pub fn read(
                 .find(|c| table.has(c))
                 .ok_or_else(|| {
                     anyhow::anyhow!(
-                        "{}: no deformation column: a simple-shear file needs `amount_of_shear` (or `shear_strain`) (header has: {})",
+                        "{}:{}: no deformation column: a simple-shear file needs `amount_of_shear` (or `shear_strain`) (header has: {})",
                         table.file.display(),
+                        table.header_line,
                         table.names.join(",")
                     )
                 })?;

@@ -220,6 +220,72 @@ fn viscoelastic_uniaxial_records_recover_prony_terms() {
     }
 }
 
+/// One load-unload cycle to stretch `s` at the nominal strain rate `rate`
+/// (1/s), as the VHB records: up and straight back down.
+fn cycle(s: f64, rate: f64) -> (Vec<f64>, Vec<f64>) {
+    let half = (s - 1.0) / rate;
+    let (mut t, mut d) = (Vec::new(), Vec::new());
+    for k in 0..=80 {
+        let u = k as f64 / 40.0;
+        t.push(half * u);
+        d.push(1.0 + (s - 1.0) * if u <= 1.0 { u } else { 2.0 - u });
+    }
+    (t, d)
+}
+
+#[test]
+fn viscoelastic_load_unload_cycles_at_several_rates_recover_prony_terms() {
+    let dir = tempfile::tempdir().unwrap();
+    // Yeoh with two Prony terms whose times (1 s, 30 s) bracket the cycle
+    // times (10 s to 200 s): the three rates separate them.
+    let law = Law::ReducedPolynomial(2);
+    let theta = [0.04, 0.002, 0.5, 1.0, 0.2, 30.0];
+    for viscous in [Viscous::Qlv(2), Viscous::Finite(2)] {
+        let model: Box<dyn ForwardModel> = match viscous {
+            Viscous::Qlv(n) => Box::new(Viscoelastic::new(
+                Box::new(Homogeneous::new(law, Mode::Uniaxial)),
+                n,
+            )),
+            Viscous::Finite(n) => Box::new(ViscousUniaxial::new(law, n).unwrap()),
+        };
+        let mut specs = Vec::new();
+        for rate in [0.01, 0.05, 0.2] {
+            let (t, d) = cycle(2.0, rate);
+            let y = model
+                .predict(
+                    &theta,
+                    &Loading::timed(Drive::Stretch, t.clone(), d.clone()),
+                )
+                .unwrap();
+            // Hysteresis: the unloading branch lies below the loading one.
+            assert!(
+                y[30] > y[50] + 1e-3,
+                "{viscous:?} rate {rate}: no hysteresis"
+            );
+            let mut text = String::from("time_s,stretch,stress_kPa\n");
+            for k in 0..t.len() {
+                text += &format!("{},{},{}\n", t[k], d[k], y[k] * 1e3);
+            }
+            let f = write(dir.path(), &format!("c{rate}.csv"), &text);
+            specs.push(format!("uniaxial={}", f.display()));
+        }
+        let data = read_data(&specs, None).unwrap();
+        let c = fit(law, &data, Some(viscous));
+        assert_params(&c, &[("C10", 0.04), ("C20", 0.002)], 1e-4);
+        // The terms may come out in either order: compared sorted by tau.
+        let v = |n: &str| c.params.get(n).unwrap().value;
+        let mut terms = [(v("tau1_s"), v("g1")), (v("tau2_s"), v("g2"))];
+        terms.sort_by(|a, b| a.0.total_cmp(&b.0));
+        for ((tau, g), (tau0, g0)) in terms.iter().zip([(1.0, 0.5), (30.0, 0.2)]) {
+            assert!(
+                (tau - tau0).abs() <= 1e-4 * tau0 && (g - g0).abs() <= 1e-4 * g0,
+                "{viscous:?}: (tau, g) = ({tau}, {g}), expected ({tau0}, {g0}); R2 {}",
+                c.r2
+            );
+        }
+    }
+}
+
 #[test]
 fn weights_pull_a_joint_fit_towards_the_heavier_record() {
     let dir = tempfile::tempdir().unwrap();
@@ -278,7 +344,7 @@ fn bad_files_name_file_line_and_column() {
     );
     let e = error(&format!("simple_shear={}", f.display()));
     assert!(
-        e.contains("sh.csv") && e.contains("`stretch`") && e.contains("axial_stretch"),
+        e.contains("sh.csv:1:") && e.contains("`stretch`") && e.contains("axial_stretch"),
         "{e}"
     );
     // A shear file given as uniaxial.
@@ -288,7 +354,10 @@ fn bad_files_name_file_line_and_column() {
         "amount_of_shear,shear_stress_MPa\n0,0\n0.1,1\n",
     );
     let e = error(&format!("uniaxial={}", f.display()));
-    assert!(e.contains("sh2.csv") && e.contains("simple_shear"), "{e}");
+    assert!(
+        e.contains("sh2.csv:1:") && e.contains("`amount_of_shear`") && e.contains("simple_shear"),
+        "{e}"
+    );
     // Inconsistent units: stress_MPa and stress_kPa that disagree (same numbers).
     let f = write(
         d,
@@ -305,10 +374,11 @@ fn bad_files_name_file_line_and_column() {
     let e = error(&format!("uniaxial={}", f.display()));
     assert!(e.contains("s.csv:3") && e.contains("`strain`"), "{e}");
     // ... a stress with no unit.
-    let f = write(d, "n.csv", "stretch,stress\n1,0\n1.1,0.2\n");
+    // (after two comment lines: the header is line 3)
+    let f = write(d, "n.csv", "# a\n# b\nstretch,stress\n1,0\n1.1,0.2\n");
     let e = error(&format!("uniaxial={}", f.display()));
     assert!(
-        e.contains("n.csv") && e.contains("`stress`") && e.contains("stress_MPa"),
+        e.contains("n.csv:3:") && e.contains("`stress`") && e.contains("stress_MPa"),
         "{e}"
     );
     // An axial stretch on a uniaxial record, a bad option, a bad weight.
@@ -326,5 +396,5 @@ fn bad_files_name_file_line_and_column() {
         "lambda1,lambda2,stress1_MPa\n1,1,0\n1.1,1,0.2\n",
     );
     let e = error(&format!("biaxial={}", f.display()));
-    assert!(e.contains("g.csv") && e.contains("stress2_MPa"), "{e}");
+    assert!(e.contains("g.csv:1:") && e.contains("stress2_MPa"), "{e}");
 }

@@ -89,6 +89,9 @@ pub enum DataError {
 pub struct Table {
     pub file: PathBuf,
     pub names: Vec<String>,
+    /// Source line (1-based, counting comments) of the header, for messages
+    /// about a column as a whole.
+    pub header_line: usize,
     pub columns: Vec<Vec<f64>>,
     pub lines: Vec<usize>,
     /// Comment lines (without the leading `#`), e.g. provenance.
@@ -104,6 +107,8 @@ pub struct Table {
 pub struct TextTable {
     pub file: PathBuf,
     pub names: Vec<String>,
+    /// Source line (1-based, counting comments) of the header.
+    pub header_line: usize,
     /// `rows[i][k]`: row i, column k.
     pub rows: Vec<Vec<String>>,
     /// Source line (1-based, counting comments) of each row.
@@ -137,6 +142,7 @@ impl TextTable {
             text
         };
         let mut names: Option<Vec<String>> = None;
+        let mut header_line = 0;
         let (mut rows, mut lines, mut comments) = (Vec::new(), Vec::new(), Vec::new());
         for (i, raw) in text.lines().enumerate() {
             let line = i + 1;
@@ -161,6 +167,7 @@ impl TextTable {
                         }
                     }
                     names = Some(fields);
+                    header_line = line;
                 }
                 Some(n) => {
                     if fields.len() != n.len() {
@@ -183,6 +190,7 @@ impl TextTable {
         Ok(TextTable {
             file,
             names,
+            header_line,
             rows,
             lines,
             comments,
@@ -247,6 +255,7 @@ impl Table {
         Ok(Table {
             file: raw.file,
             names: raw.names,
+            header_line: raw.header_line,
             columns,
             lines: raw.lines,
             comments: raw.comments,
