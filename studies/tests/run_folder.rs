@@ -1,10 +1,10 @@
 //! The run folder of `palpate run` under interruption and contention, with
-//! the built binary: a study killed (SIGINT or SIGKILL) at several points
-//! and run again gives a byte-identical results.json and no stray file; a
-//! killed rerun over a complete folder leaves that folder as it was; a
-//! smaller study into the same folder removes the larger one's files; a
-//! second concurrent run is refused with the first one's pid; files get
-//! the user's umask.
+//! the built binary: a study killed (SIGINT or SIGKILL) at several progress
+//! points, or at seeded random instants (`KILL_SEEDS`), and run again gives
+//! a byte-identical results.json and no stray file; a killed rerun over a
+//! complete folder leaves that folder as it was; a smaller study into the
+//! same folder removes the larger one's files; a second concurrent run is
+//! refused with the first one's pid; files get the user's umask.
 
 use std::collections::BTreeMap;
 use std::io::{BufRead, BufReader};
@@ -203,6 +203,125 @@ fn a_study_killed_at_several_points_resumes_to_the_same_results() {
     assert!(
         interrupted >= 5,
         "only {interrupted} of 8 kills interrupted the run"
+    );
+}
+
+/// SplitMix64 (Steele, Lea & Flood 2014): uniform numbers in [0, 1) from a
+/// seed, so that a failing kill instant can be replayed with `KILL_SEEDS`.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^= z >> 31;
+        (z >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The seeds of the random kills: `KILL_SEEDS=1,2,3` (a failure prints its
+/// seed), default four seeds. More seeds run longer; the CI runs the default.
+fn kill_seeds() -> Vec<u64> {
+    match std::env::var("KILL_SEEDS") {
+        Ok(s) => s
+            .split(',')
+            .map(|v| {
+                v.trim()
+                    .parse()
+                    .expect("KILL_SEEDS: comma-separated integers")
+            })
+            .collect(),
+        Err(_) => vec![11, 12, 13, 14],
+    }
+}
+
+#[test]
+fn a_study_killed_at_random_instants_resumes_to_the_same_results() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = study(
+        dir.path(),
+        "s.toml",
+        &["nh", "yeoh"],
+        &["absolute", "relative"],
+    );
+    let reference = dir.path().join("reference");
+    let t0 = std::time::Instant::now();
+    ok(&run(&m, &reference));
+    // The instants are drawn over 1.2 x the time of an uncached run (the
+    // load of the machine changes it; the seed fixes the fractions).
+    let span = t0.elapsed().as_secs_f64() * 1.2;
+    let want = std::fs::read(reference.join("results.json")).unwrap();
+    let mut interrupted = 0;
+    let mut kills = 0;
+    for seed in kill_seeds() {
+        let mut rng = SplitMix(seed);
+        let out = dir.path().join(format!("seed-{seed}"));
+        // Up to three runs into one folder, each killed at a random instant
+        // with SIGINT or SIGKILL (a resumed run killed again), then one run
+        // to the end.
+        for k in 0..3 {
+            let sig = if rng.next() < 0.5 { "INT" } else { "KILL" };
+            let at = span * rng.next();
+            let what = format!("seed {seed}, kill {k}: SIG{sig} at {at:.3} s");
+            let mut child = palpate()
+                .arg("run")
+                .arg(&m)
+                .arg("--out")
+                .arg(&out)
+                .stdout(Stdio::null())
+                .stderr(Stdio::null())
+                .spawn()
+                .unwrap();
+            std::thread::sleep(std::time::Duration::from_secs_f64(at));
+            kills += 1;
+            if child.try_wait().unwrap().is_none() {
+                signal(&mut child, sig);
+                interrupted += 1;
+            }
+            // Whatever the instant: a results.json is this study's, byte for
+            // byte (files are renamed into place, never written there), and
+            // a folder that says it is complete (its record of files, no
+            // INCOMPLETE: the swap marks it first) holds exactly the
+            // complete run's files.
+            if out.join("results.json").exists() {
+                assert!(
+                    std::fs::read(out.join("results.json")).unwrap() == want,
+                    "{what}: results.json differs"
+                );
+            }
+            if out.join(".palpate/files.json").exists() && !out.join("INCOMPLETE").exists() {
+                let visible = |d: &Path| -> Vec<String> {
+                    files(d)
+                        .into_keys()
+                        .filter(|f| !f.starts_with(".palpate/"))
+                        .collect()
+                };
+                assert_eq!(
+                    visible(&out),
+                    visible(&reference),
+                    "{what}: a folder marked complete holds other files"
+                );
+            }
+        }
+        let again = run(&m, &out);
+        assert!(
+            again.status.success(),
+            "seed {seed}: the resumed run failed: {}",
+            String::from_utf8_lossy(&again.stderr)
+        );
+        assert!(
+            std::fs::read(out.join("results.json")).unwrap() == want,
+            "seed {seed}: results.json differs after the kills and a rerun"
+        );
+        no_stray_files(&out, &reference);
+    }
+    eprintln!("{interrupted} of {kills} kills interrupted a run (span {span:.2} s)");
+    // Most kills must land inside a run (else the test proves little).
+    assert!(
+        2 * interrupted >= kills,
+        "only {interrupted} of {kills} kills interrupted a run"
     );
 }
 
