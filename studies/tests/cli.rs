@@ -439,3 +439,50 @@ fn sample_reports_progress_when_stderr_is_not_a_terminal() {
     assert!(lines.len() >= 3, "progress lines: {lines:?}");
     assert!(lines.iter().any(|l| l.contains("/800 (")), "{lines:?}");
 }
+
+/// `palpate CMD --help` shows the subcommand's own description, not only a
+/// one-line summary (a `///` comment on a `Command` variant would replace
+/// the `Args` doc comment: clap), and the summary is the line of `palpate
+/// --help`.
+#[test]
+fn every_subcommands_help_explains_itself() {
+    let top = String::from_utf8_lossy(&palpate(&["--help"]).stdout).to_string();
+    for (cmd, needle) in [
+        (vec!["calibrate"], "Homogeneous tests"),
+        (vec!["simulate"], "Richardson"),
+        (vec!["sample"], "R-hat"),
+        (vec!["anova"], "Bartlett"),
+        (vec!["doe"], "design.csv"),
+        (vec!["diagnose"], "candidates"),
+        (vec!["run"], "INCOMPLETE"),
+        (vec!["surrogate"], "query"),
+        (vec!["surrogate", "build"], "held-out"),
+        (vec!["surrogate", "query"], "depth-max"),
+        (vec!["localize"], "credible intervals"),
+    ] {
+        let mut args = cmd.clone();
+        args.push("--help");
+        let o = palpate(&args);
+        let help = String::from_utf8_lossy(&o.stdout).to_string();
+        assert!(o.status.success(), "{cmd:?}: {}", stderr(&o));
+        assert!(
+            help.contains(needle),
+            "{cmd:?} --help lacks `{needle}`:\n{help}"
+        );
+        // Summary, blank line, then a description before the usage line.
+        let lines: Vec<&str> = help.lines().collect();
+        assert!(
+            lines.len() > 3 && lines[1].is_empty() && !lines[2].starts_with("Usage:"),
+            "{cmd:?} --help has no description:\n{help}"
+        );
+        if cmd.len() == 1 {
+            assert!(
+                top.lines()
+                    .any(|l| l.trim_start().starts_with(cmd[0]) && l.contains(lines[0])),
+                "`palpate --help` does not list {} with `{}`",
+                cmd[0],
+                lines[0]
+            );
+        }
+    }
+}

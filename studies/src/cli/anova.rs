@@ -10,7 +10,7 @@ use palpate_uq::stats::blom_scores;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-/// ANOVA of a designed experiment.
+/// ANOVA of a table with one row per run (factor columns hold level names)
 ///
 /// The table has one row per run; factor columns hold level names (text),
 /// the response column numbers. Prints the ANOVA table (sequential SS, equal

@@ -11,7 +11,7 @@ use palpate_material::Law;
 use std::path::Path;
 use std::path::PathBuf;
 
-/// Fit a hyperelastic law to measured data.
+/// Fit a hyperelastic law to homogeneous-test data or to a C1 force record
 ///
 /// Homogeneous tests: `--data TEST=FILE` with TEST one of
 ///   uniaxial       stretch (or strain, true_strain), stress_MPa; tension and compression

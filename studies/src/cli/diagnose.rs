@@ -12,7 +12,7 @@ use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
 use std::path::{Path, PathBuf};
 
-/// Diagnose the sim-to-real gap of a record: where the misfit lies, which effect causes it, how far it shrinks.
+/// Diagnose the sim-to-real gap of a record: where the misfit lies, which effect causes it, how far it shrinks
 ///
 /// The base model is calibrated to the record; the misfit is located on the
 /// experiment's axis (time, or the drive for untimed records) against the

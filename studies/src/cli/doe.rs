@@ -45,7 +45,7 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-/// Generate (and run) a designed experiment from a TOML manifest.
+/// Generate and run a designed experiment (factorial design) from a TOML manifest
 ///
 /// Writes design.csv (run order, standard order, replicate, levels and the
 /// response), design.json (with defining relation, resolution and aliases)

@@ -14,8 +14,19 @@ use crate::output::{check_outputs, given, write_atomic, write_json};
 use crate::plot::{grid_svg, Plot, Series};
 use crate::surrogate::default_cache_dir;
 
-/// Locate nodules (position x and depth, with 94 % credible intervals) from an R2 rolled force record, by MCMC on a cached FE surrogate.
+/// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record
+///
+/// The force along the rolled pass is modelled as s [F0(x) + sum over the
+/// nodules of E(|x - x_n|; d_n)], with E from a surrogate of the FE model
+/// (one FE scan per training depth, trained once per --rd and cached), the
+/// tissue-modulus scale s free and the noise inferred; the posterior of each
+/// nodule's position and depth is sampled by MCMC and reported with 94 %
+/// credible intervals. The surrogate's held-out error is printed and added
+/// to the likelihood.
+///
+/// Example: palpate localize --benchmark R2 --rd 6 --data r2.csv --nodules 3 --json loc.json --plot loc.svg
 #[derive(Debug, Parser)]
+#[command(verbatim_doc_comment)]
 pub struct Args {
     /// The benchmark (R2: the rolled block of BENCHMARKS.md).
     #[arg(long, value_parser = ["R2", "r2"])]

@@ -29,25 +29,30 @@ pub struct Cli {
 }
 
 /// The subcommands.
+///
+/// Each subcommand's help is its `Args` doc comment: the first paragraph is
+/// the line of `palpate --help`, the rest the long help of `palpate CMD
+/// --help`. A `///` comment on a variant here would replace both (clap), so
+/// the variants carry plain comments.
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Fit a hyperelastic law to homogeneous-test data or to a C1 force record.
+    // Fit a law to homogeneous tests or a C1 record (calibrate::Args).
     Calibrate(calibrate::Args),
-    /// Run a finite-element forward model (N1 needle, C1 compression) and write its force curve.
+    // The FE forward models N1, N3, C1, Q1, R2 (simulate::Args).
     Simulate(simulate::Args),
-    /// Sample the Bayesian posterior of a model's parameters by MCMC, with diagnostics.
+    // MCMC posterior of a law's parameters (sample::Args).
     Sample(sample::Args),
-    /// ANOVA of a table with one row per run (factor columns hold level names).
+    // ANOVA of a runs table (anova::Args).
     Anova(anova::Args),
-    /// Generate and run a designed experiment (factorial design) from a manifest.
+    // Designed experiments from a manifest (doe::Args).
     Doe(doe::Args),
-    // The help of `diagnose` is its Args' doc comment (the candidates per test kind).
+    // Sim-to-real gap diagnosis (diagnose::Args).
     Diagnose(diagnose::Args),
-    /// Run a whole study described by one TOML manifest into a run folder.
+    // A whole study from one manifest (run::Args).
     Run(run::Args),
-    /// Build (from FE runs) or query the real-time force surrogate of Q1 or N1.
+    // The real-time force surrogate (surrogate::Args).
     Surrogate(surrogate::Args),
-    /// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record.
+    // Nodule localisation from an R2 record (localize::Args).
     Localize(localize::Args),
 }
 

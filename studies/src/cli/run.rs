@@ -3,7 +3,7 @@
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
-/// Run a study described by one TOML manifest.
+/// Run a whole study described by one TOML manifest into a run folder
 ///
 /// Writes into the run folder (default runs/<study name>): results.json
 /// (byte-identical when the same manifest is run again), report.md, plots/*.svg

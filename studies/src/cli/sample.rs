@@ -20,7 +20,7 @@ use palpate_uq::mcmc::{
 use serde_json::{json, Map, Value};
 use std::path::{Path, PathBuf};
 
-/// Sample the posterior of a hyperelastic law's parameters given data.
+/// Sample the Bayesian posterior of a law's parameters by MCMC, with diagnostics
 ///
 /// Data as for `palpate calibrate`: `--data TEST=FILE` for homogeneous tests
 /// (TEST = uniaxial, biaxial, planar; columns stretch,stress_MPa) or

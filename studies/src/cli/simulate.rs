@@ -1,7 +1,7 @@
 //! `palpate simulate`: run a finite-element forward model (N1 needle
-//! indentation, C1 compression or Q1 flat-punch ramp-and-hold, BENCHMARKS.md) and write its force curve,
-//! indentation, N3 needle indentation in 3D, or C1 compression, BENCHMARKS.md) and write its force curve,
-//! with the volumetric treatment used and, unless `--error-estimate off`, an
+//! indentation, N3 needle indentation in 3D, C1 compression, Q1 flat-punch
+//! ramp-and-hold or R2 rolling over nodules, BENCHMARKS.md) and write its
+//! force curve, with the volumetric treatment used and, unless `--error-estimate off`, an
 //! estimate of its discretisation error from one coarser solve (Richardson
 //! extrapolation with the model's documented order of convergence,
 //! `palpate_fe::discretisation`), printed and written as `#` lines and an
@@ -21,9 +21,29 @@ use crate::models::{C1FeSpec, Model, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Sp
 use crate::output::write_atomic;
 use crate::plot::{Plot, Series};
 
-/// Options of `palpate simulate`.
+/// Run a finite-element forward model (N1, N3, C1, Q1, R2 of BENCHMARKS.md) and write its force curve
+///
+/// The benchmark's geometry, boundary conditions and loading are those of
+/// BENCHMARKS.md; the material is --law with one --param per parameter
+/// (MPa), optionally viscoelastic (--prony, with --ramp and --hold). The
+/// force curve is printed and written with --csv (and --plot, --vtu).
+///
+/// Unless --error-estimate off, the model is solved once more on a coarser
+/// mesh and the discretisation error is estimated by Richardson
+/// extrapolation with the model's documented order of convergence (--order
+/// to change it); the estimate is printed and written as `#` lines and an
+/// error_estimate_N column of the CSV.
+///
+/// Every option is checked before solving: options of another benchmark are
+/// refused by name, and sizes (--depth / --step, --mesh) are checked against
+/// what the machine can hold.
+///
+/// Examples:
+///   palpate simulate --benchmark C1 --law neo-hookean --param C10=0.0011 --csv c1.csv
+///   palpate simulate --benchmark N1 --law yeoh --param C10=0.001 --param C20=0 --param C30=0 --mesh medium --plot n1.svg
+///   palpate simulate --benchmark R2 --rd 6 --nodules 75:15 --csv r2.csv
 #[derive(Debug, clap::Args)]
-#[command(allow_negative_numbers = true)]
+#[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), N3 (the same needle into a 70 x 80 x 80 mm block, 3D quarter model), C1 (compression of a 38 x 9 mm cylinder), Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm) or R2 (a wheel of diameter 8 mm pressed to --rd at x = 10 mm and rolled to x = 140 mm over a 150 x 30 mm block, 50 mm thick, with bonded nodules of diameter 10 mm; plane stress).
     #[arg(long, value_parser = ["N1", "N3", "C1", "Q1", "R2", "n1", "n3", "c1", "q1", "r2"])]

@@ -14,22 +14,42 @@ use palpate_uq::surrogate::realtime::{RealTimeRequest, RealTimeSurrogate};
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
-/// Build or query a real-time force surrogate.
+/// Build (from FE runs) or query the real-time force surrogate of Q1 or N1
+///
+/// `build` runs the FE model of the benchmark (an elastic ramp to
+/// --depth-max for the force curve, plus random held-out histories of ramps,
+/// holds and unloadings for its error table) for one material (--law,
+/// --param, --prony) and stores the surrogate as JSON; `query` answers any
+/// depth history, sample by sample, in well under a microsecond per sample.
+/// The surrogate is valid only for that material, benchmark and depth range.
+///
+/// Examples:
+///   palpate surrogate build --benchmark Q1 --law neo-hookean --param C10=0.0016 --prony g1=0.3,tau1=0.5 --depth-max 1 --out q1-rt.json
+///   palpate surrogate query --surrogate q1-rt.json --csv depths.csv --out forces.csv
 #[derive(Debug, clap::Args)]
+#[command(verbatim_doc_comment)]
 pub struct Args {
     #[command(subcommand)]
     pub command: Sub,
 }
 
-/// The surrogate subcommands.
+/// The surrogate subcommands (their help is their `Args` doc comment).
 #[derive(Debug, clap::Subcommand)]
 pub enum Sub {
-    /// Build from FE runs and store it.
+    // Build from FE runs and store it (BuildArgs).
     Build(BuildArgs),
-    /// Answer a CSV of time_s,displacement_mm sample by sample.
+    // Answer a depth history (QueryArgs).
     Query(QueryArgs),
 }
 
+/// Build the surrogate from FE runs and store it
+///
+/// Runs the benchmark's FE model for the material given (--law, --param,
+/// --prony): one elastic ramp to --depth-max, then --holdout random
+/// histories of --segments ramps, holds and unloadings, whose FE forces are
+/// compared with the surrogate's in a printed error table (max and RMS as a
+/// percentage of the peak force).
+///
 /// Example: palpate surrogate build --benchmark Q1 --law neo-hookean --param C10=0.0016
 ///   --prony g1=0.3,tau1=0.5,g2=0.2,tau2=10 --depth-max 1 --out q1-rt.json
 #[derive(Debug, clap::Args)]
@@ -38,6 +58,7 @@ pub struct BuildArgs {
     /// Q1 (flat punch) or N1 (needle, friction 0.8).
     #[arg(long)]
     pub benchmark: String,
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
     #[arg(long)]
     pub law: String,
     /// A law parameter, e.g. --param C10=0.0016 (MPa); repeat for each.
@@ -63,10 +84,16 @@ pub struct BuildArgs {
     pub out: PathBuf,
 }
 
+/// Answer a depth history (CSV time_s,displacement_mm) sample by sample
+///
+/// Writes time_s,displacement_mm,force_N; a depth beyond the surrogate's
+/// --depth-max is refused, naming its row (it does not extrapolate).
+///
 /// Example: palpate surrogate query --surrogate q1-rt.json --csv depths.csv --out forces.csv
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment)]
 pub struct QueryArgs {
+    /// The surrogate written by `palpate surrogate build`.
     #[arg(long, value_name = "FILE.json")]
     pub surrogate: PathBuf,
     /// Columns time_s,displacement_mm (header line; # comments).
