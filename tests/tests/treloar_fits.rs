@@ -221,7 +221,7 @@ fn arruda_boyce_matches_scipy() {
 }
 
 #[test]
-fn ogden3_matches_scipy_with_one_exponent_on_its_bound_and_is_not_identifiable_otherwise() {
+fn ogden3_matches_scipy_with_one_exponent_on_its_bound_and_is_not_identifiable_on_uniaxial_data() {
     check("ogden3");
     let reference = reference();
     let case = |residual: &str| {
@@ -234,10 +234,13 @@ fn ogden3_matches_scipy_with_one_exponent_on_its_bound_and_is_not_identifiable_o
             .clone()
     };
     // Absolute residuals: the optimum has one exponent on its upper bound
-    // (OGDEN_ALPHA_BOUND, with its mu -> 0: not identifiable, any bound is a
-    // regularisation), reported as such; with it there, the other five are
-    // identifiable (checked against scipy by `check`).
-    let r = best_fit(&case("absolute"));
+    // (OGDEN_ALPHA_BOUND, with its mu -> 0: any bound is a regularisation
+    // there), reported as such. At the bound 50 a second term vanishes too
+    // (mu ~ 2e-4, |corr(mu, alpha)| > 0.999), so the fit is reported not
+    // identifiable (at the old bound 20 the other five were); the dominant
+    // term still matches scipy's.
+    let c = case("absolute");
+    let r = best_fit(&c);
     let on_bound: Vec<_> = r
         .parameters
         .iter()
@@ -246,7 +249,34 @@ fn ogden3_matches_scipy_with_one_exponent_on_its_bound_and_is_not_identifiable_o
     assert_eq!(on_bound.len(), 1, "{:?}", r.parameters);
     assert_eq!(on_bound[0].value, OGDEN_ALPHA_BOUND);
     assert_eq!(on_bound[0].at_bound, Some(BoundSide::Upper));
-    assert!(r.identifiability.identifiable, "{:?}", r.identifiability);
+    assert!(!r.identifiability.identifiable, "{:?}", r.identifiability);
+    let dominant = |p: Vec<(String, f64)>| {
+        let p = canonical(p);
+        let v = |n: String| p.iter().find(|(m, _)| *m == n).unwrap().1;
+        (1..=3)
+            .map(|i| (v(format!("mu{i}")), v(format!("alpha{i}"))))
+            .max_by(|a, b| a.0.total_cmp(&b.0))
+            .unwrap()
+    };
+    let ours = dominant(
+        r.parameters
+            .iter()
+            .map(|p| (p.name.clone(), p.value))
+            .collect(),
+    );
+    let theirs = dominant(
+        c["params"]
+            .as_object()
+            .unwrap()
+            .iter()
+            .map(|(n, v)| (n.clone(), v.as_f64().unwrap()))
+            .collect(),
+    );
+    assert!(
+        (ours.0 - theirs.0).abs() <= 1e-4 * theirs.0
+            && (ours.1 - theirs.1).abs() <= 1e-4 * theirs.1.abs(),
+        "dominant term {ours:?} vs scipy {theirs:?}"
+    );
     // Relative residuals: an interior optimum with a vanishing term
     // (mu2 ~ 2e-9), reported not identifiable.
     let r = best_fit(&case("relative"));
