@@ -19,7 +19,7 @@ use crate::provenance::{crate_versions, git_state, hash_file, Provenance};
 use crate::report::{fit_plot, gap_svg};
 use crate::run_folder::RunFolder;
 use anyhow::Context;
-use palpate_inverse::ResidualKind;
+use palpate_inverse::{BoundSide, ResidualKind};
 use palpate_material::Law;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -432,9 +432,26 @@ fn fit_row(f: &FitEntry) -> String {
     let params: Vec<String> = c
         .params
         .iter()
-        .map(|(n, p)| match p.standard_error {
-            Some(se) if c.identifiable => format!("{n} = {:.5e} ± {:.2e}", p.value, se),
-            _ => format!("{n} = {:.5e}", p.value),
+        .map(|(n, p)| {
+            // A parameter the fit left on a bound of its range (e.g. an Ogden
+            // exponent on ±OGDEN_ALPHA_BOUND) is said to be there.
+            let bound = c
+                .fit
+                .parameters
+                .iter()
+                .find(|q| &q.name == n)
+                .and_then(|q| q.at_bound)
+                .map(|side| match side {
+                    BoundSide::Lower => " (on its lower bound)".to_string(),
+                    BoundSide::Upper => " (on its upper bound)".to_string(),
+                })
+                .unwrap_or_default();
+            match p.standard_error {
+                Some(se) if c.identifiable => {
+                    format!("{n} = {:.5e} ± {:.2e}{bound}", p.value, se)
+                }
+                _ => format!("{n} = {:.5e}{bound}", p.value),
+            }
         })
         .collect();
     let d = &c.drucker;

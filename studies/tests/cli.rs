@@ -486,3 +486,40 @@ fn every_subcommands_help_explains_itself() {
         }
     }
 }
+
+/// A parameter the fit leaves on a bound of its range is said to be there
+/// in report.md (brain cortex compression/tension, Ogden-2: the second term
+/// is not needed, its exponent ends on +OGDEN_ALPHA_BOUND with mu ~ 1e-5 MPa,
+/// docs/validation/real-data.md).
+#[test]
+fn the_report_says_when_a_parameter_ends_on_its_bound() {
+    let dir = tempfile::tempdir().unwrap();
+    let manifest = dir.path().join("s.toml");
+    std::fs::write(
+        &manifest,
+        format!(
+            "[study]\nname = \"bound\"\nseed = 1\n\n\
+             [data.uniaxial]\nfile = \"{}\"\ntest = \"uniaxial\"\n\n\
+             [models.ogden2]\nlaw = \"ogden:2\"\n\n\
+             [[steps]]\n[steps.calibrate]\nname = \"fit\"\nmodels = [\"ogden2\"]\n\
+             fits = {{ uniaxial = [\"uniaxial\"] }}\nresiduals = [\"absolute\"]\n",
+            Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("../../shared/data/real/brain_budday2017/cortex_compression_tension.csv")
+                .display()
+        ),
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let o = palpate(&[
+        "run",
+        manifest.to_str().unwrap(),
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("= 5.00000e1 (on its upper bound)"),
+        "{report}"
+    );
+}
