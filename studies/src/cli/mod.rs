@@ -8,6 +8,7 @@ pub mod calibrate;
 pub mod diagnose;
 pub mod doe;
 pub mod localize;
+pub mod merge;
 pub mod run;
 pub mod sample;
 pub mod sample_fe;
@@ -45,6 +46,8 @@ pub enum Command {
     Diagnose(diagnose::Args),
     /// Run a whole study described by one TOML manifest into a run folder.
     Run(run::Args),
+    /// Assemble a study's results from its shards (palpate run --shard I/N).
+    Merge(merge::Args),
     /// Build (from FE runs) or query the real-time force surrogate of Q1 or N1.
     Surrogate(surrogate::Args),
     /// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record.
@@ -91,6 +94,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Doe(a) => doe::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Run(a) => run::run(a),
+        Command::Merge(a) => merge::run(a),
         Command::Surrogate(a) => surrogate::run(a),
         Command::Localize(a) => localize::run(a),
     }
