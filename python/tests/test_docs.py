@@ -67,7 +67,7 @@ def test_errors_carry_the_message_of_the_command_line(tmp_path):
     with pytest.raises(palpate.PalpateError) as e:
         palpate.calibrate("yeoh", {"uniaxial": bad})
     said = str(e.value)
-    assert "u.csv" in said and "line 3" in said, said
+    assert "u.csv:3: column `stress_MPa`: `abc` is not a number" in said, said
     exe = binary()
     if exe is None:
         pytest.skip("no target/*/palpate to compare the message with")
