@@ -121,3 +121,15 @@ def test_numpy_records_read_as_the_files_do(tmp_path):
     c = palpate.calibrate("mooney-rivlin", {"uniaxial": {"stretch": x, "stress_MPa": y}})
     assert a["param_values"] == b["param_values"] == c["param_values"]
 
+
+
+def test_sample_returns_inference_data_with_the_same_draws():
+    az = pytest.importorskip("arviz")
+    path = ROOT / "studies/data/treloar/uniaxial.csv"
+    kw = dict(sampler="nuts", draws=100, max_draws=100, tune=100, seed=3)
+    plain = palpate.sample("neo-hookean", {"uniaxial": path}, arviz=False, **kw)
+    idata = palpate.sample("neo-hookean", {"uniaxial": path}, **kw)
+    c10 = idata.posterior["C10"].values
+    assert c10.shape == (4, 100)
+    assert np.array_equal(c10, plain["draws"]["C10"])
+    assert "C10" in str(az.summary(idata))

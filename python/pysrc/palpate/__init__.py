@@ -225,7 +225,10 @@ def sample(law: str, data: Any, *, benchmark: str | None = None, seed: int = 0, 
             if arviz:
                 raise
         else:
-            idata = az.from_dict(posterior=draws)
+            try:
+                idata = az.from_dict(posterior=draws)  # arviz < 1: InferenceData
+            except TypeError:
+                idata = az.from_dict({"posterior": draws})  # arviz >= 1: an xarray DataTree
             idata.posterior.attrs["palpate_summary"] = json.dumps(summary)
             return idata
     return {"draws": draws, "summary": summary}
