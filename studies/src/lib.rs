@@ -21,5 +21,6 @@ pub mod provenance;
 pub mod report;
 pub mod run_folder;
 pub mod runner;
+pub mod shard;
 pub mod surrogate;
 pub mod two_stage;

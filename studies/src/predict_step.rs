@@ -255,6 +255,9 @@ pub(crate) fn run_predict(
             key,
         });
     }
+    // Each run is a unit: cached, this process's to compute, or (a shard
+    // run) another shard's.
+    let claims: Vec<Option<bool>> = jobs.iter().map(|j| run.claim(&j.key)).collect();
     let mut forces: Vec<Option<Vec<f64>>> = jobs
         .iter()
         .map(|j| {
@@ -270,7 +273,10 @@ pub(crate) fn run_predict(
                 .message(&format!("{}: {} (cached)", step.name, j.model));
         }
     }
-    let todo: Vec<usize> = (0..jobs.len()).filter(|&k| forces[k].is_none()).collect();
+    let todo: Vec<usize> = (0..jobs.len())
+        .filter(|&k| forces[k].is_none() && claims[k] != Some(false))
+        .collect();
+    let others = (0..jobs.len()).any(|k| forces[k].is_none() && claims[k] == Some(false));
     if !todo.is_empty() {
         let names: Vec<&str> = todo.iter().map(|&k| jobs[k].model.as_str()).collect();
         run.observer.message(&format!(
@@ -305,6 +311,14 @@ pub(crate) fn run_predict(
                 .store(&jobs[k].key, &RunUnit { forces: f.clone() })?;
             forces[k] = Some(f);
         }
+    }
+    if others {
+        // Runs of other shards are missing: the runner defers the step.
+        return Ok(StepResult::Predict {
+            name: step.name.clone(),
+            runs: Vec::new(),
+            comparisons: Vec::new(),
+        });
     }
     let forces: Vec<Vec<f64>> = forces.into_iter().map(Option::unwrap_or_default).collect();
 

@@ -39,6 +39,9 @@ use std::path::{Path, PathBuf};
 pub const STATE: &str = ".palpate";
 /// The marker of a folder that does not hold a complete run.
 pub const INCOMPLETE: &str = "INCOMPLETE";
+/// The prefix of a shard's scratch folder in [`STATE`] (its plots and
+/// report, thrown away).
+pub const SHARD_SCRATCH: &str = "shard-scratch";
 /// Bumped when the cached records change shape (old entries are then unused).
 const CACHE_FORMAT: u32 = 1;
 
@@ -90,6 +93,14 @@ impl RunFolder {
             std::fs::remove_dir_all(&folder.staging)
                 .with_context(|| format!("cannot remove the stale {}", folder.staging.display()))?;
         }
+        // Scratch folders of killed shards (shards run only under a shared lock).
+        if let Ok(entries) = std::fs::read_dir(&state) {
+            for e in entries.flatten() {
+                if e.file_name().to_string_lossy().starts_with(SHARD_SCRATCH) {
+                    std::fs::remove_dir_all(e.path()).ok();
+                }
+            }
+        }
         if fresh && folder.cache.exists() {
             std::fs::remove_dir_all(&folder.cache)
                 .with_context(|| format!("cannot remove {}", folder.cache.display()))?;
@@ -101,6 +112,41 @@ impl RunFolder {
             std::fs::create_dir_all(dir)
                 .with_context(|| format!("cannot create {}", dir.display()))?;
         }
+        if !folder.is_complete() {
+            folder.mark_incomplete()?;
+        }
+        Ok(folder)
+    }
+
+    /// Opens the run folder `out` for shard `shard` ([`crate::shard`]):
+    /// under a shared lock (shards run side by side; a full run or a merge
+    /// waits for none of them and is refused while one runs), creating the
+    /// folder and its cache if needed, marking a new folder incomplete. It
+    /// removes nothing: the temporary files may be other shards' writes.
+    pub fn open_shared(out: &Path, shard: crate::shard::Shard) -> anyhow::Result<RunFolder> {
+        let shown = out.display();
+        if out.exists() && !out.is_dir() {
+            anyhow::bail!("run folder {shown}: is a file; give a folder with --out");
+        }
+        if out.is_dir() && !is_run_folder(out) && !is_empty(out)? {
+            anyhow::bail!(
+                "run folder {shown}: exists, is not empty and is not a palpate run folder (no {STATE}/ or provenance.json in it); \
+                 give a new or empty folder with --out so that nothing of yours is replaced"
+            );
+        }
+        check_writable("run folder", out, true)?;
+        let state = out.join(STATE);
+        let cache = state.join("cache");
+        std::fs::create_dir_all(&cache)
+            .with_context(|| format!("cannot create run folder {}", cache.display()))?;
+        let lock = lock_shared(&state.join("lock"), out, shard)?;
+        let folder = RunFolder {
+            out: out.to_path_buf(),
+            staging: state.join("staging"),
+            cache,
+            files: state.join("files.json"),
+            _lock: lock,
+        };
         if !folder.is_complete() {
             folder.mark_incomplete()?;
         }
@@ -144,6 +190,11 @@ impl RunFolder {
     pub fn cached<T: serde::de::DeserializeOwned>(&self, key: &str) -> Option<T> {
         let text = std::fs::read(self.cache.join(format!("{key}.json"))).ok()?;
         serde_json::from_slice(&text).ok()
+    }
+
+    /// Whether a unit's record is in the cache.
+    pub fn has(&self, key: &str) -> bool {
+        self.cache.join(format!("{key}.json")).is_file()
     }
 
     /// Stores a finished unit's record (atomically: a kill never leaves half a record).
@@ -242,6 +293,13 @@ fn lock(path: &Path, out: &Path) -> anyhow::Result<File> {
                 "" => "another palpate process".to_string(),
                 p => format!("another palpate process (pid {p})"),
             };
+            let holder = match running_shards(out) {
+                s if s.is_empty() => holder,
+                s => format!(
+                    "{holder} or the shards {} (palpate run --shard)",
+                    s.join(", ")
+                ),
+            };
             anyhow::bail!(
                 "run folder {}: {holder} is writing it (lock {}); wait until it finishes, or give another --out",
                 out.display(),
@@ -257,6 +315,62 @@ fn lock(path: &Path, out: &Path) -> anyhow::Result<File> {
         .and_then(|_| writeln!(file, "{}", std::process::id()))
         .with_context(|| format!("cannot write the lock file {}", path.display()))?;
     Ok(file)
+}
+
+/// Takes the lock file's shared lock for a shard (refused while a full run
+/// holds it exclusively), and marks the shard running (its pid in
+/// `.palpate/shards/I-of-N.running` while the process lives).
+fn lock_shared(path: &Path, out: &Path, shard: crate::shard::Shard) -> anyhow::Result<File> {
+    let file = std::fs::OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .open(path)
+        .with_context(|| format!("cannot open the lock file {}", path.display()))?;
+    match file.try_lock_shared() {
+        Ok(()) => {}
+        Err(std::fs::TryLockError::WouldBlock) => {
+            let pid = std::fs::read_to_string(path).unwrap_or_default();
+            let holder = match pid.trim() {
+                "" => "another palpate process".to_string(),
+                p => format!("another palpate process (pid {p})"),
+            };
+            anyhow::bail!(
+                "run folder {}: {holder} is running the whole study in it (lock {}); shard {shard} waits until it finishes",
+                out.display(),
+                path.display()
+            );
+        }
+        Err(std::fs::TryLockError::Error(e)) => {
+            return Err(e).with_context(|| format!("cannot lock {}", path.display()))
+        }
+    }
+    let running = crate::shard::records_dir(out).join(format!("{}.running", shard.stem()));
+    write_atomic(&running, format!("{}\n", std::process::id()).as_bytes())?;
+    Ok(file)
+}
+
+/// The shards marked running in `out` whose process still lives (their
+/// `I/N`, with the pid).
+fn running_shards(out: &Path) -> Vec<String> {
+    let Ok(entries) = std::fs::read_dir(crate::shard::records_dir(out)) else {
+        return Vec::new();
+    };
+    let mut list = Vec::new();
+    for e in entries.flatten() {
+        let name = e.file_name().to_string_lossy().into_owned();
+        let Some(stem) = name.strip_suffix(".running") else {
+            continue;
+        };
+        let pid = std::fs::read_to_string(e.path()).unwrap_or_default();
+        let pid = pid.trim();
+        if !pid.is_empty() && Path::new("/proc").join(pid).exists() {
+            list.push(format!("{} (pid {pid})", stem.replace("-of-", "/")));
+        }
+    }
+    list.sort();
+    list
 }
 
 /// A folder a run has written (or is writing).

@@ -18,6 +18,7 @@ use crate::output::{write_atomic, write_json};
 use crate::provenance::{crate_versions, git_state, hash_file, Provenance};
 use crate::report::{fit_plot, gap_svg};
 use crate::run_folder::RunFolder;
+use crate::shard::{Shard, ShardRecord};
 use anyhow::Context;
 use palpate_inverse::{BoundSide, ResidualKind};
 use palpate_material::Law;
@@ -25,6 +26,7 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicUsize, Ordering};
 
 /// The results of a whole study (`results.json`).
 #[derive(Debug, Clone, Serialize)]
@@ -100,6 +102,30 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Compute every unit again (the cache of finished units is emptied).
     pub fresh: bool,
+    /// Compute only this shard's units into the cache ([`crate::shard`]):
+    /// no results are written, other shards may run at the same time.
+    pub shard: Option<Shard>,
+}
+
+/// How many units a run computed, found in the cache, or left to other
+/// shards (these counts are not part of the results).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct UnitCounts {
+    pub computed: usize,
+    pub cached: usize,
+    /// Units of other shards not in the cache yet (shard runs only).
+    pub others: usize,
+}
+
+/// What [`run_study_counted`] did.
+#[derive(Debug, Clone)]
+pub struct RunSummary {
+    /// The run folder.
+    pub folder: PathBuf,
+    pub units: UnitCounts,
+    /// Steps a shard run deferred (they need the results of steps whose
+    /// units other shards compute).
+    pub deferred_steps: Vec<String>,
 }
 
 /// One fit of a calibrate step.
@@ -142,6 +168,7 @@ pub fn run_study(
     let options = RunOptions {
         out: out_dir.map(Path::to_path_buf),
         fresh: false,
+        shard: None,
     };
     run_study_with(path, &options, observer)
 }
@@ -152,6 +179,27 @@ pub fn run_study_with(
     options: &RunOptions,
     observer: &dyn RunObserver,
 ) -> anyhow::Result<PathBuf> {
+    run_study_counted(path, options, observer).map(|s| s.folder)
+}
+
+/// Runs the manifest at `path` as `options` say and counts the units.
+///
+/// With `options.shard`, only that shard's units not yet cached are
+/// computed; steps that need the results of a step with units of other
+/// shards still missing are deferred; nothing but the cache and the
+/// shard's record (`.palpate/shards/I-of-N.json`) is written.
+pub fn run_study_counted(
+    path: &Path,
+    options: &RunOptions,
+    observer: &dyn RunObserver,
+) -> anyhow::Result<RunSummary> {
+    if let (Some(shard), true) = (options.shard, options.fresh) {
+        anyhow::bail!(
+            "--fresh with --shard {shard}: a shard would empty the cache the other shards fill; \
+             empty it once before the shards (palpate run --fresh without --shard, or remove RUN_DIR/{}/cache)",
+            crate::run_folder::STATE
+        );
+    }
     let started = std::time::Instant::now();
     let started_unix_s = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -191,8 +239,24 @@ pub fn run_study_with(
         .chain(data_files.iter().cloned())
         .collect();
     check_not_inside(&out, &inputs)?;
-    let folder = RunFolder::open(&out, options.fresh)?;
-    let stage = folder.staging().to_path_buf();
+    let folder = match options.shard {
+        None => RunFolder::open(&out, options.fresh)?,
+        Some(shard) => RunFolder::open_shared(&out, shard)?,
+    };
+    // A shard's files (plots, report) are thrown away: only its units count.
+    let scratch = match options.shard {
+        Some(_) => Some(
+            tempfile::Builder::new()
+                .prefix(crate::run_folder::SHARD_SCRATCH)
+                .tempdir_in(out.join(crate::run_folder::STATE))
+                .with_context(|| format!("cannot create a scratch folder in {}", out.display()))?,
+        ),
+        None => None,
+    };
+    let stage = match &scratch {
+        Some(s) => s.path().to_path_buf(),
+        None => folder.staging().to_path_buf(),
+    };
     let mut results = StudyResults {
         study: manifest.study.name.clone(),
         description: manifest.study.description.clone(),
@@ -211,34 +275,80 @@ pub fn run_study_with(
         out: &stage,
         folder: &folder,
         observer,
+        shard: options.shard,
+        step_index: AtomicUsize::new(0),
+        unit_index: AtomicUsize::new(0),
+        computed: AtomicUsize::new(0),
+        cached: AtomicUsize::new(0),
+        others: AtomicUsize::new(0),
     };
-    for step in &manifest.steps {
-        match step {
-            Step::Calibrate(c) => {
-                let r = run.calibrate(c, &mut report)?;
-                results.steps.push(r);
-            }
-            Step::Diagnose(d) => {
-                let r = run.diagnose(d, &mut report)?;
-                results.steps.push(r);
-            }
-            Step::Predict(p) => {
-                let r = crate::predict_step::run_predict(&run, p, &results.steps, &mut report)?;
-                results.steps.push(r);
-            }
-            Step::Anova(a) => {
-                let r = crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?;
-                results.steps.push(r);
-            }
-            Step::TwoStage(t) => {
-                let r = crate::two_stage::run_two_stage(&run, t, &mut report)?;
-                results.steps.push(r);
-            }
-            Step::Localize(l) => {
-                let r = crate::localize_step::run_localize(&run, l, &mut report)?;
-                results.steps.push(r);
+    // Shard runs: the steps left for a later pass or the merge.
+    let mut deferred: Vec<String> = Vec::new();
+    for (i, step) in manifest.steps.iter().enumerate() {
+        run.step_index.store(i, Ordering::Relaxed);
+        run.unit_index.store(0, Ordering::Relaxed);
+        if let Some(shard) = options.shard {
+            // Steps on the results of other steps wait until those are whole;
+            // steps without units of their own are left to the merge.
+            let waits = matches!(step, Step::Predict(_) | Step::Anova(_)) && !deferred.is_empty();
+            if waits || matches!(step, Step::Anova(_) | Step::Localize(_)) {
+                observer.message(&format!(
+                    "{}: left to {} (shard {shard})",
+                    step.name(),
+                    if waits {
+                        "a later pass of the shards or the merge"
+                    } else {
+                        "the merge"
+                    }
+                ));
+                deferred.push(step.name().to_string());
+                continue;
             }
         }
+        let others_before = run.others.load(Ordering::Relaxed);
+        let r = match step {
+            Step::Calibrate(c) => run.calibrate(c, &mut report)?,
+            Step::Diagnose(d) => run.diagnose(d, &mut report)?,
+            Step::Predict(p) => {
+                crate::predict_step::run_predict(&run, p, &results.steps, &mut report)?
+            }
+            Step::Anova(a) => crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?,
+            Step::TwoStage(t) => crate::two_stage::run_two_stage(&run, t, &mut report)?,
+            Step::Localize(l) => crate::localize_step::run_localize(&run, l, &mut report)?,
+        };
+        if run.others.load(Ordering::Relaxed) > others_before {
+            deferred.push(step.name().to_string());
+        } else {
+            results.steps.push(r);
+        }
+    }
+    let units = UnitCounts {
+        computed: run.computed.load(Ordering::Relaxed),
+        cached: run.cached.load(Ordering::Relaxed),
+        others: run.others.load(Ordering::Relaxed),
+    };
+    if let Some(shard) = options.shard {
+        let record = ShardRecord {
+            shard: shard.to_string(),
+            manifest: path.to_path_buf(),
+            cwd: std::env::current_dir().context("cannot read the working directory")?,
+            manifest_sha256: hash_file(path)?.sha256,
+            computed: units.computed,
+            cached: units.cached,
+            others: units.others,
+            deferred_steps: deferred.clone(),
+        };
+        record.write(&out, shard)?;
+        std::fs::remove_file(
+            crate::shard::records_dir(&out).join(format!("{}.running", shard.stem())),
+        )
+        .ok();
+        drop(scratch);
+        return Ok(RunSummary {
+            folder: out,
+            units,
+            deferred_steps: deferred,
+        });
     }
     write_json(&stage.join("results.json"), &results)?;
     write_atomic(&stage.join("report.md"), report.as_bytes())?;
@@ -260,7 +370,11 @@ pub fn run_study_with(
         command_line: std::env::args().collect(),
     };
     write_json(&stage.join("provenance.json"), &provenance)?;
-    folder.commit()
+    Ok(RunSummary {
+        folder: folder.commit()?,
+        units,
+        deferred_steps: deferred,
+    })
 }
 
 /// Refuses a run folder that is an input file or holds one (the swap of a
@@ -293,30 +407,65 @@ pub(crate) struct Run<'a> {
     pub(crate) out: &'a Path,
     pub(crate) folder: &'a RunFolder,
     pub(crate) observer: &'a dyn RunObserver,
+    /// A shard run computes only its own units ([`crate::shard`]).
+    pub(crate) shard: Option<Shard>,
+    /// The step being run and the number of its units met so far (the
+    /// unit's place, which says which shard computes it).
+    step_index: AtomicUsize,
+    unit_index: AtomicUsize,
+    computed: AtomicUsize,
+    cached: AtomicUsize,
+    others: AtomicUsize,
 }
 
 impl Run<'_> {
     /// A unit's record: from the cache when its inputs are unchanged, else
-    /// computed and cached at once (so a kill after it keeps it).
+    /// computed and cached at once (so a kill after it keeps it). `None`:
+    /// a unit of another shard, not cached yet (shard runs only).
     pub(crate) fn unit<T, K>(
         &self,
         label: &str,
         inputs: &K,
         compute: impl FnOnce() -> anyhow::Result<T>,
-    ) -> anyhow::Result<T>
+    ) -> anyhow::Result<Option<T>>
     where
         T: Serialize + serde::de::DeserializeOwned,
         K: std::fmt::Debug,
     {
         let key = RunFolder::key(inputs);
-        if let Some(record) = self.folder.cached(&key) {
-            self.observer.message(&format!("{label} (cached)"));
-            return Ok(record);
+        let claim = self.claim(&key);
+        if claim.is_none() {
+            if let Some(record) = self.folder.cached(&key) {
+                self.observer.message(&format!("{label} (cached)"));
+                return Ok(Some(record));
+            }
+            // Unreadable: computed again (by its owner).
+        }
+        if claim == Some(false) {
+            return Ok(None);
         }
         self.observer.message(label);
         let record = compute()?;
         self.folder.store(&key, &record)?;
-        Ok(record)
+        Ok(Some(record))
+    }
+
+    /// Takes the next unit of the step (key `key`): `None` when it is
+    /// cached, else whether this process computes it (every unit without
+    /// shards; the shard's own ones with). Counts the unit. Call it once
+    /// per unit, in the manifest's order, cached or not.
+    pub(crate) fn claim(&self, key: &str) -> Option<bool> {
+        let k = self.unit_index.fetch_add(1, Ordering::Relaxed);
+        if self.folder.has(key) {
+            self.cached.fetch_add(1, Ordering::Relaxed);
+            return None;
+        }
+        let mine = self
+            .shard
+            .is_none_or(|s| s.owns(self.step_index.load(Ordering::Relaxed), k));
+        let counter = if mine { &self.computed } else { &self.others };
+        counter.fetch_add(1, Ordering::Relaxed);
+        Some(mine)
     }
 
     fn calibrate(&self, step: &CalibrateStep, report: &mut String) -> anyhow::Result<StepResult> {
@@ -363,7 +512,7 @@ fn run_calibrate(
                     residual,
                     &step.estimator,
                 );
-                let unit: FitUnit = run.unit(&label, &inputs, || {
+                let Some(unit): Option<FitUnit> = run.unit(&label, &inputs, || {
                     let calibration = calibrate(Request {
                         law,
                         model: spec,
@@ -412,7 +561,10 @@ fn run_calibrate(
                         plot: fit_plot(&fit.calibration).to_svg(),
                         entry: serde_json::to_value(&fit)?,
                     })
-                })?;
+                })?
+                else {
+                    continue;
+                };
                 let file = format!("{}-{model_name}-{group}-{residual}.svg", step.name);
                 write_atomic(&run.out.join("plots").join(&file), unit.plot.as_bytes())?;
                 units.push(((model_name, group, residual), unit));
@@ -566,7 +718,7 @@ fn run_diagnose(run: &Run, step: &DiagnoseStep, report: &mut String) -> anyhow::
             name,
             d,
         );
-        let unit: DiagnoseUnit = run.unit(&label, &inputs, || {
+        let Some(unit): Option<DiagnoseUnit> = run.unit(&label, &inputs, || {
             let model = build(&spec).map_err(|e| anyhow::anyhow!("step `{}`: {e}", step.name))?;
             let options = palpate_uq::gap::GapOptions {
                 effects: match &step.effects {
@@ -606,7 +758,10 @@ fn run_diagnose(run: &Run, step: &DiagnoseStep, report: &mut String) -> anyhow::
                     report: serde_json::to_value(&gap)?,
                 })?,
             })
-        })?;
+        })?
+        else {
+            continue;
+        };
         let _ = writeln!(report, "{}", unit.row);
         write_atomic(
             &run.out

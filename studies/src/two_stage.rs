@@ -859,7 +859,7 @@ pub(crate) fn run_two_stage(
         crate::surrogate::code_version(),
     );
     let label = format!("{}: two-stage identification of {}", step.name, step.record);
-    let unit: TwoStageUnit = run.unit(&label, &inputs, || {
+    let Some(unit): Option<TwoStageUnit> = run.unit(&label, &inputs, || {
         let mut record = Q1Record::read(&path)?;
         record.name = step.record.clone();
         let say = |s: &str| eprintln!("{s}");
@@ -868,7 +868,14 @@ pub(crate) fn run_two_stage(
             report: report(&result, step.truth.as_deref()),
             result: serde_json::to_value(&result)?,
         })
-    })?;
+    })?
+    else {
+        // Another shard's unit: the runner defers the step.
+        return Ok(crate::runner::StepResult::TwoStage {
+            name: step.name.clone(),
+            result: serde_json::Value::Null,
+        });
+    };
     let _ = writeln!(
         report_md,
         "## {} (two-stage inverse FE, Q1)\n\n{}",

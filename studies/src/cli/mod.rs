@@ -8,6 +8,7 @@ pub mod calibrate;
 pub mod diagnose;
 pub mod doe;
 pub mod localize;
+pub mod merge;
 pub mod run;
 pub mod sample;
 pub mod sample_fe;
@@ -50,6 +51,8 @@ pub enum Command {
     Diagnose(diagnose::Args),
     // A whole study from one manifest (run::Args).
     Run(run::Args),
+    // Assemble a study's results from its shards (merge::Args).
+    Merge(merge::Args),
     // The real-time force surrogate (surrogate::Args).
     Surrogate(surrogate::Args),
     // Nodule localisation from an R2 record (localize::Args).
@@ -96,6 +99,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Doe(a) => doe::run(a),
         Command::Diagnose(a) => diagnose::run(a),
         Command::Run(a) => run::run(a),
+        Command::Merge(a) => merge::run(a),
         Command::Surrogate(a) => surrogate::run(a),
         Command::Localize(a) => localize::run(a),
     }

@@ -41,6 +41,14 @@ pub struct Args {
     /// cached in the run folder.
     #[arg(long)]
     pub fresh: bool,
+    /// Compute only the I-th of N deterministic slices of the study's units
+    /// (fits, diagnosed records, model runs of predict steps, two-stage
+    /// identifications) into the run folder's cache, 0 <= I < N; shards
+    /// run at the same time, as separate processes or on other machines
+    /// sharing the folder. Then `palpate merge DIR` writes the results,
+    /// byte-identical to a run without shards. See docs/cluster.md.
+    #[arg(long, value_name = "I/N")]
+    pub shard: Option<crate::shard::Shard>,
 }
 
 /// Runs `palpate run`.
@@ -58,26 +66,40 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         );
         return Ok(());
     }
-    // A spinner on a terminal (a bar over the FE runs of a predict step);
-    // plain lines when stderr is a log file.
-    let bar = std::io::stderr().is_terminal().then(|| {
-        let bar = indicatif::ProgressBar::new_spinner();
-        bar.enable_steady_tick(std::time::Duration::from_millis(120));
-        bar
-    });
-    let observer = CliObserver {
-        bar: bar.clone(),
-        shown: std::sync::Mutex::new((String::new(), 0)),
-    };
+    let observer = CliObserver::new();
+    let bar = observer.bar.clone();
     let options = crate::runner::RunOptions {
         out: args.out.clone(),
         fresh: args.fresh,
+        shard: args.shard,
     };
-    let out = crate::runner::run_study_with(&args.manifest, &options, &observer);
+    let summary = crate::runner::run_study_counted(&args.manifest, &options, &observer);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
-    let out = out?;
+    let summary = summary?;
+    let out = summary.folder;
+    if let Some(shard) = args.shard {
+        let u = summary.units;
+        println!(
+            "shard {shard} done in {}: {} units computed, {} cached, {} of other shards not yet cached",
+            out.display(),
+            u.computed,
+            u.cached,
+            u.others
+        );
+        if !summary.deferred_steps.is_empty() {
+            println!(
+                "  steps left to a second pass of the shards or to the merge: {}",
+                summary.deferred_steps.join(", ")
+            );
+        }
+        println!(
+            "  when every shard is done: palpate merge {}",
+            out.display()
+        );
+        return Ok(());
+    }
     println!("study written to {}", out.display());
     println!("  {}", out.join("report.md").display());
     Ok(())
@@ -85,10 +107,33 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
 /// What `palpate run` shows: messages on a spinner, FE load steps on a bar
 /// (a terminal), or plain lines, progress every 10 % (a log file).
-struct CliObserver {
+pub(crate) struct CliObserver {
     bar: Option<indicatif::ProgressBar>,
     /// The label and the tenth last printed (plain lines).
     shown: std::sync::Mutex<(String, u64)>,
+}
+
+impl CliObserver {
+    /// A spinner on a terminal (a bar over the FE runs of a predict step);
+    /// plain lines when stderr is a log file.
+    pub(crate) fn new() -> CliObserver {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = indicatif::ProgressBar::new_spinner();
+            bar.enable_steady_tick(std::time::Duration::from_millis(120));
+            bar
+        });
+        CliObserver {
+            bar,
+            shown: std::sync::Mutex::new((String::new(), 0)),
+        }
+    }
+
+    /// Clears the spinner.
+    pub(crate) fn finish(&self) {
+        if let Some(b) = &self.bar {
+            b.finish_and_clear();
+        }
+    }
 }
 
 const SPINNER: &str = "{spinner} {msg}";
