@@ -31,6 +31,7 @@ use crate::mesh::{CellType, Grading, Mesh};
 use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
 use crate::motion::ToolMotion;
 use crate::n1::N1Element;
+use crate::self_contact::SelfContact;
 use crate::stepper::Progress;
 use crate::surface::Profile2d;
 use crate::system::{SolverOptions, System};
@@ -64,6 +65,20 @@ pub struct Q1Punch {
     pub penalty: f64,
     /// A Prony series on the law's isochoric stress; `None`: elastic.
     pub prony: Option<Prony>,
+    /// Self-contact of the top surface near the punch
+    /// ([`crate::self_contact::SelfContact`], penalty `penalty * mu0 /
+    /// h_fine`): the surface creases where it wraps round the punch edge.
+    pub self_contact: bool,
+    /// Width of the softened onset of the punch's contact force
+    /// ([`RigidContact::smoothing`]) as a fraction of the fine element
+    /// size (default 0: the sharp law). Without it Newton can cycle
+    /// between two contact states where the surface wraps the punch edge
+    /// (docs/validation/fe.md "Q1"); with it the small-depth force carries
+    /// a bias (points within the band outside the punch carry load).
+    pub contact_smoothing: f64,
+    /// Where the punch contact is enforced (default: the Gauss points of
+    /// the surface edges).
+    pub contact_points: ContactPoints,
     pub options: SolverOptions,
     space: ParamSpace,
     /// Number of Prony terms taken from the parameters (0: `prony` fixed).
@@ -89,6 +104,9 @@ impl Q1Punch {
             element: N1Element::Quad4,
             penalty: 100.0,
             prony: None,
+            self_contact: false,
+            contact_smoothing: 0.0,
+            contact_points: ContactPoints::EdgeGauss,
             options: SolverOptions {
                 max_step: 0.1,
                 first_step: 0.02,
@@ -304,7 +322,7 @@ impl Setup for Q1Punch {
             penalty_normal: 0.0,
             penalty_tangent: 0.0,
             penetration_tol: 1e-4,
-            points: ContactPoints::EdgeGauss,
+            points: self.contact_points,
         };
         let motion = ToolMotion::translating([0.0, self.height, 0.0], vec![(0, [0.0, -1.0, 0.0])]);
         let tool = self.tool();
@@ -318,7 +336,23 @@ impl Setup for Q1Punch {
             options,
             1,
         )?;
-        System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 1)
+        let mut parts: Vec<Box<dyn crate::contribution::Contribution>> =
+            vec![Box::new(body), Box::new(contact)];
+        if self.self_contact {
+            // the top surface from half the punch radius to 2 mm beyond its
+            // edge, pairs within 1 mm (reference) of each other
+            let (lo, hi) = (0.5 * self.punch_radius, self.punch_radius + 2.0);
+            let top = self.height;
+            parts.push(Box::new(SelfContact::new(
+                "top",
+                &mesh,
+                "top",
+                kin,
+                |x| x[0] >= lo - 1e-9 && x[0] <= hi + 1e-9 && (x[1] - top).abs() < 1e-9,
+                1.0,
+            )?));
+        }
+        System::new(mesh, 2, parts, &bcs, 1)
     }
     fn prepare(
         &self,
@@ -335,6 +369,12 @@ impl Setup for Q1Punch {
         cs.options.penalty_normal = self.penalty * mu / h;
         cs.options.penalty_tangent = self.penalty * mu / h;
         cs.options.friction = 0.0;
+        cs.smoothing = self.contact_smoothing * h;
+        if self.self_contact {
+            let sc = sys.part_mut::<SelfContact>(2)?;
+            sc.penalty = self.penalty * mu / h;
+            sc.depth = h;
+        }
         Ok(())
     }
     fn observe(&self, sys: &System) -> Vec<f64> {
