@@ -27,6 +27,9 @@ fn main() {
     let mut m = Q1Punch::new("neo-hookean".parse().unwrap());
     m.level = level;
     m.edge_radius = edge;
+    if let Ok(v) = std::env::var("REFINE") {
+        m.edge_refinement = v.parse().unwrap();
+    }
     if let Ok(v) = std::env::var("SMOOTH") {
         m.contact_smoothing = v.parse().unwrap();
     }
