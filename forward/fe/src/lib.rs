@@ -16,6 +16,7 @@
 //! * [`dofs`], [`contribution`], [`body`], [`contact`] — boundary
 //!   conditions as data and the contributions a step sums, with
 //!   trial/commit/rollback history.
+//! * [`self_contact`] — a 2D boundary's contact with itself (creases).
 //! * [`surface`], [`motion`], [`tool`] — rigid tool surfaces in 2D and 3D
 //!   and their motion along loading channels.
 //! * [`system`], [`stepper`] — Newton (chord steps, line search) on a faer
@@ -53,6 +54,7 @@ pub mod q1_viscous;
 pub mod quadrature;
 pub mod r2;
 pub mod r2_scan;
+pub mod self_contact;
 pub mod shape;
 pub mod sparse;
 pub mod stepper;

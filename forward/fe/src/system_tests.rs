@@ -833,3 +833,76 @@ fn sliding_sphere_drags_the_surface_at_the_coulomb_limit() {
         );
     }
 }
+
+/// Self-contact of a folded surface: the assembled tangent of
+/// [`crate::self_contact::SelfContact`] equals central finite differences
+/// of its residual (axisymmetric, two nodes pushed through non-adjacent,
+/// tilted segments of the same top surface), and a node outside the
+/// segment's span, or behind it deeper than `depth`, adds nothing.
+#[test]
+fn self_contact_tangent_equals_finite_differences() {
+    use crate::self_contact::SelfContact;
+    // one row of cells: every free node is on the top surface
+    let mesh = Mesh::graded_rectangle(6.0, 1.0, Grading::uniform(6.0, 6), Grading::uniform(1.0, 1))
+        .unwrap();
+    let kin = Kinematics::Axisymmetric;
+    let mut sc = SelfContact::new("top", &mesh, "top", kin, |_| true, 10.0).unwrap();
+    sc.penalty = 3.0;
+    sc.depth = 0.5;
+    let top: Vec<usize> = mesh.node_set("top").unwrap().to_vec();
+    let bcs = [Dirichlet::fixed("bottom", 0), Dirichlet::fixed("bottom", 1)];
+    let mut sys = System::new(mesh, 2, vec![Box::new(sc)], &bcs, 0).unwrap();
+    // top nodes at r = 0..6, z = 1: tilt segment (2, 3), push node 5 under
+    // it and node 0 under segment (3, 4)
+    let mut set = |n: usize, du: [f64; 2]| {
+        sys.u[2 * top[n]] = du[0];
+        sys.u[2 * top[n] + 1] = du[1];
+    };
+    set(2, [0.1, 0.15]);
+    set(3, [-0.05, -0.1]);
+    set(5, [-2.6, -0.3]);
+    set(0, [3.4, -0.12]);
+    set(4, [0.0, 0.05]);
+    for (k, u) in sys.u.iter_mut().enumerate() {
+        *u += 1e-3 * ((k as f64) * 0.7).sin();
+    }
+    let target = Target {
+        channels: vec![],
+        time: 0.0,
+        dt: 0.0,
+    };
+    sys.assemble(&target, true).unwrap();
+    let active = sys.part::<SelfContact>(0).unwrap().active();
+    // the two pushed nodes, and nodes behind the segments the fold turned
+    // over
+    assert!(active >= 2, "{active} pairs in contact");
+    let k = dense(&sys);
+    let scale = k.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    assert!(scale > 0.0);
+    let h = 1e-7;
+    let n = sys.dofs.equations;
+    let mut worst = 0.0f64;
+    for s in 0..sys.u.len() {
+        let e = sys.dofs.equation(s);
+        if e == NONE {
+            continue;
+        }
+        let u0 = sys.u[s];
+        sys.u[s] = u0 + h;
+        sys.assemble(&target, false).unwrap();
+        let rp = sys.residual.clone();
+        sys.u[s] = u0 - h;
+        sys.assemble(&target, false).unwrap();
+        let rm = sys.residual.clone();
+        sys.u[s] = u0;
+        for r in 0..n {
+            let fd = (rp[r] - rm[r]) / (2.0 * h);
+            worst = worst.max((fd - k[r][e]).abs() / scale);
+        }
+    }
+    assert!(worst < 1e-6, "worst {worst:.2e}");
+    // deeper than `depth`: nothing
+    sys.part_mut::<SelfContact>(0).unwrap().depth = 0.05;
+    sys.assemble(&target, true).unwrap();
+    assert_eq!(sys.part::<SelfContact>(0).unwrap().active(), 0);
+}
