@@ -11,7 +11,11 @@
 //!
 //! `cargo run --release -p palpate-fe --example bench_r2 -- [--segments 2]
 //!  [--step 0.5] [--rd 6] [--x 37.5,56.25,75,112.5|none]
-//!  [--from X0] [--to X1]` (`--from`/`--to`: a shorter pass, for profiling)
+//!  [--from X0] [--to X1] [--no-press] [--predictor secant|0|1]`
+//! (`--from`/`--to`: a shorter pass, for profiling; `--no-press`: print the
+//! pass forces at `--x` without the h = 1 presses; `--predictor`: the
+//! stepper's secant instead of the default wheel-following prediction,
+//! `R2Rolling::predictor`)
 
 use std::time::Instant;
 
@@ -37,6 +41,7 @@ fn main() {
     let mut xs = vec![37.5, 56.25, 75.0, 112.5];
     let mut from: Option<f64> = None;
     let mut to: Option<f64> = None;
+    let mut presses = true;
     let args: Vec<String> = std::env::args().skip(1).collect();
     if let Some(k) = args.iter().position(|a| a == "--rd") {
         rd = args[k + 1].parse().expect("mm");
@@ -67,6 +72,13 @@ fn main() {
                 model.pure_penalty = false;
                 model.options.max_augmentations = value().parse().expect("a count");
             }
+            "--predictor" => {
+                model.predictor = match value().as_str() {
+                    "secant" => None,
+                    v => Some(v.parse().expect("secant|0|1")),
+                }
+            }
+            "--no-press" => presses = false,
             "--from" => from = Some(value().parse().expect("mm")),
             "--to" => to = Some(value().parse().expect("mm")),
             other => panic!("unknown option {other}"),
@@ -138,6 +150,13 @@ fn main() {
             })
             .expect("a pass position");
         let x = positions[k];
+        if !presses {
+            println!(
+                "| {x} | {:.4} | not run | | {:+.4} | |",
+                pass[k][0], pass[k][1]
+            );
+            continue;
+        }
         let mut p = fine.clone();
         p.press_x = x;
         let n = (rd / 0.5).round() as usize;

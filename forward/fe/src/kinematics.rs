@@ -204,7 +204,9 @@ fn plane_stress(
             // d2F22 = 2 c c / d^3 - dc/dF / d^2.
             let f22 = 1.0 / det2;
             f[(2, 2)] = f22;
-            let (p9, a9) = mat.iso_stress_tangent(f);
+            // the five components F00, F01, F10, F11, F22 of P_iso and A_iso
+            // (the 2D path: the stress alone when no tangent is asked for)
+            let (p5, a5) = mat.iso_stress_tangent_2d(f, tangent);
             let c = [f[(1, 1)], -f[(1, 0)], -f[(0, 1)], f[(0, 0)]];
             let g: [f64; 4] = std::array::from_fn(|r| -c[r] * f22 * f22);
             // dc_r / dF_s: c00/dF11 = 1, c01/dF10 = -1, c10/dF01 = -1, c11/dF00 = 1
@@ -215,18 +217,19 @@ fn plane_stress(
                     _ => 0.0,
                 }
             };
-            let p22 = p9[(2, 2)];
+            // (F_IN_PLANE[r] == F_COMPONENTS[r] for r < 4; F22 is 4)
+            let p22 = p5[4];
             for (r, &k) in F_IN_PLANE.iter().enumerate() {
-                p[k] = p9[(k / 3, k % 3)] + p22 * g[r];
+                p[k] = p5[r] + p22 * g[r];
                 if !tangent {
                     continue;
                 }
                 for (s, &l) in F_IN_PLANE.iter().enumerate() {
                     let h = 2.0 * c[r] * c[s] * f22 * f22 * f22 - dc(r, s) * f22 * f22;
-                    a[k][l] = a9[(k, l)]
-                        + a9[(k, 8)] * g[s]
-                        + a9[(8, l)] * g[r]
-                        + a9[(8, 8)] * g[r] * g[s]
+                    a[k][l] = a5[r][s]
+                        + a5[r][4] * g[s]
+                        + a5[4][s] * g[r]
+                        + a5[4][4] * g[r] * g[s]
                         + p22 * h;
                 }
             }

@@ -49,6 +49,7 @@ pub mod model;
 pub mod motion;
 pub mod n1;
 pub mod n3;
+pub mod predictor;
 pub mod q1;
 pub mod q1_viscous;
 pub mod quadrature;

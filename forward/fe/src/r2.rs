@@ -38,6 +38,7 @@ use palpate_core::{
     ParamSpec,
 };
 use palpate_material::Law;
+use rayon::prelude::*;
 use std::sync::Arc;
 
 use crate::body::{RegionMaterial, SolidBody};
@@ -50,6 +51,7 @@ use crate::material::LawMaterial;
 use crate::mesh::{CellType, InclusionBlock, Mesh};
 use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Path, Setup, Simulation};
 use crate::motion::ToolMotion;
+use crate::predictor::FollowTool;
 use crate::stepper::{LoadPath, Progress};
 use crate::surface::Wheel2d;
 use crate::system::{SolverOptions, System};
@@ -150,6 +152,10 @@ pub struct R2Rolling {
     pub pure_penalty: bool,
     /// Softened contact onset width (mm, [`RigidContact::smoothing`]).
     pub contact_smoothing: f64,
+    /// The predictor of each rolled increment: `Some(order)` the field
+    /// carried with the wheel ([`FollowTool`], order 0 shifted, 1 the
+    /// secant in the wheel's frame); `None` the stepper's secant.
+    pub predictor: Option<usize>,
     pub options: SolverOptions,
     space: ParamSpace,
 }
@@ -188,6 +194,7 @@ impl R2Rolling {
             penalty: 1000.0,
             pure_penalty: true,
             contact_smoothing: 0.01,
+            predictor: Some(0),
             options: SolverOptions {
                 max_step: 0.5,
                 first_step: 0.25,
@@ -289,7 +296,8 @@ impl R2Rolling {
 
     /// The rolled pass through `positions` (increasing, within
     /// `press_x..=roll_to`), split into up to `segments` contiguous pieces
-    /// solved in parallel threads, each pressed to `rd` at its first
+    /// solved in parallel (rayon tasks: safe to call from a rayon worker),
+    /// each pressed to `rd` at its first
     /// position and rolled from there. Exact for a frictionless wheel with
     /// [`R2Rolling::pure_penalty`] contact, whose state is a function of the
     /// wheel position alone (the press at x equals the rolled state at x,
@@ -317,39 +325,37 @@ impl R2Rolling {
         let chunk = positions.len().div_ceil(n).max(1);
         let pieces: Vec<&[f64]> = positions.chunks(chunk).collect();
         type Piece = Result<(Vec<Vec<f64>>, System), ForwardError>;
-        let results: Vec<Piece> = std::thread::scope(|scope| {
-            let handles: Vec<_> = pieces
-                .iter()
-                .map(|piece| {
-                    scope.spawn(move || {
-                        let mut model = self.clone();
-                        model.press_x = piece[0];
-                        let loading = Loading::quasi_static(Drive::PositionMm, piece.to_vec());
-                        let mut report = |p: &Progress| {
-                            if p.sample > 0 {
-                                if let Some(f) = progress {
-                                    f();
-                                }
+        // Segments as rayon tasks, not threads of their own: a caller that
+        // is itself a rayon worker (a design of runs) then lends its thread
+        // to the segments and to the element loops inside them, where a
+        // worker blocked on a plain thread join would starve the pool
+        // those loops need (a deadlock once every worker waits so).
+        let results: Vec<Piece> = pieces
+            .par_iter()
+            .map(|piece| {
+                let run = || {
+                    let mut model = self.clone();
+                    model.press_x = piece[0];
+                    let loading = Loading::quasi_static(Drive::PositionMm, piece.to_vec());
+                    let mut report = |p: &Progress| {
+                        if p.sample > 0 {
+                            if let Some(f) = progress {
+                                f();
                             }
-                        };
-                        model
-                            .simulate(theta, &loading, Some(&mut report))
-                            .map(|(sim, sys)| (sim.outputs, sys))
+                        }
+                    };
+                    model
+                        .simulate(theta, &loading, Some(&mut report))
+                        .map(|(sim, sys)| (sim.outputs, sys))
+                };
+                std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)).unwrap_or_else(|_| {
+                    Err(ForwardError::InvalidConfig {
+                        field: "R2".into(),
+                        reason: "a segment of the rolled pass panicked".into(),
                     })
                 })
-                .collect();
-            handles
-                .into_iter()
-                .map(|h| {
-                    h.join().unwrap_or_else(|_| {
-                        Err(ForwardError::InvalidConfig {
-                            field: "R2".into(),
-                            reason: "a segment of the rolled pass panicked".into(),
-                        })
-                    })
-                })
-                .collect()
-        });
+            })
+            .collect();
         let mut out: Vec<[f64; 2]> = Vec::with_capacity(positions.len());
         let mut last = None;
         for r in results {
@@ -380,6 +386,28 @@ impl R2Rolling {
             }
         }
         Ok((out, last))
+    }
+
+    /// The weight of the wheel-following prediction per node
+    /// ([`FollowTool::weights`]): 0 in the nodules and rising linearly to
+    /// 1 at [`FOLLOW_FADE`] mm from their circles (a nodule does not
+    /// travel with the wheel), 1 elsewhere.
+    fn follow_weights(&self, mesh: &Mesh) -> Vec<f64> {
+        let fade = FOLLOW_FADE;
+        mesh.nodes
+            .iter()
+            .map(|x| {
+                self.nodules
+                    .iter()
+                    .map(|n| {
+                        let (cx, cy) = (n.x, self.height - n.depth);
+                        let d =
+                            ((x[0] - cx).powi(2) + (x[1] - cy).powi(2)).sqrt() - self.nodule_radius;
+                        (d / fade).clamp(0.0, 1.0)
+                    })
+                    .fold(1.0, f64::min)
+            })
+            .collect()
     }
 
     /// Checks the scalars (the geometry of the nodules is the mesh
@@ -467,6 +495,10 @@ pub fn check_model(m: &R2Rolling) -> Result<(), (String, String)> {
     m.block().check().map_err(split)
 }
 
+/// Distance from a nodule's circle (mm) over which the wheel-following
+/// prediction fades in ([`R2Rolling::follow_weights`]).
+const FOLLOW_FADE: f64 = 5.0;
+
 /// The order stated for the R2 force (docs/validation/fe.md, R2).
 const R2_ORDER: f64 = 1.0;
 
@@ -530,7 +562,13 @@ impl Setup for R2Rolling {
         )?;
         contact.pure_penalty = self.pure_penalty;
         contact.smoothing = self.contact_smoothing;
-        System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 2)
+        let mut sys = System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 2)?;
+        if let Some(order) = self.predictor {
+            let mut p = FollowTool::new(1, [1.0, 0.0, 0.0], order);
+            p.weights = Some(self.follow_weights(&sys.mesh));
+            sys.predictor = Some(Box::new(p));
+        }
+        Ok(sys)
     }
     fn prepare(
         &self,

@@ -102,10 +102,8 @@ impl R2NoduleScan {
         };
         model.press_x = first;
         model.roll_to = model.roll_to.max(last);
-        // Solved in this thread, not by `rolled_pass` (which spawns a
-        // thread per segment): scans run on rayon workers (the surrogate's
-        // design), and a worker blocked on a plain thread join while the
-        // spawned thread waits for the pool's (busy) workers deadlocks.
+        // One rolled path solved in this thread (scans already run in
+        // parallel over the surrogate's design).
         let loading = Loading::quasi_static(Drive::PositionMm, positions);
         let (sim, _) = model.simulate(&material, &loading, None)?;
         Ok(sim.outputs.iter().map(|r| r[0]).collect())

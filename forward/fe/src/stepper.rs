@@ -262,7 +262,8 @@ pub fn run(
                 time,
                 dt: time - sys.committed.time,
             };
-            // predictor: extrapolate the previous increment
+            // predictor: extrapolate the previous increment, then the
+            // model's predictor (where it applies)
             if let Some((prev, du, pdir)) = &last {
                 if *pdir == dir {
                     let f = size / prev;
@@ -270,6 +271,18 @@ pub fn run(
                         *u += f * d;
                     }
                 }
+            }
+            if let Some(mut p) = sys.predictor.take() {
+                let from = sys.committed.channels.clone();
+                p.predict(
+                    &sys.mesh,
+                    sys.dofs.dim,
+                    &from,
+                    &target.channels,
+                    &u_c,
+                    &mut sys.u,
+                );
+                sys.predictor = Some(p);
             }
             let it0 = sys.stats.iterations;
             match sys.solve_increment(&target, opts) {

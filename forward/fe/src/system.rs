@@ -122,6 +122,9 @@ pub struct System {
     /// Smallest force scale of the residual test (N), e.g. `1e-6 mu h^2`.
     pub force_floor: f64,
     pub stats: RunStats,
+    /// A model's predictor of each increment's starting state
+    /// ([`crate::predictor`]); `None` (default): the stepper's secant.
+    pub predictor: Option<Box<dyn crate::predictor::Predictor>>,
     /// A test hook: every assembly fails once this many have passed, until
     /// it is cleared.
     #[doc(hidden)]
@@ -200,6 +203,7 @@ impl System {
             length_scale,
             force_floor: 0.0,
             stats: RunStats::default(),
+            predictor: None,
             fail_after: None,
         })
     }
@@ -270,6 +274,9 @@ impl System {
         };
         for c in self.contributions.iter_mut() {
             c.reset(&self.mesh.nodes);
+        }
+        if let Some(p) = self.predictor.as_mut() {
+            p.reset();
         }
         self.stats = RunStats::default();
     }

@@ -11,6 +11,7 @@
 //! * (b) without nodules the rolled force is flat in x away from the ends.
 //! * (c) with one nodule the rolled force peaks over it.
 //! * (d) bad input gives named errors, not panics.
+//! * (e) `rolled_pass` called from rayon workers finishes (no deadlock).
 
 use palpate_core::{Drive, ForwardError, ForwardModel, Loading};
 use palpate_fe::r2::check_model;
@@ -147,6 +148,43 @@ fn rolled_force_peaks_over_the_nodule() {
     );
     assert!(peak > 1.02 * f[0][0], "{f:?}");
     assert!(peak > 1.02 * f.last().unwrap()[0], "{f:?}");
+}
+
+/// (e) `rolled_pass` called from inside rayon, from every worker of the
+/// global pool at once (a design of runs does so): its segments are rayon
+/// tasks, so the blocked workers lend themselves to them. It used to spawn
+/// threads of its own, whose element loops then waited for the pool's
+/// workers while every worker waited on a join: a deadlock. Run on a
+/// watchdog thread so that a regression fails after 10 minutes instead of
+/// hanging the suite; every call gives the same forces as one made outside
+/// the pool.
+#[test]
+fn rolled_pass_from_inside_rayon_workers_finishes() {
+    let m = one_nodule();
+    let positions = steps(24.0, 25.0, 1.0);
+    let (outside, _) = m.rolled_pass(&THETA, &positions, 2, None).unwrap();
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        let inside: Vec<_> = rayon::broadcast(|_| {
+            m.rolled_pass(&THETA, &positions, 2, None)
+                .map(|(f, _)| f)
+                .map_err(|e| e.to_string())
+        });
+        tx.send(inside).ok();
+    });
+    let inside = rx
+        .recv_timeout(std::time::Duration::from_secs(600))
+        .expect("rolled_pass called from rayon workers did not finish (deadlock)");
+    assert_eq!(inside.len(), rayon::current_num_threads());
+    for f in inside {
+        let f = f.unwrap();
+        for (a, b) in f.iter().zip(&outside) {
+            assert!(
+                (a[0] - b[0]).abs() <= 1e-9 * b[0].abs(),
+                "{f:?} vs {outside:?}"
+            );
+        }
+    }
 }
 
 fn config_error(m: &R2Rolling, field: &str, words: &str) {

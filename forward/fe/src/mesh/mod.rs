@@ -23,6 +23,7 @@ pub mod gmsh;
 pub mod grading;
 pub mod inclusions;
 pub mod jacobian;
+pub mod locate;
 pub mod quadratic;
 pub mod structured;
 pub mod vtu;
@@ -35,6 +36,7 @@ use crate::FeError;
 
 pub use grading::Grading;
 pub use inclusions::InclusionBlock;
+pub use locate::{Interpolant, Locator};
 
 /// The shape of a cell or facet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
