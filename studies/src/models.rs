@@ -297,13 +297,12 @@ pub struct N3NeedleSpec {
     pub tool: Option<String>,
 }
 
-/// The default N3 mesh: level 1 (the O-grid of 0.8 mm hexahedra, 945 cells,
-/// 4,110 equations, peak 0.05 GiB; level 2 has 7,308 cells, 30,479
-/// equations, peak 0.6 GiB; docs/validation/fe.md "N3").
+/// The default N3 mesh: level 1 (the box of 0.8 mm hexahedra, 2,340 cells,
+/// 10,125 equations; level 2 has 17,400 cells, ~70,000 equations;
+/// docs/validation/fe.md "N3").
 pub const N3_DEFAULT_MESH: &str = "coarse";
-/// The finest N3 level accepted: level 3 (24,381 hexahedra, 100,276
-/// equations, ~2.5 GiB estimated) would need more memory and time than a
-/// 2-core, few-GiB machine has.
+/// The finest N3 level accepted: level 3 (the box: ~57,000 hexahedra)
+/// would need more memory and time than a 2-core, few-GiB machine has.
 pub const N3_MAX_LEVEL: usize = 2;
 
 /// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
@@ -568,7 +567,7 @@ impl ModelSpec {
                         "mesh",
                         text,
                         format!(
-                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} equations, beyond this machine's memory and time (measured peaks: level 1 0.05 GiB, level 2 0.6 GiB)",
+                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} equations, beyond this machine's memory and time (docs/validation/fe.md, N3)",
                             n3_equations(level)
                         ),
                     ));
@@ -655,7 +654,7 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
     Ok(m)
 }
 
-/// The equations of N3 mesh `level` (the default O-grid), counted from its
+/// The equations of N3 mesh `level` (the default box), counted from its
 /// grading without building the mesh.
 fn n3_equations(level: usize) -> usize {
     let mut m = N3Needle::new(Law::NeoHookean);

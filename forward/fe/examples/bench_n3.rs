@@ -39,7 +39,7 @@ fn main() {
     let mut frictions = vec![0.0, 0.8];
     let mut grading: Option<Grading> = None;
     let mut max_step: Option<f64> = None;
-    let mut layout = N3Mesh::OGrid;
+    let mut layout: Option<N3Mesh> = None;
     let mut core: Option<usize> = None;
     let mut solver = String::from("default");
     let mut it = args.iter();
@@ -48,10 +48,10 @@ fn main() {
         match a.as_str() {
             "--depth" => depth = value().parse().expect("depth"),
             "--mesh" => {
-                layout = match value().as_str() {
+                layout = Some(match value().as_str() {
                     "box" => N3Mesh::Box,
                     _ => N3Mesh::OGrid,
-                }
+                })
             }
             "--solver" => solver = value(),
             "--core" => core = Some(value().parse().expect("core cells")),
@@ -103,7 +103,10 @@ fn main() {
                 let mut m = N3Needle::new(l.parse().expect("law"));
                 m.level = level;
                 m.grading = grading;
-                m.mesh = layout;
+                if let Some(l) = layout {
+                    m.mesh = l;
+                }
+                let layout = m.mesh;
                 m.core_cells = core;
                 match solver.as_str() {
                     "lu" => {
