@@ -261,11 +261,9 @@ def forces(dat):
     txt = open(dat).read()
     pat = re.compile(r"total force \(fx,fy,fz\) for set NNEEDLE and time\s+(\S+)\s+(\S+)\s+(\S+)\s+(\S+)")
     rows = [(float(m.group(1)), float(m.group(4))) for m in pat.finditer(txt)]
-    # step 1 reports time 1.0 at rest (force ~0); keep step 2's points
-    out = []
-    for t, fz in rows:
-        out.append((t, 4.0 * fz / 1000.0))
-    return out
+    # total time = 1 (the dummy step at rest) + depth; the needle's
+    # reaction is along -z, the force positive in compression
+    return [(round(t - 1.0, 9), -4.0 * fz / 1000.0) for t, fz in rows if t > 1.0 + 1e-9]
 
 
 def main():
