@@ -297,12 +297,12 @@ pub struct N3NeedleSpec {
     pub tool: Option<String>,
 }
 
-/// The default N3 mesh: level 1 (0.8 mm hexahedra, 10,125 unknowns, peak
-/// 0.4 GiB; level 2 (17,400 cells) has ~7x the unknowns and its sparse LU peaks above
-/// 10 GiB, docs/validation/fe.md "N3").
+/// The default N3 mesh: level 1 (the box of 0.8 mm hexahedra, 2,340 cells,
+/// 10,125 equations; level 2 has 17,400 cells, ~70,000 equations;
+/// docs/validation/fe.md "N3").
 pub const N3_DEFAULT_MESH: &str = "coarse";
-/// The finest N3 level accepted: level 3 (~40,000 hexahedra) would need
-/// more memory and time than a 2-core, few-GiB machine has.
+/// The finest N3 level accepted: level 3 (the box: ~57,000 hexahedra)
+/// would need more memory and time than a 2-core, few-GiB machine has.
 pub const N3_MAX_LEVEL: usize = 2;
 
 /// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
@@ -567,8 +567,8 @@ impl ModelSpec {
                         "mesh",
                         text,
                         format!(
-                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} displacement unknowns, beyond this machine's memory and time (measured peaks: level 1 0.4 GiB, level 2 over 10 GiB)",
-                            n3_unknowns(level)
+                            "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} equations, beyond this machine's memory and time (docs/validation/fe.md, N3)",
+                            n3_equations(level)
                         ),
                     ));
                 }
@@ -654,12 +654,12 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
     Ok(m)
 }
 
-/// The displacement unknowns of N3 mesh `level` (3 per node), counted from
-/// its grading without building the mesh.
-fn n3_unknowns(level: usize) -> usize {
-    let g = palpate_fe::n3_grading(level);
-    let n = |l: f64| g.positions(l).map_or(0, |p| p.len());
-    3 * n(35.0) * n(40.0) * n(80.0)
+/// The equations of N3 mesh `level` (the default box), counted from its
+/// grading without building the mesh.
+fn n3_equations(level: usize) -> usize {
+    let mut m = N3Needle::new(Law::NeoHookean);
+    m.level = level;
+    m.mesh_size().map_or(0, |(_, _, e)| e)
 }
 
 /// What a `homogeneous` spec's `mode` names.

@@ -8,13 +8,14 @@
 //! 10 mm (whole block) and how far the run got.
 //!
 //! `cargo run --release -p palpate-fe --example bench_n3 -- [level ...]
-//!  [--depth D] [--law nh|rp2|both] [--friction 0|0.8|both] [--grading h,zone,growth]`
+//!  [--depth D] [--law nh|rp2|both] [--friction 0|0.8|both] [--grading h,zone,growth]
+//!  [--mesh ogrid|box] [--core N] [--max-step S]`
 
 use std::time::Instant;
 
 use palpate_core::{Drive, ForwardError, Loading};
 use palpate_fe::mesh::Grading;
-use palpate_fe::N3Needle;
+use palpate_fe::{N3Mesh, N3Needle};
 
 #[path = "common/cpu.rs"]
 mod cpu;
@@ -38,11 +39,22 @@ fn main() {
     let mut frictions = vec![0.0, 0.8];
     let mut grading: Option<Grading> = None;
     let mut max_step: Option<f64> = None;
+    let mut layout: Option<N3Mesh> = None;
+    let mut core: Option<usize> = None;
+    let mut solver = String::from("default");
     let mut it = args.iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().expect("a value after the option").clone();
         match a.as_str() {
             "--depth" => depth = value().parse().expect("depth"),
+            "--mesh" => {
+                layout = Some(match value().as_str() {
+                    "box" => N3Mesh::Box,
+                    _ => N3Mesh::OGrid,
+                })
+            }
+            "--solver" => solver = value(),
+            "--core" => core = Some(value().parse().expect("core cells")),
             "--max-step" => max_step = Some(value().parse().expect("max step")),
             "--law" => {
                 laws = match value().as_str() {
@@ -91,25 +103,47 @@ fn main() {
                 let mut m = N3Needle::new(l.parse().expect("law"));
                 m.level = level;
                 m.grading = grading;
+                if let Some(l) = layout {
+                    m.mesh = l;
+                }
+                let layout = m.mesh;
+                m.core_cells = core;
+                match solver.as_str() {
+                    "lu" => {
+                        m.options.gmres = false;
+                        m.options.symmetric = false;
+                    }
+                    "gmres" => m.options.gmres = true,
+                    "ldlt" => m.options.symmetric = true,
+                    _ => {}
+                }
                 m.friction = mu;
                 if let Some(s) = max_step {
                     m.options.max_step = s;
                 }
                 let label = match grading {
-                    Some(g) => format!("grading {}/{}/{}", g.h_fine, g.fine_length, g.growth),
-                    None => format!("level {level}"),
+                    Some(g) => format!("{layout:?} {}/{}/{}", g.h_fine, g.fine_length, g.growth),
+                    None => format!("{layout:?} level {level}"),
                 };
                 let (t, c) = (Instant::now(), cpu_seconds(false));
                 let result = m.simulate(&theta, &loading, None);
                 let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(false) - c);
+                let mut linear = String::new();
                 let (forces, stats, cells, unknowns, reached) = match result {
-                    Ok((sim, sys)) => (
-                        sim.forces,
-                        Some(sim.stats),
-                        sys.mesh.cell_count(),
-                        sys.equations(),
-                        depth,
-                    ),
+                    Ok((sim, sys)) => {
+                        let (gs, gi, gf, lf, len) = sys.linear_solver_stats();
+                        linear = format!(
+                            "  gmres {gs} solves {gi} iterations {gf} to LU; ldlt->LU {lf}; L entries {}",
+                            len.map_or("-".into(), |l| l.to_string())
+                        );
+                        (
+                            sim.forces,
+                            Some(sim.stats),
+                            sys.mesh.cell_count(),
+                            sys.equations(),
+                            depth,
+                        )
+                    }
                     Err(ForwardError::NotConverged { completed, .. }) => {
                         let r = 0.25 * completed.len() as f64;
                         (completed, None, 0, 0, r)
@@ -125,7 +159,7 @@ fn main() {
                     (s.increments, s.iterations, s.factorisations)
                 });
                 println!(
-                    "{label:<28} {law:>5} {mu:>4} {cells:>7} {unknowns:>8} {inc:>5} {iters:>5} {fact:>5} {wall:>7.1} {cpu:>7.1} {:>8.0} {:>10} {:>10} {:>10}  {reached} mm",
+                    "{label:<28} {law:>5} {mu:>4} {cells:>7} {unknowns:>8} {inc:>5} {iters:>5} {fact:>5} {wall:>7.1} {cpu:>7.1} {:>8.0} {:>10} {:>10} {:>10}  {reached} mm{linear}",
                     peak_rss_mib(),
                     at(2.0),
                     at(5.0),

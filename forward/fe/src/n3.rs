@@ -36,11 +36,13 @@ use crate::system::{SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::FeError;
 
-/// The N3 grading of mesh level `n` (the same in x, y and z from the
-/// needle): elements of `0.8 / n` mm over a 4 mm zone, growing by
-/// `1 + 0.4 / n` beyond it. Level 1 has 2,340 hexahedra (10,125 unknowns,
-/// 0.43 GiB peak, 25-41 s of CPU to 10 mm); level 2 has ~7x the unknowns
-/// (17,400 cells) and its LU does not fit in 10 GiB (docs/validation/fe.md, N3).
+/// The N3 grading of mesh level `n` (radially and in z from the needle):
+/// elements of `0.8 / n` mm over a 4 mm zone, growing by `1 + 0.4 / n`
+/// beyond it; the O-grid has `3n` core cells per side ([`n3_core_cells`]).
+/// O-grid level 1 has 945 hexahedra (4,110 equations), level 2 7,308
+/// (30,479), level 3 24,381 (100,276, beyond 2 GiB). The box of the same
+/// grading (`N3Mesh::Box`) has 2,340 hexahedra at level 1 and 17,400 at
+/// level 2 (docs/validation/fe.md, N3).
 pub fn n3_grading(level: usize) -> Grading {
     let n = level.max(1) as f64;
     Grading {
@@ -48,6 +50,27 @@ pub fn n3_grading(level: usize) -> Grading {
         fine_length: 4.0,
         growth: 1.0 + 0.4 / n,
     }
+}
+
+/// How the N3 quarter block is meshed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum N3Mesh {
+    /// The quarter O-grid ([`Mesh::quarter_ogrid`]): rings of hexahedra
+    /// around the needle's axis, fine radially and in z under the needle,
+    /// blended to the rectangular outer boundary.
+    OGrid,
+    /// The graded tensor box ([`Mesh::graded_box`], the same grading in x,
+    /// y and z): fine lines repeated across the whole block.
+    Box,
+}
+
+/// The number of O-grid core cells per side for elements of `h_fine` mm:
+/// a core of about 2.4 mm (`round(2.4 / h)`, at least 2: 3 per 0.8 mm, so
+/// levels 1, 2, 3 have 3, 6, 9 and the cells around a ring are refined with
+/// the radial ones), whose rings have `2n` cells of `pi r / 4n` mm around.
+pub fn n3_core_cells(h_fine: f64) -> usize {
+    ((2.4 / h_fine).round() as usize).max(2)
 }
 
 /// The N3 model.
@@ -59,9 +82,16 @@ pub struct N3Needle {
     pub tool: ToolShape,
     /// Mesh level ([`n3_grading`]); 1 coarse, 2 medium, 3 fine.
     pub level: usize,
-    /// When set, this grading (x, y from the axis and z from the top)
-    /// replaces the one of `level`.
+    /// The mesh layout (default the box, the mesh of the mesa2011 study;
+    /// the O-grid is 2.5-8x smaller for the same element size under the
+    /// needle but, at level 1, 1.2 % stiffer at 10 mm: docs/validation/fe.md, N3).
+    pub mesh: N3Mesh,
+    /// When set, this grading (radial and z from the needle) replaces the
+    /// one of `level`.
     pub grading: Option<Grading>,
+    /// When set, the O-grid's core cells per side ([`n3_core_cells`] of the
+    /// grading otherwise).
+    pub core_cells: Option<usize>,
     /// Quarter-block sizes (mm): x, y, height.
     pub size: [f64; 3],
     /// Height of the tool tip above the top face at the start (mm); a
@@ -79,8 +109,11 @@ pub struct N3Needle {
 
 impl N3Needle {
     /// BENCHMARKS.md N3 with the given law: friction 0.8, exact
-    /// incompressibility, mesh level 1, contact at the facet Gauss points,
-    /// multipliers updated once per increment (as N1).
+    /// incompressibility, the box of mesh level 1, contact at the facet
+    /// Gauss points, multipliers updated once per increment (as N1), each
+    /// Newton system solved by GMRES on the LDL^T of the tangent's
+    /// symmetric part (`options.gmres`; the LU's fill in 3D is many times
+    /// larger).
     pub fn new(law: Law) -> Self {
         N3Needle {
             space: law_space(&law),
@@ -89,7 +122,9 @@ impl N3Needle {
             friction: 0.8,
             tool: ToolShape::n1_needle(),
             level: 1,
+            mesh: N3Mesh::Box,
             grading: None,
+            core_cells: None,
             size: [35.0, 40.0, 80.0],
             start_gap: 0.0,
             penalty: 100.0,
@@ -99,6 +134,7 @@ impl N3Needle {
                 max_step: 0.25,
                 first_step: 0.05,
                 max_augmentations: 0,
+                gmres: true,
                 ..SolverOptions::default()
             },
             friction_is_parameter: false,
@@ -109,32 +145,81 @@ impl N3Needle {
         self.grading.unwrap_or_else(|| n3_grading(self.level))
     }
 
-    /// The estimated peak memory of a run (bytes) from the number of
-    /// equations, counted from the grading without building anything:
-    /// `1.6 GiB x (equations / 24,500)^1.8`, through the measured peak of
-    /// the 0.6 mm mesh (24,500 equations, 1.6 GiB) with the exponent that
-    /// level 2's lower bound needs (> 10.5 GiB at ~70,000; level 1 at 10,125
-    /// equations measured 0.43 GiB, estimated 0.33). docs/validation/fe.md, N3.
-    pub fn memory_estimate(&self) -> Result<f64, FeError> {
+    /// The O-grid's core cells per side.
+    fn effective_core_cells(&self) -> usize {
+        self.core_cells
+            .unwrap_or_else(|| n3_core_cells(self.effective_grading().h_fine))
+    }
+
+    /// The radius (mm) up to which the O-grid's rings are circles.
+    fn circle_radius(&self) -> f64 {
+        0.5 * self.size[0].min(self.size[1])
+    }
+
+    /// Nodes, cells and equations of the mesh, counted from the grading
+    /// without building it.
+    pub fn mesh_size(&self) -> Result<(usize, usize, usize), FeError> {
         let g = self.effective_grading();
         let [lx, ly, lz] = self.size;
-        let (nx, ny, nz) = (
-            g.positions(lx)?.len(),
-            g.positions(ly)?.len(),
-            g.positions(lz)?.len(),
-        );
-        let cells = (nx - 1) * (ny - 1) * (nz - 1);
+        let nz = g.positions(lz)?.len();
+        let (plane_nodes, plane_cells, sym_nodes) = match self.mesh {
+            N3Mesh::Box => {
+                let (nx, ny) = (g.positions(lx)?.len(), g.positions(ly)?.len());
+                (nx * ny, (nx - 1) * (ny - 1), nx + ny)
+            }
+            N3Mesh::OGrid => {
+                let n = self.effective_core_cells();
+                let k = g.positions(lx.min(ly))?.len() - 1;
+                let rings = k.saturating_sub(n);
+                (
+                    (n + 1) * (n + 1) + rings * (2 * n + 1),
+                    n * n + rings * 2 * n,
+                    2 * (k + 1),
+                )
+            }
+        };
+        let nodes = plane_nodes * nz;
+        let cells = plane_cells * (nz - 1);
         // displacements less the fixed ones (bottom, two symmetry planes),
         // plus one pressure per cell
-        let equations = (3 * nx * ny * nz).saturating_sub(3 * nx * ny + ny * nz + nx * nz) + cells;
-        Ok(1.6 * GIB * (equations as f64 / 24_500.0).powf(1.8))
+        let equations = (3 * nodes).saturating_sub(3 * plane_nodes + sym_nodes * (nz - 1)) + cells;
+        Ok((nodes, cells, equations))
+    }
+
+    /// The estimated peak memory of a run (bytes) from the number of
+    /// equations ([`N3Needle::mesh_size`]), without building anything.
+    /// O-grid (LDL^T and GMRES): `0.6 GiB x (equations / 30,500)^1.25`,
+    /// through the measured peaks of O-grid levels 1, 1.5 and 2 (4,110,
+    /// 13,248 and 30,479 equations: 0.05, 0.2 and 0.6 GiB) with a slightly
+    /// steeper exponent than they show (1.2). Box (the LU of the first N3):
+    /// `1.6 GiB x (equations / 24,500)^1.8`, through the 0.6 mm box's peak
+    /// (24,500 equations, 1.6 GiB) with the exponent its level 2's lower
+    /// bound needs (> 10.5 GiB at ~70,000). docs/validation/fe.md, N3.
+    pub fn memory_estimate(&self) -> Result<f64, FeError> {
+        let (_, _, equations) = self.mesh_size()?;
+        let e = equations as f64;
+        Ok(match self.mesh {
+            N3Mesh::OGrid => 0.6 * GIB * (e / 30_500.0).powf(1.25),
+            N3Mesh::Box => 1.6 * GIB * (e / 24_500.0).powf(1.8),
+        })
     }
 
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
         let [lx, ly, lz] = self.size;
-        Mesh::graded_box(lx, ly, lz, g, g, g)
+        match self.mesh {
+            N3Mesh::Box => Mesh::graded_box(lx, ly, lz, g, g, g),
+            N3Mesh::OGrid => Mesh::quarter_ogrid(
+                lx,
+                ly,
+                lz,
+                g,
+                g,
+                self.effective_core_cells(),
+                self.circle_radius(),
+            ),
+        }
     }
 
     /// The coarser companion of the error estimate: elements twice as large
@@ -149,6 +234,7 @@ impl N3Needle {
         };
         let mut model = self.clone();
         model.grading = Some(coarse);
+        model.core_cells = Some((self.effective_core_cells() / 2).max(2));
         Coarser {
             model,
             ratio: 2.0,

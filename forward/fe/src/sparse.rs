@@ -1,7 +1,10 @@
 //! The global sparse tangent: a compressed-column pattern built once from the
 //! element connectivity, and faer's sparse LU (unsymmetric, partial pivoting)
 //! whose symbolic analysis (ordering, elimination structure) is computed once
-//! and reused for every numeric factorisation.
+//! and reused for every numeric factorisation. Optionally a symmetric LDL^T
+//! factorisation instead: of the tangent itself when it is symmetric, or of
+//! its symmetric part as the preconditioner of GMRES ([`crate::gmres`]) when
+//! it is not (3D meshes, where the LU's fill is many times the LDL^T's).
 
 use faer::dyn_stack::{MemBuffer, MemStack};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
@@ -16,6 +19,7 @@ use faer::sparse::linalg::SupernodalThreshold;
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMat};
 use faer::{Conj, Par, Side};
 
+use crate::gmres::{gmres, GmresOutcome};
 use crate::FeError;
 
 /// Marks a constrained (eliminated) degree of freedom.
@@ -105,10 +109,10 @@ impl Pattern {
 /// and the callers (several evaluators) hold the cores.
 pub struct SparseLu {
     symbolic_mat: SymbolicSparseColMat<usize>,
-    symbolic_lu: SymbolicLu<usize>,
+    /// The LU's symbolic analysis, made at the first LU factorisation (a
+    /// run that only uses the LDL^T never pays for it).
+    lu: Option<LuSymbolic>,
     numeric: NumericLu<usize, f64>,
-    factor_scratch: MemBuffer,
-    solve_scratch: MemBuffer,
     /// Number of numeric factorisations done.
     pub factorisations: usize,
     /// Whether `numeric` holds valid factors.
@@ -119,7 +123,33 @@ pub struct SparseLu {
     ldlt_factored: bool,
     /// Symmetric factorisations that met a zero pivot and fell back to LU.
     pub ldlt_fallbacks: usize,
+    /// How the LDL^T is used: `None` not at all, `Some(false)` the tangent
+    /// is symmetric, `Some(true)` GMRES on the tangent with the LDL^T of its
+    /// symmetric part as preconditioner.
+    mode: Option<bool>,
+    /// Equations from this one on are owned unknowns (pressures: zero or
+    /// negative diagonal), ordered after their neighbours for the LDL^T.
+    first_owned: usize,
+    /// The values of the last factorised matrix (GMRES multiplies by it).
+    values: Vec<f64>,
+    /// Slot of the transposed entry of each slot (GMRES mode).
+    transpose: Vec<usize>,
+    /// GMRES solves and their iterations; solves that fell back to the LU.
+    pub gmres_solves: usize,
+    pub gmres_iterations: usize,
+    pub gmres_fallbacks: usize,
 }
+
+/// The LU's symbolic analysis and its scratch.
+struct LuSymbolic {
+    symbolic: SymbolicLu<usize>,
+    factor_scratch: MemBuffer,
+    solve_scratch: MemBuffer,
+}
+
+/// GMRES relative residual target and iteration limit (one restart cycle).
+const GMRES_TOLERANCE: f64 = 1e-10;
+const GMRES_MAX_ITERATIONS: usize = 80;
 
 /// A sparse LDL^T factorisation (faer's supernodal Cholesky without
 /// pivoting: fill-reducing AMD ordering computed once), for tangents that are
@@ -134,7 +164,7 @@ struct Ldlt {
 }
 
 impl SparseLu {
-    /// Symbolic analysis of `pattern`.
+    /// Symbolic analysis of `pattern` (the LU's is made on first use).
     pub fn new(pattern: &Pattern) -> Result<SparseLu, FeError> {
         let symbolic_mat = SymbolicSparseColMat::new_checked(
             pattern.n,
@@ -143,32 +173,61 @@ impl SparseLu {
             None,
             pattern.row_idx.clone(),
         );
-        let symbolic_lu = factorize_symbolic_lu(
-            symbolic_mat.as_ref(),
-            LuSymbolicParams {
-                supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
-                ..Default::default()
-            },
-        )
-        .map_err(|e| FeError::Factorisation {
-            reason: format!("symbolic analysis: {e:?}"),
-        })?;
-        let factor_scratch = MemBuffer::new(
-            symbolic_lu.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
-        );
-        let solve_scratch = MemBuffer::new(symbolic_lu.solve_in_place_scratch::<f64>(1, Par::Seq));
         Ok(SparseLu {
             symbolic_mat,
-            symbolic_lu,
+            lu: None,
             numeric: NumericLu::new(),
-            factor_scratch,
-            solve_scratch,
             factorisations: 0,
             factored: false,
             ldlt: None,
             ldlt_factored: false,
             ldlt_fallbacks: 0,
+            mode: None,
+            first_owned: pattern.n,
+            values: Vec::new(),
+            transpose: Vec::new(),
+            gmres_solves: 0,
+            gmres_iterations: 0,
+            gmres_fallbacks: 0,
         })
+    }
+
+    /// Marks the equations from `first` on as owned unknowns (the pressures
+    /// of a mixed element): the LDL^T orders each right after the last of
+    /// its displacement neighbours, so its pivot is the (negative) Schur
+    /// complement of the displacements already eliminated, never the zero
+    /// diagonal of an exactly incompressible element.
+    pub fn set_first_owned(&mut self, first: usize) {
+        if first != self.first_owned {
+            self.first_owned = first.min(self.symbolic_mat.nrows());
+            self.ldlt = None;
+            self.mode = None;
+        }
+    }
+
+    fn lu_symbolic(&mut self) -> Result<&mut LuSymbolic, FeError> {
+        if self.lu.is_none() {
+            let symbolic = factorize_symbolic_lu(
+                self.symbolic_mat.as_ref(),
+                LuSymbolicParams {
+                    supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
+                    ..Default::default()
+                },
+            )
+            .map_err(|e| FeError::Factorisation {
+                reason: format!("symbolic analysis: {e:?}"),
+            })?;
+            let factor_scratch = MemBuffer::new(
+                symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+            );
+            let solve_scratch = MemBuffer::new(symbolic.solve_in_place_scratch::<f64>(1, Par::Seq));
+            self.lu = Some(LuSymbolic {
+                symbolic,
+                factor_scratch,
+                solve_scratch,
+            });
+        }
+        Ok(self.lu.as_mut().expect("made above"))
     }
 
     /// Uses a symmetric LDL^T factorisation (the lower triangle of the
@@ -177,19 +236,56 @@ impl SparseLu {
     /// is not read. A factorisation that meets a zero pivot falls back to
     /// the LU (counted in [`SparseLu::ldlt_fallbacks`]).
     pub fn set_symmetric(&mut self, symmetric: bool) -> Result<(), FeError> {
-        if !symmetric {
-            self.ldlt = None;
-            self.ldlt_factored = false;
-            self.factored = false;
+        self.set_mode(symmetric.then_some(false))
+    }
+
+    /// Solves with GMRES preconditioned by the LDL^T of the matrix's
+    /// symmetric part `(A + A^T) / 2` (`true`; a solve that does not reach
+    /// a relative residual of 1e-10 in 80 iterations falls back to the LU),
+    /// or with the LU again (`false`). For unsymmetric tangents whose
+    /// unsymmetric part is small and local (frictional contact on a 3D
+    /// body).
+    pub fn set_gmres(&mut self, gmres: bool) -> Result<(), FeError> {
+        self.set_mode(gmres.then_some(true))
+    }
+
+    fn set_mode(&mut self, mode: Option<bool>) -> Result<(), FeError> {
+        if mode == self.mode {
             return Ok(());
+        }
+        self.mode = mode;
+        self.factored = false;
+        self.ldlt_factored = false;
+        if mode.is_none() {
+            self.ldlt = None;
+            return Ok(());
+        }
+        if mode == Some(true) && self.transpose.is_empty() {
+            let m = self.symbolic_mat.as_ref();
+            let mut t = vec![NONE; m.compute_nnz()];
+            for c in 0..m.ncols() {
+                let start = m.col_ptr()[c];
+                for (k, &r) in m.row_idx()[start..m.col_ptr()[c + 1]].iter().enumerate() {
+                    let rows = &m.row_idx()[m.col_ptr()[r]..m.col_ptr()[r + 1]];
+                    t[start + k] =
+                        rows.binary_search(&c)
+                            .map(|i| m.col_ptr()[r] + i)
+                            .map_err(|_| FeError::Factorisation {
+                                reason: "GMRES needs a structurally symmetric pattern".into(),
+                            })?;
+                }
+            }
+            self.transpose = t;
         }
         if self.ldlt.is_some() {
             return Ok(());
         }
+        let (fwd, inv) = owned_last_amd(self.symbolic_mat.as_ref(), self.first_owned)?;
+        let perm = faer::perm::PermRef::new_checked(&fwd, &inv, fwd.len());
         let symbolic = factorize_symbolic_cholesky(
             self.symbolic_mat.as_ref(),
             Side::Lower,
-            SymmetricOrdering::Amd,
+            SymmetricOrdering::Custom(perm),
             CholeskySymbolicParams::default(),
         )
         .map_err(|e| FeError::Factorisation {
@@ -208,6 +304,11 @@ impl SparseLu {
         Ok(())
     }
 
+    /// Stored entries of the LDL^T factor (when enabled).
+    pub fn ldlt_len(&self) -> Option<usize> {
+        self.ldlt.as_ref().map(|l| l.symbolic.len_val())
+    }
+
     /// Factorises the matrix with values `values` (in pattern order) and
     /// overwrites `rhs` with the solution.
     pub fn solve(&mut self, values: &[f64], rhs: &mut [f64]) -> Result<(), FeError> {
@@ -220,8 +321,22 @@ impl SparseLu {
     pub fn factorize(&mut self, values: &[f64]) -> Result<(), FeError> {
         self.factored = false;
         self.ldlt_factored = false;
-        let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), values);
-        if let Some(l) = self.ldlt.as_mut() {
+        if let Some(gmres) = self.mode {
+            let sym;
+            let factor_values: &[f64] = if gmres {
+                self.values.clear();
+                self.values.extend_from_slice(values);
+                sym = values
+                    .iter()
+                    .zip(&self.transpose)
+                    .map(|(v, &t)| 0.5 * (v + values[t]))
+                    .collect::<Vec<f64>>();
+                &sym
+            } else {
+                values
+            };
+            let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), factor_values);
+            let l = self.ldlt.as_mut().expect("made by set_mode");
             let ok = l
                 .symbolic
                 .factorize_numeric_ldlt(
@@ -243,12 +358,19 @@ impl SparseLu {
             }
             self.ldlt_fallbacks += 1;
         }
-        self.symbolic_lu
+        self.factorize_lu(values)
+    }
+
+    fn factorize_lu(&mut self, values: &[f64]) -> Result<(), FeError> {
+        self.lu_symbolic()?;
+        let lu = self.lu.as_mut().expect("made above");
+        let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), values);
+        lu.symbolic
             .factorize_numeric_lu(
                 &mut self.numeric,
                 mat,
                 Par::Seq,
-                MemStack::new(&mut self.factor_scratch),
+                MemStack::new(&mut lu.factor_scratch),
                 Default::default(),
             )
             .map_err(|e| FeError::Factorisation {
@@ -256,6 +378,7 @@ impl SparseLu {
             })?;
         self.factorisations += 1;
         self.factored = true;
+        self.ldlt_factored = false;
         Ok(())
     }
 
@@ -267,6 +390,57 @@ impl SparseLu {
                 reason: "no factorisation to solve with".into(),
             });
         }
+        if self.ldlt_factored && self.mode == Some(true) {
+            self.gmres_solves += 1;
+            let l = self.ldlt.as_mut().expect("factored");
+            let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), &self.values);
+            let b = rhs.to_vec();
+            let outcome = gmres(
+                |x: &[f64], y: &mut [f64]| {
+                    y.iter_mut().for_each(|v| *v = 0.0);
+                    for c in 0..mat.ncols() {
+                        let xc = x[c];
+                        if xc == 0.0 {
+                            continue;
+                        }
+                        let (rows, vals) = (mat.row_idx_of_col_raw(c), mat.val_of_col(c));
+                        for (&r, &v) in rows.iter().zip(vals) {
+                            y[r] += v * xc;
+                        }
+                    }
+                },
+                |z: &mut [f64]| {
+                    LdltRef::new(&l.symbolic, &l.l_values).solve_in_place_with_conj(
+                        Conj::No,
+                        faer::ColMut::from_slice_mut(z).as_mat_mut(),
+                        Par::Seq,
+                        MemStack::new(&mut l.solve_scratch),
+                    )
+                },
+                &b,
+                rhs,
+                GMRES_TOLERANCE,
+                GMRES_MAX_ITERATIONS,
+            );
+            match outcome {
+                GmresOutcome::Converged { iterations } => {
+                    self.gmres_iterations += iterations;
+                }
+                GmresOutcome::NotConverged { iterations } => {
+                    self.gmres_iterations += iterations;
+                    self.gmres_fallbacks += 1;
+                    let values = std::mem::take(&mut self.values);
+                    let r = self.factorize_lu(&values);
+                    self.values = values;
+                    r?;
+                    rhs.copy_from_slice(&b);
+                    self.solve_lu(rhs)?;
+                    // the LU stays the factorisation of this matrix
+                    return check_finite(rhs);
+                }
+            }
+            return check_finite(rhs);
+        }
         match self.ldlt.as_mut() {
             Some(l) if self.ldlt_factored => LdltRef::new(&l.symbolic, &l.l_values)
                 .solve_in_place_with_conj(
@@ -275,20 +449,98 @@ impl SparseLu {
                     Par::Seq,
                     MemStack::new(&mut l.solve_scratch),
                 ),
-            _ => LuRef::new_unchecked(&self.symbolic_lu, &self.numeric).solve_in_place_with_conj(
-                Conj::No,
-                faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
-                Par::Seq,
-                MemStack::new(&mut self.solve_scratch),
-            ),
+            _ => self.solve_lu(rhs)?,
         }
-        if rhs.iter().any(|v| !v.is_finite()) {
-            return Err(FeError::Factorisation {
-                reason: "singular tangent (non-finite solution)".into(),
-            });
-        }
+        check_finite(rhs)
+    }
+
+    fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), FeError> {
+        let lu = self.lu.as_mut().ok_or_else(|| FeError::Factorisation {
+            reason: "no LU factorisation to solve with".into(),
+        })?;
+        LuRef::new_unchecked(&lu.symbolic, &self.numeric).solve_in_place_with_conj(
+            Conj::No,
+            faer::ColMut::from_slice_mut(rhs).as_mat_mut(),
+            Par::Seq,
+            MemStack::new(&mut lu.solve_scratch),
+        );
         Ok(())
     }
+}
+
+fn check_finite(x: &[f64]) -> Result<(), FeError> {
+    if x.iter().any(|v| !v.is_finite()) {
+        return Err(FeError::Factorisation {
+            reason: "singular tangent (non-finite solution)".into(),
+        });
+    }
+    Ok(())
+}
+
+/// The fill-reducing ordering of the LDL^T: approximate minimum degree
+/// (faer's AMD) on the pattern of the equations before `first_owned` (the
+/// displacements), then each owned unknown (a pressure) placed right after
+/// the last of its neighbours in that order. Its pivot is then the Schur
+/// complement `-g^T K^-1 g` of its eliminated displacements, negative for a
+/// positive definite displacement block, where AMD on the whole pattern
+/// would pick the pressures first (lowest degree) and meet their zero
+/// diagonal. Returns the forward and inverse permutations.
+fn owned_last_amd(
+    a: faer::sparse::SymbolicSparseColMatRef<'_, usize>,
+    first_owned: usize,
+) -> Result<(Vec<usize>, Vec<usize>), FeError> {
+    let n = a.ncols();
+    let m = first_owned.min(n);
+    // the displacement block's pattern
+    let mut col_ptr = Vec::with_capacity(m + 1);
+    let mut row_idx = Vec::new();
+    col_ptr.push(0);
+    for c in 0..m {
+        row_idx.extend(a.row_idx_of_col_raw(c).iter().copied().filter(|&r| r < m));
+        col_ptr.push(row_idx.len());
+    }
+    let mut fwd_m = vec![0usize; m];
+    let mut inv_m = vec![0usize; m];
+    if m > 0 {
+        let sub = SymbolicSparseColMat::new_checked(m, m, col_ptr, None, row_idx);
+        let nnz = sub.compute_nnz();
+        let mut mem = MemBuffer::try_new(faer::sparse::linalg::amd::order_scratch::<usize>(m, nnz))
+            .map_err(|_| FeError::Factorisation {
+                reason: "out of memory for the AMD ordering".into(),
+            })?;
+        faer::sparse::linalg::amd::order(
+            &mut fwd_m,
+            &mut inv_m,
+            sub.as_ref(),
+            Default::default(),
+            MemStack::new(&mut mem),
+        )
+        .map_err(|e| FeError::Factorisation {
+            reason: format!("AMD ordering: {e:?}"),
+        })?;
+    }
+    // owned unknowns by the position of their last displacement neighbour
+    let mut after: Vec<Vec<usize>> = vec![Vec::new(); m + 1];
+    for p in m..n {
+        let last = a
+            .row_idx_of_col_raw(p)
+            .iter()
+            .filter(|&&r| r < m)
+            .map(|&r| inv_m[r])
+            .max();
+        after[last.map_or(m, |t| t)].push(p);
+    }
+    let mut fwd = Vec::with_capacity(n);
+    for (t, &e) in fwd_m.iter().enumerate() {
+        fwd.push(e);
+        fwd.extend_from_slice(&after[t]);
+    }
+    fwd.extend_from_slice(&after[m]);
+    let mut inv = vec![0usize; n];
+    for (i, &e) in fwd.iter().enumerate() {
+        inv[e] = i;
+    }
+    Ok((fwd, inv))
 }
 
 #[cfg(test)]
@@ -387,5 +639,83 @@ mod tests {
             (b[0] - 3.0).abs() < 1e-14 && (b[1] - 2.0).abs() < 1e-14,
             "{b:?}"
         );
+    }
+
+    /// A saddle-point system like an exactly incompressible mixed element's
+    /// (displacements with a positive definite block, pressures with a zero
+    /// diagonal): the LDL^T with the pressures ordered after their
+    /// displacements solves it without falling back to the LU (AMD alone
+    /// would take a pressure first: zero pivot), and GMRES preconditioned
+    /// with the symmetric part solves an unsymmetric perturbation of it,
+    /// both as the LU does.
+    #[test]
+    fn owned_unknowns_last_and_gmres_solve_a_saddle_point_system() {
+        let (nu, np) = (24, 6);
+        let n = nu + np;
+        // "cells": 5 consecutive displacements and one pressure
+        let eqs: Vec<Vec<usize>> = (0..np)
+            .map(|j| {
+                let mut v: Vec<usize> = (4 * j..(4 * j + 5).min(nu)).collect();
+                v.push(nu + j);
+                v
+            })
+            .collect();
+        let p = Pattern::new(n, &eqs);
+        let mut vals = vec![0.0; p.nnz()];
+        let mut add = |r: usize, c: usize, v: f64| {
+            vals[p.slot(r, c).unwrap()] += v;
+        };
+        for (j, e) in eqs.iter().enumerate() {
+            let u = &e[..e.len() - 1];
+            for (a, &r) in u.iter().enumerate() {
+                add(r, r, 3.0 + 0.1 * r as f64);
+                if a + 1 < u.len() {
+                    add(r, u[a + 1], -1.0);
+                    add(u[a + 1], r, -1.0);
+                }
+                let g = 0.5 + 0.2 * ((a + j) % 3) as f64;
+                add(r, nu + j, g);
+                add(nu + j, r, g);
+            }
+        }
+        let rhs: Vec<f64> = (0..n).map(|i| ((i * 7) % 5) as f64 - 2.0).collect();
+        let solve = |vals: &[f64], mode: &str| {
+            let mut lu = SparseLu::new(&p).unwrap();
+            lu.set_first_owned(nu);
+            match mode {
+                "ldlt" => lu.set_symmetric(true).unwrap(),
+                "gmres" => lu.set_gmres(true).unwrap(),
+                _ => {}
+            }
+            let mut x = rhs.clone();
+            lu.solve(vals, &mut x).unwrap();
+            (x, lu.ldlt_fallbacks, lu.gmres_solves, lu.gmres_fallbacks)
+        };
+        let (x_lu, ..) = solve(&vals, "lu");
+        let (x_ldlt, fallbacks, ..) = solve(&vals, "ldlt");
+        assert_eq!(fallbacks, 0);
+        // an unsymmetric perturbation (friction-like, on a few displacements)
+        let mut skew = vals.clone();
+        for r in 0..6 {
+            skew[p.slot(r, r + 1).unwrap()] += 0.4;
+        }
+        let (x_lu2, ..) = solve(&skew, "lu");
+        let (x_gm, fallbacks, solves, gmres_fallbacks) = solve(&skew, "gmres");
+        assert_eq!((fallbacks, solves, gmres_fallbacks), (0, 1, 0));
+        for i in 0..n {
+            assert!((x_lu[i] - x_ldlt[i]).abs() < 1e-10, "{i}");
+            assert!((x_lu2[i] - x_gm[i]).abs() < 1e-8, "{i}");
+        }
+        // the ordering puts every pressure after its displacements
+        let (fwd, inv) = owned_last_amd(p_symbolic(&p).as_ref(), nu).unwrap();
+        assert_eq!(fwd.len(), n);
+        for (j, e) in eqs.iter().enumerate() {
+            let last = e[..e.len() - 1].iter().map(|&r| inv[r]).max().unwrap();
+            assert!(inv[nu + j] > last, "pressure {j}");
+        }
+    }
+
+    fn p_symbolic(p: &Pattern) -> SymbolicSparseColMat<usize> {
+        SymbolicSparseColMat::new_checked(p.n, p.n, p.col_ptr.clone(), None, p.row_idx.clone())
     }
 }

@@ -39,6 +39,14 @@ pub struct SolverOptions {
     /// pivot. Default `false`. A model must set it only when every
     /// contribution's tangent is symmetric: the upper triangle is not read.
     pub symmetric: bool,
+    /// Solve each Newton system by GMRES preconditioned with the LDL^T
+    /// factors of the tangent's symmetric part (owned pressures ordered
+    /// after their displacements), falling back to the LU when a solve does
+    /// not converge ([`crate::sparse::SparseLu::set_gmres`]). For 3D meshes
+    /// with frictional contact (N3), whose LU fills many times more than the
+    /// symmetric factorisation. Ignored when `symmetric` is set. Default
+    /// `false`.
+    pub gmres: bool,
     /// For timed histories: the largest time increment (s). `None`: time
     /// does not limit increments (rate-independent materials: a hold at
     /// constant drive costs no increment, and `dt` still reaches the
@@ -65,6 +73,7 @@ impl Default for SolverOptions {
             stagnation_tolerance: 1e-4,
             reuse_factorisation: true,
             symmetric: false,
+            gmres: false,
             max_time_step: None,
             max_update: None,
         }
@@ -180,7 +189,9 @@ impl System {
             );
         }
         let pattern = Pattern::new(dofs.equations, &groups);
-        let lu = SparseLu::new(&pattern)?;
+        let mut lu = SparseLu::new(&pattern)?;
+        // node displacements are numbered first, owned unknowns after them
+        lu.set_first_owned(dofs.equations - extra);
         let n = dofs.len();
         let length_scale = mesh.extent();
         let nnz = pattern.nnz();
@@ -229,6 +240,19 @@ impl System {
         self.contributions
             .get(index)
             .and_then(|c| c.as_any().downcast_ref::<T>())
+    }
+
+    /// The linear solver's counters: GMRES solves, their iterations and
+    /// fallbacks to the LU, LDL^T fallbacks to the LU, and the stored
+    /// entries of the LDL^T factor (when used).
+    pub fn linear_solver_stats(&self) -> (usize, usize, usize, usize, Option<usize>) {
+        (
+            self.lu.gmres_solves,
+            self.lu.gmres_iterations,
+            self.lu.gmres_fallbacks,
+            self.lu.ldlt_fallbacks,
+            self.lu.ldlt_len(),
+        )
     }
 
     /// Number of equations.
@@ -391,7 +415,11 @@ impl System {
     /// backtracking line search).
     pub(crate) fn newton(&mut self, target: &Target, opts: &SolverOptions) -> Result<(), FeError> {
         self.prescribe(target);
-        self.lu.set_symmetric(opts.symmetric)?;
+        if opts.symmetric {
+            self.lu.set_symmetric(true)?;
+        } else {
+            self.lu.set_gmres(opts.gmres)?;
+        }
         let mut a = self.assemble(target, true)?;
         let mut du = vec![0.0; self.dofs.equations];
         let mut chord = false;

@@ -12,6 +12,7 @@
 //! * [`gmsh`] — reader for Gmsh MSH 4.1 ASCII files (physical groups become
 //!   regions, facet sets and node sets).
 //! * [`jacobian`] — corner Jacobian determinants (the inversion test).
+//! * [`ogrid`] — the quarter O-grid of hexahedra around a tool's axis (N3).
 //! * [`quadratic`] — order elevation, 4-node to 9-node quadrilaterals.
 //! * [`vtu`] — VTK XML UnstructuredGrid output of a mesh or a facet set,
 //!   any cell type, with point and cell data.
@@ -24,6 +25,7 @@ pub mod grading;
 pub mod inclusions;
 pub mod jacobian;
 pub mod locate;
+pub mod ogrid;
 pub mod quadratic;
 pub mod structured;
 pub mod vtu;
