@@ -1,18 +1,33 @@
-//! Gap diagnosis on every FE model (issue 14, item 5) — the cheap part that
-//! runs in CI; the heavier runs are release examples
-//! (`examples/gap_fe_effects.rs`).
+//! Gap diagnosis on every FE model (issue 14, item 5). The cheap tests run
+//! in CI; the full diagnoses of the development records are `#[ignore]`d
+//! (minutes of CPU each) and run with
+//!
+//!     cargo test -p palpate-tests --test gap_fe_effects -- --ignored
+//!
+//! (or the release example `examples/gap_fe_effects.rs`, which prints the
+//! table of docs/gap-diagnosis.md).
 //!
 //! * Q1 (`viscoelasticity`): the enrichment's "off" point and its
-//!   relaxation. The diagnosis of the records of `tests/data/gap-q1/` (ten
-//!   minutes of CPU) is the release example's.
+//!   relaxation; the records of `tests/data/gap-q1/`.
 //! * N1 -> N3 (`modelling_space`): the enrichment is the 3D model of the
 //!   same needle, law and friction, with the same parameters (a discrete
-//!   switch), offered only where N3 has the same physics.
+//!   switch), offered only where N3 has the same physics; the records of
+//!   `tests/data/gap-n3/`.
+//! * R2 (`inclusion`, `friction`, `boundary_condition`): the enrichments on
+//!   a coarse pass; the records of `tests/data/gap-r2/`.
 
 use palpate_core::enrichable::{effects_of, embed, enrich};
-use palpate_core::{Drive, Effect, ForwardModel, Loading};
-use palpate_fe::{N1Needle, Q1Punch};
+use palpate_core::{Drive, Effect, ForwardModel, Loading, Table};
+use palpate_fe::{MeshDensity, N1Needle, Q1Punch, R2Gap};
 use palpate_material::Law;
+use palpate_tests::r2_dev;
+use palpate_uq::gap::{diagnose, GapOptions, GapReport};
+use rayon::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Largest relative difference of the R2 pass with a contrast-1 nodule (its
+/// O-grid mesh) from the base's pass on the coarse mesh.
+const R2_OFF_TOL: f64 = 0.01;
 
 /// The `viscoelasticity` enrichment of Q1: "off" (g1 = 0) is the elastic
 /// model bit for bit; with relaxation the force falls during the hold
@@ -68,4 +83,205 @@ fn modelling_space_turns_the_axisymmetric_needle_into_the_3d_one() {
     assert!(!effects_of(sliding.as_ref()).contains(&Effect::ModellingSpace));
     let rough = enrich(&n1, Effect::Friction).unwrap();
     assert!(!effects_of(rough.as_ref()).contains(&Effect::ModellingSpace));
+}
+
+// ---------------------------------------------------------------- R2 ----
+
+/// The R2 effects on a coarse development pass (4 mm elements, a sample
+/// every 4 mm): at contrast 1 the added nodule is tissue and the pass is
+/// the base's to within the two meshes' discretisation; a stiff nodule
+/// raises the force most where the wheel passes over it; a sliding bottom
+/// softens the thin block; friction changes the vertical force of a rolled
+/// pass (a path-dependent contact, never the press shortcut).
+#[test]
+fn r2_effects_on_a_coarse_pass() {
+    let loading = r2_dev::loading(4.0);
+    let base = R2Gap::new(r2_dev::rolling(4.0), 1.0);
+    assert_eq!(
+        effects_of(&base),
+        [
+            Effect::Inclusion,
+            Effect::Friction,
+            Effect::BoundaryCondition
+        ]
+    );
+    let c10 = 2.5e-3;
+    let f0 = base.predict(&[c10], &loading).unwrap();
+    let inclusion = enrich(&base, Effect::Inclusion).unwrap();
+    let off = embed(inclusion.as_ref(), &[c10]);
+    assert_eq!(off[1], 1.0);
+    let f_off = inclusion.predict(&off, &loading).unwrap();
+    for (a, b) in f_off.iter().zip(&f0) {
+        assert!((a - b).abs() < R2_OFF_TOL * b, "{f_off:?} vs {f0:?}");
+    }
+    let f_in = inclusion
+        .predict(&[c10, 14.7, 44.0, 10.0], &loading)
+        .unwrap();
+    let gain: Vec<f64> = f_in.iter().zip(&f0).map(|(a, b)| a / b - 1.0).collect();
+    let (k_max, g_max) =
+        gain.iter()
+            .enumerate()
+            .fold((0, f64::MIN), |m, (k, &g)| if g > m.1 { (k, g) } else { m });
+    assert!(g_max > 0.05, "{gain:?}");
+    assert!((loading.drive[k_max] - 44.0).abs() <= 4.0, "{gain:?}");
+    assert!(
+        gain[0] < 0.3 * g_max && gain[gain.len() - 1] < 0.3 * g_max,
+        "{gain:?}"
+    );
+    let sliding = enrich(&base, Effect::BoundaryCondition).unwrap();
+    let f_sl = sliding.predict(&[c10], &loading).unwrap();
+    for (a, b) in f_sl.iter().zip(&f0) {
+        assert!(a < b, "{f_sl:?} vs {f0:?}");
+    }
+    let friction = enrich(&base, Effect::Friction).unwrap();
+    let f_fr = friction.predict(&[c10, 0.6], &loading).unwrap();
+    let change = f_fr
+        .iter()
+        .zip(&f0)
+        .map(|(a, b)| (a / b - 1.0).abs())
+        .fold(0.0, f64::max);
+    assert!(change > 1e-4 && change < 0.2, "{f_fr:?} vs {f0:?}");
+}
+
+// ------------------------------------------- development records ----
+
+fn data(dir: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data").join(dir)
+}
+
+fn truth(dir: &str) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(data(dir).join("truth.json")).unwrap()).unwrap()
+}
+
+/// A record: its loading (drive from `drive_column`, time when present)
+/// and forces.
+fn record(dir: &str, name: &str, drive: Drive) -> (Loading, Vec<f64>) {
+    let t = Table::read(data(dir).join(format!("{name}.csv"))).unwrap();
+    let x = t.column(drive.column()).unwrap().to_vec();
+    let f = t.column("force_N").unwrap().to_vec();
+    let loading = match t.column("time_s") {
+        Ok(time) => Loading::timed(drive, time.to_vec(), x),
+        Err(_) => Loading::quasi_static(drive, x),
+    };
+    (loading, f)
+}
+
+/// RMS of `y` minus its least-squares multiple of `f`, over `sd`.
+fn scaled_misfit(y: &[f64], f: &[f64], sd: f64) -> f64 {
+    let a = y.iter().zip(f).map(|(y, f)| y * f).sum::<f64>() / f.iter().map(|f| f * f).sum::<f64>();
+    let ss: f64 = y.iter().zip(f).map(|(y, f)| (y - a * f).powi(2)).sum();
+    (ss / y.len() as f64).sqrt() / sd
+}
+
+/// Diagnoses every record of `dir` with the base `base` and `effects`
+/// (every effect the base offers when `None`), in parallel, and checks each
+/// verdict against `truth.json`'s `expected`.
+fn check_verdicts(
+    dir: &str,
+    drive: Drive,
+    base: &(dyn ForwardModel + Sync),
+    effects: Option<Vec<Effect>>,
+) {
+    let truth = truth(dir);
+    let names: Vec<String> = truth.as_object().unwrap().keys().cloned().collect();
+    let reports: Vec<(String, GapReport)> = names
+        .par_iter()
+        .map(|name| {
+            let (loading, f) = record(dir, name, drive);
+            let options = GapOptions {
+                effects: effects.clone(),
+                ..GapOptions::default()
+            };
+            (
+                name.clone(),
+                diagnose(base, &loading, &f, &options).unwrap(),
+            )
+        })
+        .collect();
+    let mut wrong = Vec::new();
+    for (name, r) in &reports {
+        let expected = truth[name.as_str()]["expected"].as_str().unwrap();
+        eprintln!(
+            "{name}: verdict {} (expected {expected}), base misfit {:.3e}, noise {:.3e}, ranking {:?}",
+            r.verdict,
+            r.base.misfit,
+            r.noise_sd,
+            r.ranking
+                .iter()
+                .map(|e| (e.effect, e.misfit_after, e.earns))
+                .collect::<Vec<_>>()
+        );
+        if r.verdict.to_string() != expected {
+            wrong.push(format!("{name}: {} (expected {expected})", r.verdict));
+        }
+    }
+    assert!(wrong.is_empty(), "{wrong:?}");
+}
+
+/// The R2 development records (`examples/make_gap_r2.rs`: 1 mm mesh) against
+/// the 2 mm base with its three effects. Heavy: some 50-80 passes of 8 s of
+/// CPU per record.
+#[test]
+#[ignore = "R2 diagnoses, tens of minutes of CPU: cargo test -p palpate-tests --release --test gap_fe_effects -- --ignored r2_"]
+fn r2_records_get_the_expected_verdicts() {
+    let base = R2Gap::new(r2_dev::rolling(2.0), 1.0);
+    check_verdicts("gap-r2", Drive::PositionMm, &base, None);
+}
+
+/// The Q1 development records (`examples/make_gap_q1.rs`: two-term
+/// generator, steps of tau_min / 10) against the elastic punch on mesh
+/// level 2 with `viscoelasticity`.
+#[test]
+#[ignore = "Q1 diagnoses, minutes of CPU: cargo test -p palpate-tests --release --test gap_fe_effects -- --ignored q1_"]
+fn q1_records_get_the_expected_verdicts() {
+    let mut base = Q1Punch::new(Law::NeoHookean);
+    base.level = 2;
+    check_verdicts(
+        "gap-q1",
+        Drive::DisplacementMm,
+        &base,
+        Some(vec![Effect::Viscoelasticity]),
+    );
+}
+
+/// The needle records of `tests/data/gap-n3/` (`examples/make_gap_n3.rs`)
+/// against the coarse axisymmetric N1 base with `modelling_space` and
+/// `friction`.
+#[test]
+#[ignore = "N3 runs, minutes of CPU: cargo test -p palpate-tests --release --test gap_fe_effects -- --ignored n3_"]
+fn n3_records_get_the_expected_verdicts() {
+    let mut base = N1Needle::new(Law::NeoHookean);
+    base.friction = 0.0;
+    base.mesh = MeshDensity::COARSE;
+    check_verdicts(
+        "gap-n3",
+        Drive::DisplacementMm,
+        &base,
+        Some(vec![Effect::ModellingSpace, Effect::Friction]),
+    );
+}
+
+/// The premise of the N3 records, cheaply (two coarse N1 runs): the coarse
+/// axisymmetric base scaled to the 3D record leaves the misfit that
+/// `truth.json` states (the 3D record's shape is not N1's), and to the
+/// MEDIUM-mesh N1 record a misfit at the noise (the same physics). A
+/// change to N1, N3 or the records that breaks what the ignored diagnosis
+/// relies on fails here.
+#[test]
+fn n3_records_differ_from_the_axisymmetric_base_as_stated() {
+    let truth = truth("gap-n3");
+    let mut base = N1Needle::new(Law::NeoHookean);
+    base.friction = 0.0;
+    base.mesh = MeshDensity::COARSE;
+    for name in ["n3-3d", "n3-axisymmetric"] {
+        let (loading, y) = record("gap-n3", name, Drive::DisplacementMm);
+        let f = base.predict(&[1e-3], &loading).unwrap();
+        let t = &truth[name];
+        let sd = t["noise_sd_N"].as_f64().unwrap();
+        let visible = t["visible_rms_in_sd"].as_f64().unwrap();
+        // noise adds about one SD in quadrature
+        let got = scaled_misfit(&y, &f, sd);
+        let want = (visible * visible + 1.0).sqrt();
+        assert!((got - want).abs() < 0.35, "{name}: {got} vs {want}");
+    }
 }
