@@ -311,7 +311,15 @@ fn main() {
     }
     if run("n3") {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n3");
-        for name in ["n3-3d", "n3-axisymmetric"] {
+        let names: Vec<String> = match std::env::args().nth(2) {
+            Some(list) => list.split(',').map(String::from).collect(),
+            None => vec![
+                "n3-3d".into(),
+                "n3-3d-precise".into(),
+                "n3-axisymmetric".into(),
+            ],
+        };
+        for name in names.iter().map(String::as_str) {
             let (loading, f) = read(&dir.join(format!("{name}.csv")));
             let mut base = N1Needle::new(Law::NeoHookean);
             base.friction = 0.0;

@@ -17,8 +17,10 @@
 //! materiality threshold) it is `none`, "too weak to see"; the cases are
 //! chosen to avoid the band between.
 //!
-//! `cargo run --release -p palpate-tests --example make_gap_r2`. The records
-//! are committed; rerun only to change them.
+//! `cargo run --release -p palpate-tests --example make_gap_r2 [-- NAME,...]`
+//! (a subset replaces only its entries of `truth.json`, so one process per
+//! record can run them in parallel). The records are committed; rerun only
+//! to change them.
 
 use palpate_core::{Effect, ForwardModel};
 use palpate_fe::R2Gap;
@@ -78,7 +80,10 @@ fn main() {
     let fine = R2Gap::new(r2_dev::rolling(1.0), 1.0);
     let base = R2Gap::new(r2_dev::rolling(2.0), 1.0);
     let base_f = base.predict(&[1e-3], &loading).expect("base pass");
-    let mut entries = Vec::new();
+    // truth.json: the whole file for a full run; a subset (`-- NAME,...`)
+    // replaces only its own entries
+    let truth_path = dir.join("truth.json");
+    let mut all = serde_json::Map::new();
     for c in &cases {
         if only
             .as_ref()
@@ -139,22 +144,36 @@ fn main() {
             .zip(&theta)
             .map(|(n, v)| format!("\"{n}\": {v}"))
             .collect();
-        entries.push(format!(
-            "  \"{}\": {{\"benchmark\": \"R2 (development pass, palpate_tests::r2_dev)\", \
+        let entry = format!(
+            "{{\"benchmark\": \"R2 (development pass, palpate_tests::r2_dev)\", \
              \"base_model\": \"neo-Hookean, no nodule, frictionless, bonded bottom, 2 mm mesh\", \
              \"generator\": \"R2Gap on a 1 mm mesh\", \"effects\": [{}], \"params\": {{{}}}, \
              \"noise_sd_N\": {sd:.6e}, \"visible_rms_in_sd\": {size:.3}, \"expected\": \"{expected}\"}}",
-            c.name,
             c.effect.map_or(String::new(), |(e, _)| format!("\"{e}\"")),
             params.join(", ")
-        ));
+        );
+        // re-read just before writing: other processes may write other subsets
+        let mut truth: serde_json::Map<String, serde_json::Value> = if only.is_some() {
+            std::fs::read_to_string(&truth_path)
+                .ok()
+                .and_then(|t| serde_json::from_str(&t).ok())
+                .unwrap_or_default()
+        } else {
+            std::mem::take(&mut all)
+        };
+        truth.insert(
+            c.name.to_string(),
+            serde_json::from_str(&entry).expect("truth entry"),
+        );
+        let mut text = serde_json::to_string_pretty(&truth).expect("truth.json");
+        text.push('\n');
+        std::fs::write(&truth_path, text).expect("write truth.json");
+        if only.is_none() {
+            all = truth;
+        }
         eprintln!(
             "{}: peak {fmax:.4} N, noise sd {sd:.2e} N, visible {size:.2} SD -> {expected}",
             c.name
         );
-    }
-    if only.is_none() {
-        let truth = format!("{{\n{}\n}}\n", entries.join(",\n"));
-        std::fs::write(dir.join("truth.json"), truth).expect("write truth.json");
     }
 }
