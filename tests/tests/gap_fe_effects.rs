@@ -18,7 +18,7 @@
 
 use palpate_core::enrichable::{effects_of, embed, enrich};
 use palpate_core::{Drive, Effect, ForwardModel, Loading, Table};
-use palpate_fe::{MeshDensity, N1Needle, Q1Punch, R2Gap};
+use palpate_fe::{MeshDensity, N1Needle, Nodule, Q1Punch, R2Gap, R2Rolling};
 use palpate_material::Law;
 use palpate_tests::r2_dev;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
@@ -134,6 +134,71 @@ fn r2_effects_on_a_coarse_pass() {
     for (a, b) in f_sl.iter().zip(&f0) {
         assert!(a < b, "{f_sl:?} vs {f0:?}");
     }
+}
+
+/// The R2 effects, their parameters and "off" points, and where they are
+/// offered (no solve).
+#[test]
+fn r2_effects_and_their_parameters() {
+    let base = || {
+        let mut r = R2Rolling::new(Law::NeoHookean, Law::NeoHookean, 2.0);
+        r.nodules.clear();
+        R2Gap::new(r, 10.0)
+    };
+    let b = base();
+    assert_eq!(
+        effects_of(&b),
+        [
+            Effect::Inclusion,
+            Effect::Friction,
+            Effect::BoundaryCondition
+        ]
+    );
+    assert_eq!(b.space().names(), ["C10"]);
+    let inc = enrich(&b, Effect::Inclusion).unwrap();
+    assert_eq!(
+        inc.space().names(),
+        [
+            "C10",
+            "inclusion_contrast",
+            "inclusion_x_mm",
+            "inclusion_depth_mm"
+        ]
+    );
+    assert_eq!(embed(inc.as_ref(), &[2e-3]), [2e-3, 1.0, 75.0, 15.0]);
+    let fr = enrich(&b, Effect::Friction).unwrap();
+    assert_eq!(embed(fr.as_ref(), &[2e-3]), [2e-3, 0.0]);
+    let bc = enrich(&b, Effect::BoundaryCondition).unwrap();
+    assert_eq!(bc.space().names(), ["C10"]);
+    assert!(bc.name().contains("sliding base"), "{}", bc.name());
+    // one enrichment at a time
+    assert!(effects_of(bc.as_ref()).is_empty());
+    assert!(enrich(fr.as_ref(), Effect::Inclusion).is_err());
+    // a base that knows its nodules is not offered another
+    let mut known = base();
+    known.rolling.nodules = Nodule::r2_default();
+    assert!(!effects_of(&known).contains(&Effect::Inclusion));
+    // the nodule's moduli are the tissue's times the contrast
+    let (m, full) = b.resolve(&[2e-3]).unwrap();
+    assert!(m.nodules.is_empty());
+    assert_eq!(full, [2e-3, 20e-3]);
+    let inc = b.enriched(Effect::Inclusion).unwrap();
+    let (m, full) = inc.resolve(&[2e-3, 5.0, 40.0, 12.0]).unwrap();
+    assert_eq!(
+        m.nodules,
+        [Nodule {
+            x: 40.0,
+            depth: 12.0
+        }]
+    );
+    assert_eq!(full, [2e-3, 10e-3]);
+    assert!(inc.resolve(&[2e-3, 5.0, 40.0, 3.0]).is_err());
+    let (m, _) = b
+        .enriched(Effect::Friction)
+        .unwrap()
+        .resolve(&[2e-3, 0.4])
+        .unwrap();
+    assert_eq!(m.friction, 0.4);
 }
 
 // ------------------------------------------- development records ----
