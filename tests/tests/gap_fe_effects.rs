@@ -269,7 +269,7 @@ fn check_verdicts(
                 .map(|e| (e.effect, e.misfit_after, e.earns))
                 .collect::<Vec<_>>()
         );
-        if r.verdict.to_string() != expected {
+        if r.verdict != expected {
             wrong.push(format!("{name}: {} (expected {expected})", r.verdict));
         }
     }
