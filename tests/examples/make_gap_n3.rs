@@ -32,6 +32,17 @@ use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
 use std::path::Path;
 
+/// A record: name, generator, its noiseless forces, noise fraction of the
+/// peak, seed, planted effect.
+type Case<'a> = (
+    &'a str,
+    &'a dyn ForwardModel,
+    &'a [f64],
+    f64,
+    u64,
+    Option<&'a str>,
+);
+
 fn main() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n3");
     std::fs::create_dir_all(&dir).expect("create data/gap-n3");
@@ -49,7 +60,8 @@ fn main() {
     medium.mesh = MeshDensity::MEDIUM;
     let f_3d = n3.predict(&[c10], &loading).expect("3D record");
     let f_medium = medium.predict(&[c10], &loading).expect("MEDIUM record");
-    let cases: [(&str, &dyn ForwardModel, &[f64], f64, u64, Option<&str>); 3] = [
+    // (name, generator, its noiseless forces, noise fraction, seed, effect)
+    let cases: [Case; 3] = [
         ("n3-3d", &n3, &f_3d, 0.01, 31, Some("modelling_space")),
         (
             "n3-3d-precise",
