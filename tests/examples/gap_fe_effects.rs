@@ -6,28 +6,29 @@
 //! * Q1 `viscoelasticity`: the three records of `tests/data/gap-q1/`
 //!   (`examples/make_gap_q1.rs`) against the elastic punch on mesh level 2
 //!   (`-- q1 q1-relaxation,q1-none` for a subset).
-//! * N1 -> N3 `modelling_space`: a 6 mm needle record made by the 3D model
-//!   (N3 level 1, neo-Hookean C10 1e-3 MPa, frictionless, noise 1 % of the
-//!   peak, seed 31; written once to `target/gap_n3_record.csv`), diagnosed
-//!   against the coarse axisymmetric N1 base with `modelling_space` and
-//!   `friction` as candidates; and an N1 (MEDIUM mesh) record of the same
-//!   needle with the same candidates, where `modelling_space` must not be
-//!   named.
+//! * N1 -> N3 `modelling_space`: the records of `tests/data/gap-n3/`
+//!   (`examples/make_gap_n3.rs`: a 6 mm needle record made by the 3D model,
+//!   and a null one made by N1 on the MEDIUM mesh), diagnosed against the
+//!   coarse axisymmetric N1 base with `modelling_space` and `friction` as
+//!   candidates.
+//! * R2 `inclusion`, `friction`, `boundary_condition`: the records of
+//!   `tests/data/gap-r2/` (`examples/make_gap_r2.rs`) against the R2
+//!   development pass on the 2 mm mesh ([`palpate_tests::r2_dev`]) with
+//!   every effect it offers (`-- r2 r2-inclusion` for a subset;
+//!   `-- r2probe [H [STEP]]` times one pass per effect).
 //!
-//! `cargo run --release -p palpate-tests --example gap_fe_effects [-- q1|n3|probe]`
+//! `cargo run --release -p palpate-tests --example gap_fe_effects [-- q1|n3|r2|probe|r2probe]`
 
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace, Table,
 };
-use palpate_fe::{MeshDensity, N1Needle, N3Needle, Q1Punch};
+use palpate_fe::{MeshDensity, N1Needle, Q1Punch, R2Gap};
 use palpate_material::Law;
+use palpate_tests::r2_dev;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
-use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
 use std::collections::BTreeMap;
-use std::fmt::Write;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
@@ -154,27 +155,81 @@ fn read(path: &Path) -> (Loading, Vec<f64>) {
     (loading, f)
 }
 
-/// A needle record to 6 mm every 0.25 mm from `model`, noise 1 % of the
-/// peak (seed), written once to `target/<name>.csv`.
-fn needle_record(name: &str, model: &dyn ForwardModel, seed: u64) -> PathBuf {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../target/{name}.csv"));
-    if !path.exists() {
-        let depths: Vec<f64> = (0..=24).map(|i| 0.25 * i as f64).collect();
-        let loading = Loading::quasi_static(Drive::DisplacementMm, depths.clone());
-        let f = model.predict(&[1.0e-3], &loading).expect("needle record");
-        let peak = f.iter().cloned().fold(0.0, f64::max);
-        let noise = Normal::new(0.0, 0.01 * peak).expect("sd");
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
-        let mut csv = format!(
-            "# {} C10 1e-3, noise 1 % of peak, seed {seed}\ndisplacement_mm,force_N\n",
-            model.name()
-        );
-        for (d, v) in depths.iter().zip(&f) {
-            let _ = writeln!(csv, "{d},{:.6e}", v + noise.sample(&mut rng));
+/// The R2 development records (`examples/make_gap_r2.rs`).
+const R2_RECORDS: [&str; 4] = ["r2-inclusion", "r2-friction", "r2-sliding", "r2-none"];
+
+/// Element size (mm) of the R2 base model of the diagnosis.
+const R2_BASE_H: f64 = 2.0;
+
+fn read_r2(path: &Path) -> (Loading, Vec<f64>) {
+    let t = Table::read(path).expect("record");
+    let x = t.column("position_mm").unwrap().to_vec();
+    let f = t.column("force_N").unwrap().to_vec();
+    (Loading::quasi_static(Drive::PositionMm, x), f)
+}
+
+/// Cost and size of each R2 effect on the development pass: one solve per
+/// variant, its CPU seconds and the force at a few positions.
+fn r2_probe() {
+    let h: f64 = std::env::args()
+        .nth(2)
+        .map_or(R2_BASE_H, |a| a.parse().unwrap());
+    let step: f64 = std::env::args().nth(3).map_or(1.0, |a| a.parse().unwrap());
+    let loading = r2_dev::loading(step);
+    let base = R2Gap::new(r2_dev::rolling(h), 1.0);
+    let variants: Vec<(&str, Box<dyn ForwardModel>, Vec<f64>)> = vec![
+        ("base", Box::new(base.clone()), vec![1e-3]),
+        (
+            "inclusion c14.7 x44 d10",
+            base.as_enrichable()
+                .unwrap()
+                .enrich(Effect::Inclusion)
+                .unwrap(),
+            vec![1e-3, 14.7, 44.0, 10.0],
+        ),
+        (
+            "inclusion c1 (off)",
+            base.as_enrichable()
+                .unwrap()
+                .enrich(Effect::Inclusion)
+                .unwrap(),
+            vec![1e-3, 1.0, 40.0, 10.0],
+        ),
+        (
+            "friction 0.5",
+            base.as_enrichable()
+                .unwrap()
+                .enrich(Effect::Friction)
+                .unwrap(),
+            vec![1e-3, 0.5],
+        ),
+        (
+            "sliding",
+            base.as_enrichable()
+                .unwrap()
+                .enrich(Effect::BoundaryCondition)
+                .unwrap(),
+            vec![1e-3],
+        ),
+    ];
+    let n = loading.len();
+    for (name, m, theta) in variants {
+        let t0 = cpu_seconds();
+        let w0 = Instant::now();
+        match m.predict(&theta, &loading) {
+            Ok(f) => println!(
+                "{name}: F[0] {:.5} F[n/4] {:.5} F[n/2] {:.5} F[3n/4] {:.5} F[n-1] {:.5}; {:.1} s CPU, {:.1} s wall",
+                f[0],
+                f[n / 4],
+                f[n / 2],
+                f[3 * n / 4],
+                f[n - 1],
+                cpu_seconds() - t0,
+                w0.elapsed().as_secs_f64()
+            ),
+            Err(e) => println!("{name}: {e} ({:.1} s CPU)", cpu_seconds() - t0),
         }
-        std::fs::write(&path, csv).expect("write record");
     }
-    path
 }
 
 fn main() {
@@ -182,6 +237,25 @@ fn main() {
     let run = |w: &str| which.as_deref().is_none_or(|x| x == w);
     println!("| record | candidates | verdict | noise SD (N) | best misfit before -> after (N) | FE solves | wall s | CPU s |");
     println!("|---|---|---|---|---|---|---|---|");
+    if which.as_deref() == Some("r2probe") {
+        r2_probe();
+        return;
+    }
+    if run("r2") {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-r2");
+        let names: Vec<String> = match std::env::args().nth(2) {
+            Some(list) => list.split(',').map(String::from).collect(),
+            None => R2_RECORDS.map(String::from).to_vec(),
+        };
+        for name in &names {
+            let (loading, f) = read_r2(&dir.join(format!("{name}.csv")));
+            let base = Counted(Arc::new(R2Gap::new(r2_dev::rolling(R2_BASE_H), 1.0)));
+            let effects = base.effects();
+            row(name, &effects, || {
+                diagnose(&base, &loading, &f, &GapOptions::default()).expect("diagnosis")
+            });
+        }
+    }
     if which.as_deref() == Some("probe") {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-q1");
         let (loading, _) = read(&dir.join("q1-relaxation.csv"));
@@ -236,23 +310,17 @@ fn main() {
         }
     }
     if run("n3") {
-        let mut n3 = N3Needle::new(Law::NeoHookean);
-        n3.friction = 0.0;
-        let mut n1 = N1Needle::new(Law::NeoHookean);
-        n1.friction = 0.0;
-        n1.mesh = MeshDensity::MEDIUM;
-        let records = [
-            (
-                "n3-frictionless (3D record)",
-                needle_record("gap_n3_record", &n3, 31),
-            ),
-            (
-                "n1-frictionless (MEDIUM N1 record)",
-                needle_record("gap_n1_medium_record", &n1, 32),
-            ),
-        ];
-        for (name, path) in records {
-            let (loading, f) = read(&path);
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n3");
+        let names: Vec<String> = match std::env::args().nth(2) {
+            Some(list) => list.split(',').map(String::from).collect(),
+            None => vec![
+                "n3-3d".into(),
+                "n3-3d-precise".into(),
+                "n3-axisymmetric".into(),
+            ],
+        };
+        for name in names.iter().map(String::as_str) {
+            let (loading, f) = read(&dir.join(format!("{name}.csv")));
             let mut base = N1Needle::new(Law::NeoHookean);
             base.friction = 0.0;
             base.mesh = MeshDensity::COARSE;

@@ -140,6 +140,10 @@ pub struct R2Rolling {
     pub press_x: f64,
     pub roll_to: f64,
     pub friction: f64,
+    /// Bottom support: bonded (both components fixed, BENCHMARKS.md R2) or
+    /// sliding (vertical component fixed, horizontal free except at the
+    /// bottom node nearest mid-block, which removes the rigid translation).
+    pub base: crate::Base,
     /// Mesh level ([`r2_element_size`]).
     pub level: usize,
     /// When set, replaces the element size of `level` (mm).
@@ -189,6 +193,7 @@ impl R2Rolling {
             press_x: 10.0,
             roll_to: 140.0,
             friction: 0.0,
+            base: crate::Base::Bonded,
             level: 1,
             element_size: None,
             penalty: 1000.0,
@@ -518,7 +523,7 @@ impl Setup for R2Rolling {
     }
     fn build(&self) -> Result<System, FeError> {
         self.check()?;
-        let mesh = self.build_mesh()?;
+        let mut mesh = self.build_mesh()?;
         let kin = Kinematics::PlaneStress {
             thickness: self.thickness,
         };
@@ -533,7 +538,34 @@ impl Setup for R2Rolling {
             kernel_for(CellType::Quad9, kin, PressureSpace::None)?,
             false,
         )?;
-        let bcs = vec![Dirichlet::fixed("bottom", 0), Dirichlet::fixed("bottom", 1)];
+        let bcs = match self.base {
+            crate::Base::Bonded => {
+                vec![Dirichlet::fixed("bottom", 0), Dirichlet::fixed("bottom", 1)]
+            }
+            crate::Base::Sliding => {
+                let mid = self.length / 2.0;
+                let anchor = mesh
+                    .node_sets
+                    .get("bottom")
+                    .into_iter()
+                    .flatten()
+                    .copied()
+                    .min_by(|&a, &b| {
+                        (mesh.nodes[a][0] - mid)
+                            .abs()
+                            .total_cmp(&(mesh.nodes[b][0] - mid).abs())
+                    })
+                    .ok_or_else(|| FeError::InvalidMesh {
+                        field: "bottom".into(),
+                        reason: "the block has no bottom nodes".into(),
+                    })?;
+                mesh.node_sets.insert("bottom_anchor".into(), vec![anchor]);
+                vec![
+                    Dirichlet::fixed("bottom", 1),
+                    Dirichlet::fixed("bottom_anchor", 0),
+                ]
+            }
+        };
         let options = ContactOptions {
             friction: self.friction,
             penalty_normal: 0.0,
@@ -651,8 +683,12 @@ impl ForwardModel for R2Rolling {
             .iter()
             .map(|n| format!("{}:{}", n.x, n.depth))
             .collect();
+        let base = match self.base {
+            crate::Base::Bonded => "",
+            crate::Base::Sliding => ", sliding base",
+        };
         format!(
-            "R2 FE rolling indentation (plane stress), RD {} mm, nodules {}, {} / {}, friction {}",
+            "R2 FE rolling indentation (plane stress), RD {} mm, nodules {}, {} / {}, friction {}{base}",
             self.rd,
             if nodules.is_empty() {
                 "none".to_string()
