@@ -9,7 +9,10 @@
 //!
 //! `cargo run --release -p palpate-fe --example bench_n3 -- [level ...]
 //!  [--depth D] [--law nh|rp2|both] [--friction 0|0.8|both] [--grading h,zone,growth]
-//!  [--mesh ogrid|box] [--core N] [--max-step S]`
+//!  [--mesh ogrid|box] [--core N] [--max-step S] [--bulk K/mu]`
+//! (`--bulk`: compressible with K = ratio x mu instead of exactly
+//! incompressible, as CalculiX's K = 1000 mu; to 1 mm or less every force
+//! is printed)
 
 use std::time::Instant;
 
@@ -42,6 +45,7 @@ fn main() {
     let mut layout: Option<N3Mesh> = None;
     let mut core: Option<usize> = None;
     let mut solver = String::from("default");
+    let mut bulk: Option<f64> = None;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().expect("a value after the option").clone();
@@ -54,6 +58,7 @@ fn main() {
                 })
             }
             "--solver" => solver = value(),
+            "--bulk" => bulk = Some(value().parse().expect("K/mu")),
             "--core" => core = Some(value().parse().expect("core cells")),
             "--max-step" => max_step = Some(value().parse().expect("max step")),
             "--law" => {
@@ -108,6 +113,9 @@ fn main() {
                 }
                 let layout = m.mesh;
                 m.core_cells = core;
+                if let Some(r) = bulk {
+                    m.bulk = palpate_fe::Bulk::Ratio(r);
+                }
                 match solver.as_str() {
                     "lu" => {
                         m.options.gmres = false;
@@ -165,6 +173,12 @@ fn main() {
                     at(5.0),
                     at(10.0)
                 );
+                if depth <= 1.0 {
+                    // small depths (the CalculiX comparison of
+                    // docs/validation/fe.md, N3): every sample
+                    let all: Vec<String> = forces.iter().map(|f| format!("{f:.6}")).collect();
+                    println!("  F(0.25 .. {depth}) N: {}", all.join(" "));
+                }
             }
         }
     }
