@@ -100,7 +100,8 @@ fn main() {
             None => (Box::new(fine.clone()), vec![c.c10]),
         };
         // a pass that does not converge writes no record (friction 0.6 on the
-        // 1 mm mesh: the first rolled increment stalls, docs/gap-diagnosis.md)
+        // 1 mm mesh stalled at its first rolled increment until the stick
+        // penalty was lowered, `R2Rolling::tangent_penalty`)
         let f = match model.predict(&theta, &loading) {
             Ok(f) => f,
             Err(e) => {

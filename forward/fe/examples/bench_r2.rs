@@ -78,6 +78,8 @@ fn main() {
                     v => Some(v.parse().expect("secant|0|1")),
                 }
             }
+            "--friction" => model.friction = value().parse().expect("a coefficient"),
+            "--tangent-penalty" => model.tangent_penalty = value().parse().expect("a fraction"),
             "--no-press" => presses = false,
             "--from" => from = Some(value().parse().expect("mm")),
             "--to" => to = Some(value().parse().expect("mm")),
