@@ -506,3 +506,100 @@ where
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::manifest::Manifest;
+
+    /// The manifest of one sample step with `fields` (TOML lines), its
+    /// refusal (parse or validation) as text, or "" when accepted.
+    fn refusal(fields: &str) -> String {
+        let dir = tempfile::tempdir().unwrap();
+        let rec = "displacement_mm,force_N\n0,0\n0.5,0.2\n1,0.5\n";
+        std::fs::write(dir.path().join("c1.csv"), rec).unwrap();
+        std::fs::write(dir.path().join("n1.csv"), rec).unwrap();
+        let text = format!(
+            "[study]\nname = \"s\"\n\n[data.c1]\nfile = \"c1.csv\"\ntest = \"C1\"\n\n\
+             [data.n1]\nfile = \"n1.csv\"\ntest = \"N1\"\n\n[models.nh]\nlaw = \"neo-hookean\"\n\n\
+             [models.fe.n1_needle]\nlaw = \"neo-hookean\"\nmesh = \"coarse\"\n\n\
+             [[steps]]\n[steps.sample]\nname = \"p\"\n{fields}\n"
+        );
+        let path = dir.path().join("s.toml");
+        std::fs::write(&path, &text).unwrap();
+        match Manifest::parse(&path, &text).and_then(|m| m.validate(&path).map(|_| m)) {
+            Ok(_) => String::new(),
+            Err(e) => format!("{e:#}"),
+        }
+    }
+
+    #[test]
+    fn bad_fields_are_refused_naming_the_field() {
+        assert_eq!(refusal("model = \"nh\"\ndata = [\"c1\"]"), "");
+        assert_eq!(
+            refusal("model = \"fe\"\ndata = [\"n1\"]\nbox = { C10 = [0.001, 0.002] }"),
+            ""
+        );
+        let at = "steps[0].sample (\"p\")";
+        for (fields, says) in [
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\nsampler = \"gibbs\"",
+                format!("{at}.sampler = \"gibbs\": expected nuts, demc or ensemble"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\ndraws = 2",
+                format!("{at}.draws = 2: between 4"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\nchains = 0",
+                format!("{at}.chains = 0: between 1 and 1024"),
+            ),
+            (
+                "model = \"nope\"\ndata = [\"c1\"]",
+                format!("{at}.model: unknown model \"nope\" (defined: fe, nh)"),
+            ),
+            (
+                "model = \"nh\"\ndata = []",
+                format!("{at}.data = []: give at least one record"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c2\"]",
+                format!("{at}.data: unknown data set \"c2\""),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\", \"c1\"]",
+                format!("{at}.data: \"c1\" is listed twice"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\nsigma = -1.0",
+                format!("{at}.sigma = -1: must be a positive number"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\nbox = { C10 = [1.0, 2.0] }",
+                format!("{at}.box: for FE models"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\ndesign = 4",
+                format!("{at}.design: for FE models"),
+            ),
+            (
+                "model = \"fe\"\ndata = [\"n1\"]",
+                format!("{at}.box: an FE model is sampled through a surrogate"),
+            ),
+            (
+                "model = \"fe\"\ndata = [\"n1\", \"c1\"]\nbox = { C10 = [1.0, 2.0] }",
+                format!("{at}.data: an FE model is sampled on one record"),
+            ),
+            (
+                "model = \"fe\"\ndata = [\"n1\"]\nbox = { C10 = [1.0] }",
+                format!("{at}.box.C10: expected [LO, HI], got 1 numbers"),
+            ),
+            (
+                "model = \"nh\"\ndata = [\"c1\"]\nwalkers = 3",
+                "unknown field `walkers`".to_string(),
+            ),
+        ] {
+            let e = refusal(fields);
+            assert!(e.contains(&says), "{fields}:\n{e}\nexpected: {says}");
+        }
+    }
+}
