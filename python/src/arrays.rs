@@ -30,6 +30,10 @@ use std::borrow::Cow;
 /// A record from Python: its column names and the columns.
 type PyRecord<'py> = (Vec<String>, Vec<PyReadonlyArray1<'py, f64>>);
 
+/// A record's names and its columns as slices (borrowed, or copied when
+/// the array was not contiguous).
+type Columns<'a> = (Vec<String>, Vec<Cow<'a, [f64]>>);
+
 /// The command line `palpate NAME ARGS...` parsed.
 fn parse(name: &str, args: Vec<String>) -> PyResult<Command> {
     Ok(parse_cli(std::iter::once(name.to_string()).chain(args).collect())?.command)
@@ -43,7 +47,7 @@ fn other(expected: &str) -> PyErr {
 
 /// The columns of the records as slices: borrowed when contiguous, else
 /// copied once (returned in the Cow).
-fn columns<'a>(records: &'a [PyRecord<'_>]) -> Vec<(Vec<String>, Vec<Cow<'a, [f64]>>)> {
+fn columns<'a>(records: &'a [PyRecord<'_>]) -> Vec<Columns<'a>> {
     records
         .iter()
         .map(|(names, cols)| {
@@ -59,7 +63,7 @@ fn columns<'a>(records: &'a [PyRecord<'_>]) -> Vec<(Vec<String>, Vec<Cow<'a, [f6
         .collect()
 }
 
-fn array_records<'a>(cols: &'a [(Vec<String>, Vec<Cow<'a, [f64]>>)]) -> Vec<ArrayRecord<'a>> {
+fn array_records<'a>(cols: &'a [Columns<'a>]) -> Vec<ArrayRecord<'a>> {
     cols.iter()
         .map(|(names, c)| ArrayRecord {
             names: names.clone(),

@@ -421,7 +421,7 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
     )?;
     // needle benchmarks (N1, N3): 10 mm every 0.25 mm
     let n1 = args.benchmark.eq_ignore_ascii_case("n1") || args.benchmark.eq_ignore_ascii_case("n3");
-    let q1 = is_q1(&args);
+    let q1 = is_q1(args);
     let depth = args.depth.unwrap_or(if n1 {
         10.0
     } else if q1 {
@@ -462,7 +462,7 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         &model,
     )?;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
-    let time = timed_history(&args, depth, &mut drive)?;
+    let time = timed_history(args, depth, &mut drive)?;
     if let Some(end) = time.as_ref().and_then(|t| t.last()) {
         crate::checks::check_increments(&model, *end)?;
     }
