@@ -2,8 +2,10 @@
 //! writes the same bytes as `palpate run` in one process: a calibrate ->
 //! predict (FE, N1 coarse) -> anova chain, merged after one pass of the
 //! shards (the merge computes the deferred FE runs) and after two passes
-//! (the shards compute them, the merge only assembles). Bad `--shard`
-//! values and a merge with a shard missing are refused with the reason.
+//! (the shards compute them, the merge only assembles). The same for two
+//! sample steps, whose chains and surrogate FE runs are units. Bad
+//! `--shard` values and a merge with a shard missing are refused with the
+//! reason.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
