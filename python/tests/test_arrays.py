@@ -144,3 +144,17 @@ def test_errors_carry_the_command_lines_messages(tmp_path):
     bad[1] = np.nan
     assert "uniaxial arrays:3: column `stress_MPa`: value is NaN or infinite" in message(
         lambda: palpate.calibrate("yeoh", {"uniaxial": (stretch, bad)}))
+
+
+def test_a_c1_force_record_as_arrays_fits_and_samples_as_the_file():
+    path = ROOT / "tests/data/mesa2011/c1-compression.csv"
+    rows = [line for line in path.read_text().splitlines() if line and not line.startswith("#")]
+    d, f = np.loadtxt(rows[1:], delimiter=",", unpack=True)
+    a = palpate.calibrate("neo-hookean", (d, f), benchmark="C1")
+    b = palpate.calibrate("neo-hookean", path, benchmark="C1")
+    assert a["params"] == b["params"] and a["sse"] == b["sse"]
+    kw = dict(benchmark="C1", sampler="demc", draws=50, max_draws=50, tune=50, parallel=1, seed=2, arviz=False)
+    x = palpate.sample("neo-hookean", {"displacement_mm": d, "force_N": f}, **kw)
+    y = palpate.sample("neo-hookean", path, **kw)
+    assert np.array_equal(x["draws"]["C10"], y["draws"]["C10"])
+    assert_moved_from_rust(x["draws"]["C10"])
