@@ -8,8 +8,12 @@
 //! the whole run (`Python::detach`), so Python threads (a Dask worker's
 //! other tasks) go on meanwhile. An error is raised as `PalpateError` with
 //! the message the command line prints (`error: ...` and each
-//! `caused by: ...`). The Python wrappers in `pysrc/palpate` turn numpy
-//! arrays into the files the commands read and their outputs into arrays.
+//! `caused by: ...`). `simulate_arrays`, `calibrate_arrays` and
+//! `sample_arrays` ([`arrays`]) pass numpy arrays in memory; for the rest
+//! the Python wrappers in `pysrc/palpate` turn numpy arrays into the files
+//! the commands read and their outputs into arrays.
+
+mod arrays;
 
 use clap::Parser;
 use palpate_studies::cli::{dispatch, join_negative_values, Cli};
@@ -35,8 +39,36 @@ fn message(e: &anyhow::Error) -> String {
     text
 }
 
-fn to_py(e: anyhow::Error) -> PyErr {
+pub(crate) fn to_py(e: anyhow::Error) -> PyErr {
     PalpateError::new_err(message(&e))
+}
+
+/// `palpate ARGS...` parsed as the command line parses it: Ok(Ok(cli)),
+/// Ok(Err(text)) for `--help`/`--version`, or PalpateError with clap's
+/// message for a bad option.
+fn try_parse(args: Vec<String>) -> PyResult<Result<Cli, String>> {
+    let argv = std::iter::once("palpate".to_string())
+        .chain(args)
+        .map(std::ffi::OsString::from);
+    match Cli::try_parse_from(join_negative_values(argv)) {
+        Ok(cli) => Ok(Ok(cli)),
+        Err(e) => {
+            use clap::error::ErrorKind;
+            let text = e.render().to_string();
+            match e.kind() {
+                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => Ok(Err(text)),
+                _ => Err(PalpateError::new_err(
+                    text.trim_end().trim_start_matches("error: ").to_string(),
+                )),
+            }
+        }
+    }
+}
+
+/// [`try_parse`] where a help text is an error too (the array functions
+/// return results, not texts).
+pub(crate) fn parse_cli(args: Vec<String>) -> PyResult<Cli> {
+    try_parse(args)?.map_err(PalpateError::new_err)
 }
 
 /// Runs `palpate ARGS...` in this process, the GIL released. Returns the
@@ -44,21 +76,9 @@ fn to_py(e: anyhow::Error) -> PyErr {
 /// the command line's message (clap's for a bad option).
 #[pyfunction]
 fn run_cli(py: Python<'_>, args: Vec<String>) -> PyResult<Option<String>> {
-    let argv = std::iter::once("palpate".to_string())
-        .chain(args)
-        .map(std::ffi::OsString::from);
-    let cli = match Cli::try_parse_from(join_negative_values(argv)) {
+    let cli = match try_parse(args)? {
         Ok(cli) => cli,
-        Err(e) => {
-            use clap::error::ErrorKind;
-            let text = e.render().to_string();
-            return match e.kind() {
-                ErrorKind::DisplayHelp | ErrorKind::DisplayVersion => Ok(Some(text)),
-                _ => Err(PalpateError::new_err(
-                    text.trim_end().trim_start_matches("error: ").to_string(),
-                )),
-            };
-        }
+        Err(help) => return Ok(Some(help)),
     };
     py.detach(|| dispatch(cli)).map_err(to_py)?;
     Ok(None)
@@ -128,5 +148,8 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_cli, m)?)?;
     m.add_function(wrap_pyfunction!(run_study, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::simulate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::calibrate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::sample_arrays, m)?)?;
     Ok(())
 }

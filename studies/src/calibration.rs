@@ -161,7 +161,19 @@ impl TestData {
         path: &Path,
         options: ReadOptions,
     ) -> anyhow::Result<TestData> {
-        let table = Table::read(path)?;
+        Self::from_table(name, test, Table::read(path)?, options)
+    }
+
+    /// A record from a table already read (a file's, or the columns of an
+    /// [`crate::arrays::ArrayRecord`]); messages name `table.file`.
+    pub fn from_table(
+        name: &str,
+        test: TestKind,
+        table: Table,
+        options: ReadOptions,
+    ) -> anyhow::Result<TestData> {
+        let path = table.file.clone();
+        let path = path.as_path();
         if options.axial_stretch != 1.0 && test != TestKind::SimpleShear {
             anyhow::bail!(
                 "{}: axial_stretch = {} is for simple-shear records, not {test:?}",

@@ -5,6 +5,7 @@
 //! module per subcommand under [`cli`]).
 
 pub mod anova_step;
+pub mod arrays;
 pub mod calibration;
 pub mod checks;
 pub mod cli;
@@ -21,6 +22,7 @@ pub mod provenance;
 pub mod report;
 pub mod run_folder;
 pub mod runner;
+pub mod sample_step;
 pub mod shard;
 pub mod surrogate;
 pub mod two_stage;

@@ -242,6 +242,7 @@ pub enum Step {
     Anova(AnovaStep),
     TwoStage(crate::two_stage::TwoStageStep),
     Localize(LocalizeStep),
+    Sample(crate::sample_step::SampleStep),
 }
 
 pub use crate::anova_step::AnovaStep;
@@ -392,6 +393,7 @@ impl Manifest {
                     dir,
                 )?,
                 Step::Localize(l) => l.validate(self, i, &where_.to_string())?,
+                Step::Sample(p) => p.validate(self, i, &where_.to_string())?,
                 Step::Calibrate(c) => {
                     let at = format!("steps[{i}].calibrate (\"{}\")", c.name);
                     for (field, list) in [
@@ -541,6 +543,7 @@ impl Step {
             Step::Anova(a) => &a.name,
             Step::TwoStage(t) => &t.name,
             Step::Localize(l) => &l.name,
+            Step::Sample(p) => &p.name,
         }
     }
 
@@ -553,6 +556,7 @@ impl Step {
             Step::Anova(_) => "anova",
             Step::TwoStage(_) => "two_stage",
             Step::Localize(_) => "localize",
+            Step::Sample(_) => "sample",
         }
     }
 }

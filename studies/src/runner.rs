@@ -74,6 +74,11 @@ pub enum StepResult {
         name: String,
         results: Vec<serde_json::Value>,
     },
+    /// [`crate::sample_step`]: the posterior summary.
+    Sample {
+        name: String,
+        result: serde_json::Value,
+    },
 }
 
 /// A finished fit as cached: its results entry, its report rows and its plot.
@@ -315,6 +320,7 @@ pub fn run_study_counted(
             Step::Anova(a) => crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?,
             Step::TwoStage(t) => crate::two_stage::run_two_stage(&run, t, &mut report)?,
             Step::Localize(l) => crate::localize_step::run_localize(&run, l, &mut report)?,
+            Step::Sample(p) => crate::sample_step::run_sample(&run, p, &mut report)?,
         };
         if run.others.load(Ordering::Relaxed) > others_before {
             deferred.push(step.name().to_string());
@@ -466,6 +472,20 @@ impl Run<'_> {
         let counter = if mine { &self.computed } else { &self.others };
         counter.fetch_add(1, Ordering::Relaxed);
         Some(mine)
+    }
+
+    /// Counts the next unit of the step (key `key`) as one that cannot be
+    /// computed yet (it needs units of other shards): cached, or left to a
+    /// later pass or the merge whichever shard owns it. Call it where
+    /// [`Run::claim`] would be called.
+    pub(crate) fn wait(&self, key: &str) {
+        self.unit_index.fetch_add(1, Ordering::Relaxed);
+        let counter = if self.folder.has(key) {
+            &self.cached
+        } else {
+            &self.others
+        };
+        counter.fetch_add(1, Ordering::Relaxed);
     }
 
     fn calibrate(&self, step: &CalibrateStep, report: &mut String) -> anyhow::Result<StepResult> {

@@ -2,8 +2,10 @@
 //! writes the same bytes as `palpate run` in one process: a calibrate ->
 //! predict (FE, N1 coarse) -> anova chain, merged after one pass of the
 //! shards (the merge computes the deferred FE runs) and after two passes
-//! (the shards compute them, the merge only assembles). Bad `--shard`
-//! values and a merge with a shard missing are refused with the reason.
+//! (the shards compute them, the merge only assembles). The same for two
+//! sample steps, whose chains and surrogate FE runs are units. Bad
+//! `--shard` values and a merge with a shard missing are refused with the
+//! reason.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -147,10 +149,13 @@ fn shards(m: &Path, out: &Path, n: usize) -> Vec<String> {
 /// The files a run writes (provenance.json holds times and the command line).
 fn compared_files(dir: &Path) -> Vec<String> {
     let mut files = vec!["results.json".to_string(), "report.md".to_string()];
+    // (A study without plots has no plots folder.)
     let mut plots: Vec<String> = std::fs::read_dir(dir.join("plots"))
-        .unwrap()
-        .map(|e| format!("plots/{}", e.unwrap().file_name().to_string_lossy()))
-        .collect();
+        .map(|d| {
+            d.map(|e| format!("plots/{}", e.unwrap().file_name().to_string_lossy()))
+                .collect()
+        })
+        .unwrap_or_default();
     plots.sort();
     files.extend(plots);
     files
@@ -371,4 +376,134 @@ fn the_slurm_scripts_of_the_docs_run_an_array_and_merge_it() {
     let said = ok(c.output().unwrap(), "merge.sh");
     assert!(said.contains("0 computed here"), "{said}");
     assert_same(&single, &run_dir);
+}
+
+/// A study of two sample steps: a C1 posterior (analytic model, 4 NUTS
+/// chains) and an N1 posterior through a surrogate (coarse mesh, record cut
+/// at 1 mm: 5 load steps; 4 + 2 FE runs in its design, 2 chains). Units:
+/// 4 chains; 6 FE runs, then 2 chains that need all 6.
+fn sample_manifest(dir: &Path) -> PathBuf {
+    manifest(dir); // writes the cut needle records
+    let text = format!(
+        r#"
+[study]
+name = "sampled"
+seed = 5
+
+[data.compression]
+file = "{c}"
+test = "C1"
+
+[data.needle-1]
+file = "{n1}"
+test = "N1"
+
+[models.nh]
+law = "neo-hookean"
+
+[models.nh-axi.n1_needle]
+law = "neo-hookean"
+mesh = "coarse"
+
+[[steps]]
+[steps.sample]
+name = "c1-posterior"
+model = "nh"
+data = ["compression"]
+draws = 150
+tune = 150
+chains = 4
+
+[[steps]]
+[steps.sample]
+name = "n1-posterior"
+model = "nh-axi"
+data = ["needle-1"]
+sampler = "demc"
+draws = 100
+tune = 100
+chains = 2
+box = {{ C10 = [0.0002, 0.003] }}
+design = 4
+holdout = 2
+"#,
+        c = data_dir().join("c1-compression.csv").display(),
+        n1 = dir.join("needle-1.csv").display(),
+    );
+    let path = dir.join("sampled.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+#[test]
+fn chains_and_surrogate_runs_are_shard_units_and_merge_to_the_single_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = sample_manifest(dir.path());
+    let single = dir.path().join("single");
+    let said = ok(
+        palpate(&[
+            "run",
+            m.to_str().unwrap(),
+            "--out",
+            single.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap(),
+        "single run",
+    );
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(single.join("results.json")).unwrap()).unwrap();
+    let steps = results["steps"].as_array().unwrap();
+    let c1 = &steps[0]["sample"]["result"];
+    assert_eq!(c1["chains"], 4, "{said}");
+    assert_eq!(c1["draws_per_chain"], 150);
+    assert!(c1["params"]["C10"]["mean"].as_f64().unwrap() > 0.0);
+    let n1 = &steps[1]["sample"]["result"];
+    assert_eq!(n1["surrogate"]["training_runs"], 4, "{n1}");
+    assert_eq!(n1["surrogate"]["held_out_runs"], 2, "{n1}");
+    assert_eq!(
+        n1["chains"].as_u64().unwrap(),
+        2 * 3,
+        "demc: 2 populations of 3 chains"
+    );
+
+    // One pass of 3 shards: the 4 C1 chains and the 6 FE runs are spread;
+    // the N1 chains wait for all 6 FE runs, so the merge computes those
+    // still missing. Every unit is computed exactly once.
+    let one = dir.path().join("one-pass");
+    let said = shards(&m, &one, 3);
+    let computed: Vec<usize> = said.iter().map(|s| count(s, "units computed")).collect();
+    assert!(computed.iter().all(|&c| c >= 3), "{said:?}");
+    let merged = ok(
+        palpate(&["merge", one.to_str().unwrap()]).output().unwrap(),
+        "merge",
+    );
+    let here = count(&merged, "computed here");
+    assert_eq!(
+        computed.iter().sum::<usize>() + here,
+        12,
+        "{said:?} {merged}"
+    );
+    assert_same(&single, &one);
+
+    // Two passes of 2 shards: the second pass runs the N1 chains on the
+    // surrogate the first pass's FE runs make; the merge only assembles.
+    let two = dir.path().join("two-passes");
+    let first = shards(&m, &two, 2);
+    let second = shards(&m, &two, 2);
+    let total: usize = first
+        .iter()
+        .chain(&second)
+        .map(|s| count(s, "units computed"))
+        .sum();
+    assert_eq!(total, 12, "{first:?} {second:?}");
+    let merged = ok(
+        palpate(&["merge", two.to_str().unwrap()]).output().unwrap(),
+        "merge",
+    );
+    assert!(
+        merged.contains("12 units from the shards' cache, 0 computed here"),
+        "{merged}"
+    );
+    assert_same(&single, &two);
 }

@@ -5,6 +5,9 @@ code behind the ``palpate`` command line, with its options, defaults and
 checks), with the GIL released while it runs. Arrays go in as numpy arrays
 (or file paths) and come out as numpy arrays; an error is raised as
 :class:`PalpateError` carrying the message the command line prints.
+``calibrate``, ``simulate`` and ``sample`` pass arrays in memory (no copy
+at the boundary, docs/python.md says where); ``diagnose`` goes through
+temporary files.
 
 See docs/python.md for a worked example.
 """
@@ -19,6 +22,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from . import _native
 from ._native import PalpateError, __version__
 from ._native import merge as _merge
 from ._native import run_cli as _run_cli
@@ -51,35 +55,78 @@ def cli(*args: str) -> str | None:
     return _run_cli([str(a) for a in args])
 
 
-def _write_record(value: Any, test: str | None, folder: str, name: str) -> str:
-    """A record as a file path: a path as it is; arrays written as CSV.
+def _columns(value: Any, test: str | None, name: str) -> tuple[list[str], list[np.ndarray]] | None:
+    """A record's column names and float64 columns, or None for a path.
 
     Arrays: a mapping ``{column: array}`` with the reader's column names
     (``stretch``, ``stress_MPa``, ``time_s``, ``displacement_mm``,
     ``force_N``, ...), or a pair ``(x, y)`` (stretch and nominal stress in
     MPa for a homogeneous test; displacement in mm and force in N for a
-    benchmark record), or an (n, 2) array read the same way.
+    benchmark record), or an (n, 2) array read the same way. A float64
+    array is taken as it is (``np.asarray`` makes no copy of it); other
+    dtypes are converted.
     """
     if isinstance(value, (str, os.PathLike)):
-        return os.fspath(value)
+        return None
     if isinstance(value, Mapping):
         names = list(value.keys())
-        cols = [np.asarray(value[k], dtype=float).ravel() for k in names]
+        cols = [_column(value[k]) for k in names]
     else:
-        arr = value if isinstance(value, (tuple, list)) else np.asarray(value, dtype=float).T
+        arr = value if isinstance(value, (tuple, list)) else np.asarray(value, dtype=np.float64).T
         if len(arr) != 2:
             raise PalpateError(
                 f"record `{name}`: give a path, a mapping {{column: array}} or a pair (x, y); got {len(arr)} columns"
             )
         names = list(_COLUMNS.get((test or "").lower(), _FORCE))
-        cols = [np.asarray(c, dtype=float).ravel() for c in arr]
+        cols = [_column(c) for c in arr]
     if len({c.size for c in cols}) != 1:
         sizes = ", ".join(f"{n}: {c.size}" for n, c in zip(names, cols))
         raise PalpateError(f"record `{name}`: columns of different lengths ({sizes})")
+    return names, cols
+
+
+def _column(values: Any) -> np.ndarray:
+    """A column as a 1-D float64 array: a 1-D float64 array is returned as
+    it is (the same object, so palpate reads the caller's memory)."""
+    a = np.asarray(values, dtype=np.float64)
+    return a if a.ndim == 1 else a.ravel()
+
+
+def _write_record(value: Any, test: str | None, folder: str, name: str) -> str:
+    """A record as a file path: a path as it is; arrays written as CSV
+    (see :func:`_columns`), for the functions that read files only."""
+    columns = _columns(value, test, name)
+    if columns is None:
+        return os.fspath(value)
+    names, cols = columns
     path = os.path.join(folder, f"{name}.csv")
     # repr-exact: 17 significant digits read back to the same doubles.
     np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(names), comments="", fmt="%.17g")
     return path
+
+
+def _data_in_memory(data: Any, benchmark: str | None) -> tuple[list[str], list]:
+    """``--data`` options and the records they name: a record given as
+    arrays is ``--data TEST=<array:K>`` with K its place in the list (passed
+    to palpate in memory), a path is ``--data TEST=PATH``."""
+    records: list = []
+
+    def option(value: Any, test: str | None, name: str) -> str:
+        columns = _columns(value, test, name)
+        if columns is None:
+            return os.fspath(value)
+        records.append(columns)
+        return f"<array:{len(records) - 1}>"
+
+    if benchmark is not None and not isinstance(data, Mapping) or _is_columns(data):
+        return ["--data", option(data, None, "record")], records
+    if isinstance(data, (str, os.PathLike)):
+        return ["--data", os.fspath(data)], records
+    out = []
+    for i, (test, rec) in enumerate(data.items()):
+        base = test.split("[", 1)[0]
+        out += ["--data", f"{test}={option(rec, base, f'{i}-{base}')}"]
+    return out, records
 
 
 def _data_options(data: Any, benchmark: str | None, folder: str) -> list[str]:
@@ -139,12 +186,21 @@ def calibrate(law: str, data: Any, *, benchmark: str | None = None, fix: Mapping
 
     Returns the JSON of ``--json`` as a dict, with ``params`` (name ->
     value) and, per data set in ``predictions``, numpy arrays.
+
+    Records given as float64 arrays go to palpate in memory (read there as
+    borrowed slices); ``benchmark="Q1"`` (the staged FE identification)
+    reads files, so its record is written to a temporary CSV.
     """
+    flags = _flags({"benchmark": benchmark, "fix": fix, **options})
+    if (benchmark or "").lower() != "q1":
+        data_args, records = _data_in_memory(data, benchmark)
+        result = json.loads(_native.calibrate_arrays(["--law", law, *data_args, *flags], records))
+        _arrays(result)
+        return result
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "fit.json")
         args = ["calibrate", "--law", law, *_data_options(data, benchmark, tmp), "--json", out]
-        args += _flags({"benchmark": benchmark, "fix": fix, **options})
-        _run_cli(args)
+        _run_cli(args + flags)
         result = json.loads(Path(out).read_text())
     _arrays(result)
     return result
@@ -170,16 +226,24 @@ def simulate(benchmark: str, law: str | None = None, params: Mapping[str, float]
     numpy arrays (``displacement_mm``, ``force_N`` and, when present,
     ``time_s``, ``error_estimate_N``; R2: ``position_mm``, ``force_N``,
     ``force_x_N``) and the ``comments`` the CSV carries.
+
+    N1, N3, C1, Q1: the arrays are palpate's own vectors, moved into numpy
+    (no copy, full precision). R2 (a scan) goes through a CSV file (values
+    to the CSV's 10 significant digits).
     """
+    args = ["--benchmark", benchmark]
+    if law is not None:
+        args += ["--law", law]
+    for k, v in (params or {}).items():
+        args += ["--param", f"{k}={float(v)!r}"]
+    args += _flags(options)
+    if benchmark.lower() != "r2":
+        curve = _native.simulate_arrays(args)
+        del curve["title"]
+        return curve
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "curve.csv")
-        args = ["simulate", "--benchmark", benchmark]
-        if law is not None:
-            args += ["--law", law]
-        for k, v in (params or {}).items():
-            args += ["--param", f"{k}={float(v)!r}"]
-        args += _flags(options) + ["--csv", out]
-        _run_cli(args)
+        _run_cli(["simulate", *args, "--csv", out])
         return _read_curve(out)
 
 
@@ -206,18 +270,23 @@ def sample(law: str, data: Any, *, benchmark: str | None = None, seed: int = 0, 
     dims chain x draw; the summary in ``attrs``) when arviz is importable
     (``arviz=False`` refuses it), else a dict: ``draws`` (name -> array
     chains x draws), ``summary`` (the ``--json`` of the command line).
+
+    The draws are palpate's own vector moved into numpy (no copy): each
+    parameter's array is a strided view of it. Records given as float64
+    arrays go to palpate in memory; for the FE benchmarks (N1, N3, Q1) the
+    record is written to a temporary CSV (their surrogate reads files).
     """
+    flags = _flags({"benchmark": benchmark, **options})
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
-        summary_path = os.path.join(tmp, "summary.json")
-        chains_path = os.path.join(tmp, "chains.json")
-        args = ["sample", "--law", law, *_data_options(data, benchmark, tmp), "--seed", str(seed)]
-        args += _flags({"benchmark": benchmark, **options})
-        args += ["--json", summary_path, "--chains", chains_path]
-        _run_cli(args)
-        summary = json.loads(Path(summary_path).read_text())
-        ch = json.loads(Path(chains_path).read_text())
-    values = np.asarray(ch["values"], dtype=float).reshape(ch["n_chains"], ch["n_draws"], len(ch["names"]))
-    draws = {name: values[:, :, j] for j, name in enumerate(ch["names"])}
+        if (benchmark or "").lower() in ("n1", "n3", "q1"):
+            data_args, records = _data_options(data, benchmark, tmp), []
+        else:
+            data_args, records = _data_in_memory(data, benchmark)
+        args = ["--law", law, *data_args, "--seed", str(seed), *flags]
+        names, flat, n_chains, n_draws, summary = _native.sample_arrays(args, records)
+    summary = json.loads(summary)
+    values = flat.reshape(n_chains, n_draws, len(names))  # a view of palpate's vector
+    draws = {name: values[:, :, j] for j, name in enumerate(names)}
     if arviz is not False:
         try:
             import arviz as az  # noqa: PLC0415

@@ -1,7 +1,10 @@
 //! `palpate calibrate`: fit a hyperelastic law to homogeneous-test data or a
 //! C1 force record, print a table, optionally write JSON and an SVG plot.
 
-use crate::calibration::{calibrate, parse_method, ReadOptions, Request, TestData, TestKind};
+use crate::arrays::{record_for, ArrayRecord};
+use crate::calibration::{
+    calibrate, parse_method, Calibration, ReadOptions, Request, TestData, TestKind,
+};
 use crate::models::Viscous;
 use crate::output::{write_atomic, write_json};
 use crate::report::{calibration_table, fit_plot};
@@ -137,6 +140,24 @@ pub fn split_data(d: &str) -> anyhow::Result<(&str, ReadOptions, &str)> {
 
 /// Reads the `--data` options.
 pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec<TestData>> {
+    read_data_with(data, benchmark, &[])
+}
+
+/// Reads the `--data` options, a file part `<array:K>` taking the columns of
+/// `arrays[K]` instead of a file ([`crate::arrays`]).
+pub fn read_data_with(
+    data: &[String],
+    benchmark: Option<&str>,
+    arrays: &[ArrayRecord],
+) -> anyhow::Result<Vec<TestData>> {
+    let read = |name: &str, kind: TestKind, path: &str, options: ReadOptions| match record_for(
+        path, arrays,
+    )
+    .with_context(|| format!("--data {path}"))?
+    {
+        Some(r) => TestData::from_table(name, kind, r.table(&format!("{name} arrays"))?, options),
+        None => TestData::read_with(name, kind, std::path::Path::new(path), options),
+    };
     let mut out = Vec::new();
     match benchmark {
         Some(b) if b.eq_ignore_ascii_case("c1") => {
@@ -152,11 +173,7 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
                         );
                     }
                 }
-                out.push(TestData::read(
-                    "C1",
-                    TestKind::C1,
-                    std::path::Path::new(path),
-                )?);
+                out.push(read("C1", TestKind::C1, path, ReadOptions::default())?);
             }
         }
         Some(b) => anyhow::bail!(
@@ -171,12 +188,7 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
                 } else {
                     test.to_string()
                 };
-                out.push(TestData::read_with(
-                    &name,
-                    kind,
-                    std::path::Path::new(path),
-                    options,
-                )?);
+                out.push(read(&name, kind, path, options)?);
             }
         }
     }
@@ -189,13 +201,42 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .law
         .parse()
         .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
-    if args
-        .benchmark
-        .as_deref()
-        .is_some_and(|b| b.eq_ignore_ascii_case("q1"))
-    {
+    if is_q1(&args) {
         return run_q1(&args, law);
     }
+    let result = fit(&args, &[])?;
+    print!("{}", calibration_table(&result));
+    if let Some(p) = &args.json {
+        write_json(p, &result)?;
+        eprintln!("wrote {}", p.display());
+    }
+    if let Some(p) = &args.plot {
+        write_atomic(p, fit_plot(&result).to_svg().as_bytes())?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
+}
+
+/// Whether `--benchmark Q1` (the staged identification, files only).
+pub fn is_q1(args: &Args) -> bool {
+    args.benchmark
+        .as_deref()
+        .is_some_and(|b| b.eq_ignore_ascii_case("q1"))
+}
+
+/// The fit of `palpate calibrate` (not Q1) without its outputs: what
+/// [`run`] prints and writes, for callers that hold the data in memory
+/// (`--data TEST=<array:K>` takes `arrays[K]`, [`crate::arrays`]). The
+/// checks and messages are those of the command line.
+pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
+    let law: Law = args
+        .law
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    anyhow::ensure!(
+        !is_q1(args),
+        "--benchmark Q1: the staged identification reads its record from a file (palpate calibrate --benchmark Q1 --data FILE)"
+    );
     for (given, name) in [
         (args.stages.is_some(), "--stages"),
         (args.prony_terms.is_some(), "--prony-terms"),
@@ -235,11 +276,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(Viscous::parse)
         .transpose()
         .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
-    let data = read_data(&args.data, args.benchmark.as_deref())?;
+    let data = read_data_with(&args.data, args.benchmark.as_deref(), arrays)?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
     crate::output::check_outputs(&inputs, &outputs)?;
-    let result = calibrate(Request {
+    calibrate(Request {
         law,
         model: None,
         fitted: &data,
@@ -249,17 +290,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fixed,
         observer: None,
         viscous,
-    })?;
-    print!("{}", calibration_table(&result));
-    if let Some(p) = &args.json {
-        write_json(p, &result)?;
-        eprintln!("wrote {}", p.display());
-    }
-    if let Some(p) = &args.plot {
-        write_atomic(p, fit_plot(&result).to_svg().as_bytes())?;
-        eprintln!("wrote {}", p.display());
-    }
-    Ok(())
+    })
 }
 
 /// `palpate calibrate --benchmark Q1`: the staged inverse FE identification

@@ -4,7 +4,7 @@
 //! (`palpate_uq::mcmc::sample_until_converged`); finite-element benchmarks
 //! are sampled through a cached surrogate ([`super::sample_fe`]).
 
-use crate::cli::calibrate::read_data;
+use crate::cli::calibrate::read_data_with;
 use crate::output::{write_atomic, write_json};
 use crate::plot::{grid_svg, Band, Plot, Series, Style};
 use anyhow::Context;
@@ -218,15 +218,37 @@ fn max_draws(args: &Args, draws: usize) -> usize {
     args.max_draws.unwrap_or(draws.saturating_mul(16))
 }
 
+/// The outcome of `palpate sample`: what `--chains OUT.json` and `--json`
+/// write, held in memory.
+#[derive(Debug, Clone)]
+pub struct Sampled {
+    /// The sampled parameters (the law's, then the noise parameters).
+    pub names: Vec<String>,
+    /// Every draw in physical units (chain-major: `values[(c * n_draws +
+    /// d) * dim + k]` is parameter k of draw d of chain c).
+    pub chains: Chains,
+    /// The summary `--json` writes.
+    pub summary: Value,
+}
+
 /// Runs `palpate sample`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    draw(&args, &[]).map(|_| ())
+}
+
+/// Runs `palpate sample` (printing its table and writing the outputs it is
+/// given) and returns the draws and the summary, for callers that want
+/// them in memory (the Python package). `--data TEST=<array:K>` takes the
+/// record `arrays[K]` ([`crate::arrays`]; not with the FE benchmarks N1,
+/// N3, Q1, whose record is read from a file).
+pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Result<Sampled> {
     let law: Law = args
         .law
         .parse()
         .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
-    let sampler = sampler_from(&args)?;
-    check_sizes(&args, &sampler, law.params().len() + 2 * args.data.len())?;
-    super::sample_fe::check_options(&args)?;
+    let sampler = sampler_from(args)?;
+    check_sizes(args, &sampler, law.params().len() + 2 * args.data.len())?;
+    super::sample_fe::check_options(args)?;
     let fe_kind = super::sample_fe::fe_benchmark(args.benchmark.as_deref());
     if let Some(s) = args.sigma {
         anyhow::ensure!(
@@ -258,6 +280,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     let output_dirs = crate::output::given(&[("--plot", &args.plot)]);
     let (sets, fe) = if let Some(kind) = fe_kind {
         anyhow::ensure!(
+            arrays.is_empty(),
+            "--benchmark {kind}: the record is read from a file (--data FILE), not from arrays"
+        );
+        anyhow::ensure!(
             !args.ar1,
             "--ar1: the surrogate's error variance is added to independent noise only; leave out --ar1 with --benchmark {kind}"
         );
@@ -265,7 +291,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             let p = d.split_once('=').map_or(d.as_str(), |x| x.1);
             crate::output::check_outputs_and_dirs(&[Path::new(p)], &outputs, &output_dirs)?;
         }
-        let fe = super::sample_fe::setup(kind, &args)?;
+        let fe = super::sample_fe::setup(kind, args)?;
         let set = DataSet {
             name: kind.to_string(),
             model: fe.surrogate.clone(),
@@ -275,7 +301,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         };
         (vec![set], Some(fe))
     } else {
-        let data = read_data(&args.data, args.benchmark.as_deref())?;
+        let data = read_data_with(&args.data, args.benchmark.as_deref(), arrays)?;
         let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
         crate::output::check_outputs_and_dirs(&inputs, &outputs, &output_dirs)?;
         let sets: Vec<DataSet> = data
@@ -350,7 +376,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 
     let first_draws = palpate_uq::mcmc::converge::draws_of(&sampler);
     let convergence = Convergence {
-        max_draws: max_draws(&args, first_draws),
+        max_draws: max_draws(args, first_draws),
         ..Default::default()
     };
     let bar = std::sync::RwLock::new(None::<crate::limits::Progress>);
@@ -483,9 +509,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     } else {
         None
     };
-    if let Some(path) = &args.json {
+    let summary_json = {
         let mut v = report(
-            &args, &post, run, &summary, &corr, &lap_mean, &lap_sd, &start,
+            args, &post, run, &summary, &corr, &lap_mean, &lap_sd, &start,
         );
         v["evaluations"] = json!(converged.evaluations);
         v["wall_time_s"] = json!(converged.wall_time_s);
@@ -528,7 +554,10 @@ pub fn run(args: Args) -> anyhow::Result<()> {
                 "evaluations": ti.evaluations,
             });
         }
-        write_json(path, &v)?;
+        v
+    };
+    if let Some(path) = &args.json {
+        write_json(path, &summary_json)?;
         eprintln!("wrote {}", path.display());
     }
     if let Some(path) = &args.chains_out {
@@ -549,7 +578,11 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         plots(dir, &post, &x, args.seed)?;
         eprintln!("wrote plots into {}", dir.display());
     }
-    Ok(())
+    Ok(Sampled {
+        names,
+        chains: x,
+        summary: summary_json,
+    })
 }
 
 #[allow(clippy::too_many_arguments)]

@@ -321,6 +321,22 @@ fn is_q1(args: &Args) -> bool {
     args.benchmark.eq_ignore_ascii_case("q1")
 }
 
+/// A force curve of `palpate simulate` (N1, N3, C1, Q1), as its CSV holds
+/// it but at full precision: the columns are the vectors the solver filled.
+#[derive(Debug, Clone)]
+pub struct Curve {
+    /// The model's name.
+    pub title: String,
+    /// The CSV's comment lines (model, volumetric treatment, error estimate).
+    pub comments: Vec<String>,
+    /// `time_s` (Q1 and timed histories), else `None`.
+    pub time_s: Option<Vec<f64>>,
+    pub displacement_mm: Vec<f64>,
+    pub force_n: Vec<f64>,
+    /// `error_estimate_N` when `--error-estimate on` could estimate it.
+    pub error_estimate_n: Option<Vec<f64>>,
+}
+
 /// Runs `palpate simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let model = model_spec(&args)?
@@ -329,6 +345,67 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     if let Model::R2(m) = model {
         return super::simulate_r2::run(&args, m);
     }
+    let (c, solver) = compute(&args, model)?;
+    if let Some(path) = &args.csv {
+        write_curve(
+            path,
+            &c.comments,
+            c.time_s.as_deref(),
+            &c.displacement_mm,
+            &c.force_n,
+            c.error_estimate_n.as_deref(),
+        )?;
+    }
+    if let Some(path) = &args.vtu {
+        let vtu = palpate_fe::vtu::to_vtu(&solver).map_err(|e| anyhow!("{e}"))?;
+        write_atomic(path, vtu.as_bytes())?;
+    }
+    if let Some(path) = &args.plot {
+        let plot = match &c.time_s {
+            Some(t) => {
+                Plot::new(&c.title, "time (s)", "force (N)").with(Series::line("FE", t, &c.force_n))
+            }
+            None => Plot::new(&c.title, "displacement (mm)", "force (N)").with(Series::line(
+                "FE",
+                &c.displacement_mm,
+                &c.force_n,
+            )),
+        };
+        write_atomic(path, plot.to_svg().as_bytes())
+            .with_context(|| format!("plot {}", path.display()))?;
+    }
+    if args.csv.is_none() {
+        print!(
+            "{}",
+            curve_text(
+                &c.comments,
+                c.time_s.as_deref(),
+                &c.displacement_mm,
+                &c.force_n,
+                c.error_estimate_n.as_deref()
+            )
+        );
+    }
+    Ok(())
+}
+
+/// The curve of `palpate simulate` without writing it (the outputs
+/// `--csv`, `--vtu`, `--plot` are left to [`run`]): for callers that want
+/// the vectors, such as the Python package. R2 (a scan, not a force curve)
+/// is refused with the command to use.
+pub fn curve(args: &Args) -> anyhow::Result<Curve> {
+    let model = model_spec(args)?
+        .validate()
+        .map_err(|e| anyhow!("{}", e.as_option()))?;
+    if let Model::R2(_) = model {
+        bail!("--benchmark R2: a scan (position_mm, force_N, force_x_N), not a force curve; run it with palpate simulate --benchmark R2 --csv FILE");
+    }
+    compute(args, model).map(|(c, _)| c)
+}
+
+/// The FE run of `palpate simulate` for a validated N1, N3, C1 or Q1 model:
+/// its curve and the solved system (for `--vtu`).
+fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::system::System)> {
     let law_text = args.law.clone().unwrap_or_default();
     let law: Law = law_text
         .parse()
@@ -344,7 +421,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     )?;
     // needle benchmarks (N1, N3): 10 mm every 0.25 mm
     let n1 = args.benchmark.eq_ignore_ascii_case("n1") || args.benchmark.eq_ignore_ascii_case("n3");
-    let q1 = is_q1(&args);
+    let q1 = is_q1(args);
     let depth = args.depth.unwrap_or(if n1 {
         10.0
     } else if q1 {
@@ -385,7 +462,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         &model,
     )?;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
-    let time = timed_history(&args, depth, &mut drive)?;
+    let time = timed_history(args, depth, &mut drive)?;
     if let Some(end) = time.as_ref().and_then(|t| t.last()) {
         crate::checks::check_increments(&model, *end)?;
     }
@@ -485,47 +562,17 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         comments.push("discretisation error: not estimated (--error-estimate off)".into());
         None
     };
-    if let Some(path) = &args.csv {
-        write_curve(
-            path,
-            &comments,
-            time.as_deref(),
-            &drive,
-            &sim.forces,
-            errors.as_deref(),
-        )?;
-    }
-    if let Some(path) = &args.vtu {
-        let vtu = palpate_fe::vtu::to_vtu(&solver).map_err(|e| anyhow!("{e}"))?;
-        write_atomic(path, vtu.as_bytes())?;
-    }
-    if let Some(path) = &args.plot {
-        let plot = match &time {
-            Some(t) => {
-                Plot::new(&title, "time (s)", "force (N)").with(Series::line("FE", t, &sim.forces))
-            }
-            None => Plot::new(&title, "displacement (mm)", "force (N)").with(Series::line(
-                "FE",
-                &drive,
-                &sim.forces,
-            )),
-        };
-        write_atomic(path, plot.to_svg().as_bytes())
-            .with_context(|| format!("plot {}", path.display()))?;
-    }
-    if args.csv.is_none() {
-        print!(
-            "{}",
-            curve_text(
-                &comments,
-                time.as_deref(),
-                &drive,
-                &sim.forces,
-                errors.as_deref()
-            )
-        );
-    }
-    Ok(())
+    Ok((
+        Curve {
+            title: title.to_string(),
+            comments,
+            time_s: time,
+            displacement_mm: drive,
+            force_n: sim.forces,
+            error_estimate_n: errors,
+        },
+        solver,
+    ))
 }
 
 /// The volumetric treatment in words.

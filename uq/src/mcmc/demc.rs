@@ -63,7 +63,25 @@ impl Default for DemcSettings {
     }
 }
 
-fn run_population(
+/// The checks of [`sample_demc`]'s settings.
+pub(crate) fn check_settings(settings: &DemcSettings) -> Result<(), McmcError> {
+    if settings.populations == 0
+        || settings.chains < 1
+        || settings.draws < 4
+        || settings.thin == 0
+        || settings.archive_every == 0
+    {
+        return Err(McmcError::InvalidSettings {
+            field: "populations/chains/draws/thin/archive_every".into(),
+            reason: "need populations >= 1, chains >= 1, draws >= 4, thin >= 1, archive_every >= 1"
+                .into(),
+        });
+    }
+    Ok(())
+}
+
+/// Population `pop` of a DE-MCz run, alone (its stream is `chain_rng(seed, pop)`).
+pub(crate) fn run_population(
     density: &dyn LogDensity,
     start: &Start,
     s: &DemcSettings,
@@ -164,18 +182,7 @@ pub fn sample_demc(
     let std = Standardized::new(density, start);
     let unit = Start::ball(vec![0.0; d], 1.0);
     let (density, start): (&dyn LogDensity, &Start) = (&std, &unit);
-    if settings.populations == 0
-        || settings.chains < 1
-        || settings.draws < 4
-        || settings.thin == 0
-        || settings.archive_every == 0
-    {
-        return Err(McmcError::InvalidSettings {
-            field: "populations/chains/draws/thin/archive_every".into(),
-            reason: "need populations >= 1, chains >= 1, draws >= 4, thin >= 1, archive_every >= 1"
-                .into(),
-        });
-    }
+    check_settings(settings)?;
     let t0 = std::time::Instant::now();
     let outs: Vec<GroupOut> = (0..settings.populations)
         .into_par_iter()

@@ -63,7 +63,26 @@ impl EnsembleSettings {
     }
 }
 
-fn run_one(
+/// The checks of [`sample_ensemble`]'s settings for dimension `d`.
+pub(crate) fn check_settings(settings: &EnsembleSettings, d: usize) -> Result<(), McmcError> {
+    let nw = settings.walkers_for(d);
+    if nw < 2 * d + 2 {
+        return Err(McmcError::InvalidSettings {
+            field: "walkers".into(),
+            reason: format!("need at least 2 d + 2 = {} walkers, got {nw}", 2 * d + 2),
+        });
+    }
+    if settings.ensembles == 0 || settings.draws < 4 || settings.thin == 0 || settings.a <= 1.0 {
+        return Err(McmcError::InvalidSettings {
+            field: "ensembles/draws/thin/a".into(),
+            reason: "need ensembles >= 1, draws >= 4, thin >= 1, a > 1".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Ensemble `e` of a run, alone (its stream is `chain_rng(seed, e)`).
+pub(crate) fn run_one(
     density: &dyn LogDensity,
     start: &Start,
     s: &EnsembleSettings,
@@ -146,19 +165,7 @@ pub fn sample_ensemble(
     let std = Standardized::new(density, start);
     let unit = Start::ball(vec![0.0; d], 1.0);
     let (density, start): (&dyn LogDensity, &Start) = (&std, &unit);
-    let nw = settings.walkers_for(d);
-    if nw < 2 * d + 2 {
-        return Err(McmcError::InvalidSettings {
-            field: "walkers".into(),
-            reason: format!("need at least 2 d + 2 = {} walkers, got {nw}", 2 * d + 2),
-        });
-    }
-    if settings.ensembles == 0 || settings.draws < 4 || settings.thin == 0 || settings.a <= 1.0 {
-        return Err(McmcError::InvalidSettings {
-            field: "ensembles/draws/thin/a".into(),
-            reason: "need ensembles >= 1, draws >= 4, thin >= 1, a > 1".into(),
-        });
-    }
+    check_settings(settings, d)?;
     let t0 = std::time::Instant::now();
     let outs: Vec<GroupOut> = (0..settings.ensembles)
         .into_par_iter()

@@ -11,6 +11,8 @@
 //! * [`diagnostics`]: R-hat, bulk/tail ESS, MCSE, autocorrelation time, as ArviZ.
 //! * [`summary`]: mean, SD, HDI, correlation.
 //! * [`laplace()`]: mode, Hessian covariance and Laplace evidence.
+//! * [`units`]: a run's chains (populations, ensembles) one at a time, for
+//!   studies that spread them over processes.
 
 // Index loops over coordinates mirror the equations (x_i, L_ij) more
 // plainly than zipped iterators in this numerical code.
@@ -29,6 +31,7 @@ pub mod rng;
 mod standardized;
 pub mod start;
 pub mod summary;
+pub mod units;
 
 pub use chains::{Chains, SampleRun};
 pub use converge::{sample_until_converged, ConvergedRun, Convergence, Worst};
@@ -41,6 +44,7 @@ pub use nuts::{sample_nuts, NutsSettings};
 pub use rng::{chain_rng, ChainRng};
 pub use start::Start;
 pub use summary::{correlation, hdi, summarize, ParamSummary};
+pub use units::UnitRun;
 
 /// Which sampler to run, with its settings.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]

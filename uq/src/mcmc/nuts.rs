@@ -349,16 +349,34 @@ fn initial_eps(ctx: &mut Ctx, z: &Point) -> f64 {
     ctx.eps
 }
 
-struct ChainOut {
-    draws: Vec<Vec<f64>>,
-    logp: Vec<f64>,
-    accept: f64,
-    divergences: usize,
-    eps: f64,
-    evaluations: u64,
+/// What one NUTS chain returns (draws in the standardised space).
+pub(crate) struct ChainOut {
+    pub(crate) draws: Vec<Vec<f64>>,
+    pub(crate) logp: Vec<f64>,
+    pub(crate) accept: f64,
+    pub(crate) divergences: usize,
+    pub(crate) eps: f64,
+    pub(crate) evaluations: u64,
 }
 
-fn run_chain(
+/// The checks of [`sample_nuts`]'s settings.
+pub(crate) fn check_settings(settings: &NutsSettings) -> Result<(), McmcError> {
+    if settings.chains == 0
+        || settings.draws < 4
+        || settings.max_depth == 0
+        || !(settings.target_accept > 0.0 && settings.target_accept < 1.0)
+    {
+        return Err(McmcError::InvalidSettings {
+            field: "chains/draws/max_depth/target_accept".into(),
+            reason: "need chains >= 1, draws >= 4, max_depth >= 1, 0 < target_accept < 1".into(),
+        });
+    }
+    Ok(())
+}
+
+/// Chain `c` of a NUTS run, alone: its stream is `chain_rng(seed, c)`, so
+/// it is the same whichever other chains run, where, or when.
+pub(crate) fn run_chain(
     density: &dyn LogDensity,
     start: &Start,
     s: &NutsSettings,
@@ -497,16 +515,7 @@ pub fn sample_nuts(
     let std = Standardized::new(density, start);
     let unit = Start::ball(vec![0.0; d], 1.0);
     let (density, start): (&dyn LogDensity, &Start) = (&std, &unit);
-    if settings.chains == 0
-        || settings.draws < 4
-        || settings.max_depth == 0
-        || !(settings.target_accept > 0.0 && settings.target_accept < 1.0)
-    {
-        return Err(McmcError::InvalidSettings {
-            field: "chains/draws/max_depth/target_accept".into(),
-            reason: "need chains >= 1, draws >= 4, max_depth >= 1, 0 < target_accept < 1".into(),
-        });
-    }
+    check_settings(settings)?;
     let t0 = std::time::Instant::now();
     let outs: Vec<ChainOut> = (0..settings.chains)
         .into_par_iter()

@@ -211,6 +211,26 @@ impl Surrogate {
     ) -> Result<Surrogate, SurrogateError> {
         let t0 = Instant::now();
         let c0 = cpu_seconds();
+        let all_pts = Self::design(req)?;
+        let width = req.model.outputs().len();
+        let done = std::sync::atomic::AtomicUsize::new(0);
+        let results = run_all(
+            req.model,
+            req.loading,
+            &all_pts,
+            width,
+            &done,
+            all_pts.len(),
+            progress,
+        );
+        Self::assemble(req, results, t0, c0)
+    }
+
+    /// The model runs a surrogate of `req` needs, checked: the training
+    /// points, then the held-out ones (Halton points of the box). Each is
+    /// independent of the others ([`Surrogate::run_point`]), so they may be
+    /// computed anywhere and handed to [`Surrogate::from_runs`] in this order.
+    pub fn design(req: &SurrogateRequest<'_>) -> Result<Vec<Vec<f64>>, SurrogateError> {
         let model = req.model;
         let d = model.space().len();
         if req.bounds.len() != d || req.bounds.names != model.space().names() {
@@ -241,15 +261,59 @@ impl Surrogate {
         req.loading
             .validate()
             .map_err(|e| SurrogateError::InvalidOptions(format!("loading: {e}")))?;
+        let mut all_pts = req.bounds.halton(0, o.training_runs);
+        all_pts.extend(req.bounds.halton(o.training_runs, o.validation_runs));
+        Ok(all_pts)
+    }
+
+    /// One model run of a design: the model's outputs at `theta` along
+    /// `loading` (samples x outputs), or why it failed (a failed run is
+    /// left out of the surrogate, as in [`Surrogate::build`]).
+    pub fn run_point(
+        model: &dyn ForwardModel,
+        loading: &Loading,
+        theta: &[f64],
+    ) -> Result<Vec<f64>, String> {
+        let mut out = vec![0.0; loading.len() * model.outputs().len()];
+        model
+            .evaluator()
+            .predict_outputs_into(theta, loading, &mut out)
+            .map(|_| out)
+            .map_err(|e| e.to_string())
+    }
+
+    /// The surrogate of `req` from the runs at [`Surrogate::design`]'s
+    /// points, in that order (computed by [`Surrogate::run_point`]): the
+    /// same surrogate as [`Surrogate::build`] but for its build times,
+    /// which count this assembly only.
+    pub fn from_runs(
+        req: &SurrogateRequest<'_>,
+        results: Vec<Result<Vec<f64>, String>>,
+    ) -> Result<Surrogate, SurrogateError> {
+        let t0 = Instant::now();
+        let c0 = cpu_seconds();
+        let expected = Self::design(req)?.len();
+        if results.len() != expected {
+            return Err(SurrogateError::InvalidOptions(format!(
+                "{} model runs given for a design of {expected}",
+                results.len()
+            )));
+        }
+        Self::assemble(req, results, t0, c0)
+    }
+
+    fn assemble(
+        req: &SurrogateRequest<'_>,
+        results: Vec<Result<Vec<f64>, String>>,
+        t0: Instant,
+        c0: Option<f64>,
+    ) -> Result<Surrogate, SurrogateError> {
+        let model = req.model;
+        let d = model.space().len();
+        let o = &req.options;
         let outputs = model.outputs();
-        let width = outputs.len();
-        let train_pts = req.bounds.halton(0, o.training_runs);
-        let valid_pts = req.bounds.halton(o.training_runs, o.validation_runs);
-        let total = o.training_runs + o.validation_runs;
-        let done = std::sync::atomic::AtomicUsize::new(0);
-        let mut all_pts = train_pts.clone();
-        all_pts.extend(valid_pts.iter().cloned());
-        let results = run_all(model, req.loading, &all_pts, width, &done, total, progress);
+        let all_pts = Self::design(req)?;
+        let total = all_pts.len();
         let mut failed = Vec::new();
         let mut design = Vec::new();
         let mut curves = Vec::new();
