@@ -293,7 +293,12 @@ pub(crate) fn run_localize(
     let label = format!("{}: {} posteriors", step.name, plans.len());
     let posteriors: Vec<Option<PosteriorRun>> =
         run.units_when(&post_keys, &ready, &label, |i| {
-            let (model, force) = parts[i].as_ref().expect("ready");
+            let (model, force) = parts[i].as_ref().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{at}: the posterior at RD {} before its FE runs",
+                    plans[i].rd
+                )
+            })?;
             posterior(step, &plans[i], model, force, seed)
         })?;
     if posteriors.iter().any(Option::is_none) {
@@ -332,16 +337,12 @@ pub(crate) fn run_localize(
     for ((p, part), post) in plans.iter().zip(parts).zip(posteriors) {
         let rd = p.rd;
         let (Some((model, force)), Some(post)) = (part, post) else {
-            unreachable!("every posterior is there, so every model is");
+            anyhow::bail!("{at}: the results at RD {rd} before its FE runs and posterior");
         };
         let record = noisy_record(step, p, &force, seed)?;
         let mut csv = String::from("position_mm,force_N,force_fe_N\n");
-        for i in 0..record.positions.len() {
-            let _ = writeln!(
-                csv,
-                "{},{:.9e},{:.9e}",
-                record.positions[i], record.force[i], force[i]
-            );
+        for ((x, y), f) in record.positions.iter().zip(&record.force).zip(&force) {
+            let _ = writeln!(csv, "{x},{y:.9e},{f:.9e}");
         }
         write_atomic(&run.out.join(&record.file), csv.as_bytes())?;
         write_json(

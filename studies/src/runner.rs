@@ -489,8 +489,8 @@ impl Run<'_> {
     }
 
     /// The units of `keys` (in order, each claimed once): cached ones read,
-    /// this process's computed in parallel (`compute(k)`) and cached, others'
-    /// `None`.
+    /// this process's computed in parallel (`compute(k)`), each cached as
+    /// soon as it is done, others' `None`.
     pub(crate) fn units<T>(
         &self,
         keys: &[String],
@@ -550,11 +550,19 @@ impl Run<'_> {
                 todo.len(),
                 keys.len()
             ));
-            let done: Vec<anyhow::Result<T>> = todo.par_iter().map(|&k| compute(k)).collect();
+            // Each unit is cached as soon as it is computed: a kill (or a
+            // failed unit) keeps the others (FE runs of minutes each).
+            let folder = self.folder;
+            let done: Vec<anyhow::Result<T>> = todo
+                .par_iter()
+                .map(|&k| {
+                    let unit = compute(k)?;
+                    folder.store(&keys[k], &unit)?;
+                    Ok(unit)
+                })
+                .collect();
             for (&k, r) in todo.iter().zip(done) {
-                let unit = r?;
-                self.folder.store(&keys[k], &unit)?;
-                out[k] = Some(unit);
+                out[k] = Some(r?);
             }
         }
         Ok(out)

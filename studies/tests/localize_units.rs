@@ -10,7 +10,7 @@
 //! tested by studies/tests/shards.rs, ignored for its cost).
 
 use palpate_core::{
-    Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
+    Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
 use palpate_studies::localize::units::{ModelRun, ModelUnits};
 use palpate_studies::localize::{Baseline, LocModel, LocSetup};
@@ -105,17 +105,18 @@ fn units_computed_apart_assemble_to_the_model_built_in_one_go() {
     assert!(va.iter().zip(&vb).all(|(x, y)| x.to_bits() == y.to_bits()));
 
     // Missing, misplaced or unknown units are refused with the reason.
-    let e = units
-        .assemble(runs[..runs.len() - 1].to_vec())
-        .unwrap_err()
-        .to_string();
+    let refusal = |runs: Vec<ModelRun>| match units.assemble(runs) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => format!("{e:#}"),
+    };
+    let e = refusal(runs[..runs.len() - 1].to_vec());
     assert!(
         e.contains("8 results for the 9 units") && e.contains("RD 6"),
         "{e}"
     );
     let mut swapped = runs.clone();
     swapped.swap(0, 1);
-    let e = format!("{:#}", units.assemble(swapped).unwrap_err());
+    let e = refusal(swapped);
     assert!(
         e.contains("unit 0") && e.contains("not the baseline"),
         "{e}"
