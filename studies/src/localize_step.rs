@@ -290,7 +290,7 @@ pub(crate) fn run_localize(
         })
         .collect();
     let ready: Vec<bool> = parts.iter().map(Option::is_some).collect();
-    let label = format!("{}: {} posteriors", step.name, plans.len());
+    let label = format!("{}: posteriors (one per RD)", step.name);
     let posteriors: Vec<Option<PosteriorRun>> =
         run.units_when(&post_keys, &ready, &label, |i| {
             let (model, force) = parts[i].as_ref().ok_or_else(|| {

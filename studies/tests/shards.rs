@@ -3,7 +3,8 @@
 //! predict (FE, N1 coarse) -> anova chain, merged after one pass of the
 //! shards (the merge computes the deferred FE runs) and after two passes
 //! (the shards compute them, the merge only assembles). The same for two
-//! sample steps, whose chains and surrogate FE runs are units. Bad
+//! sample steps, whose chains and surrogate FE runs are units, and (ignored:
+//! minutes of CPU) a localize step, whose FE runs and posterior are. Bad
 //! `--shard` values and a merge with a shard missing are refused with the
 //! reason.
 
@@ -539,12 +540,15 @@ noise = 0.01
 /// assembles; its files (results, report, the record, the localisation
 /// JSON and plot) are byte for byte those of a single run.
 ///
-/// Cost: the single run and the shards each compute the 10 FE runs once
-/// (367 s of CPU for one run of this step, dev profile, at a load average
-/// of 5 to 10 on the 2-core machine); measured in release: see
-/// docs/cluster.md ("A localize step").
+/// Cost: the single run and the shards each compute the 10 FE runs once,
+/// far past the ~90 s of CPU an un-ignored test may take (one run of this
+/// step: 367 s of CPU in the dev profile). Measured in release on the
+/// 2-core machine shared with other jobs (load average 7.3 to 10.4): the
+/// whole test 499 s of CPU (user+sys), 819 s wall; per process in
+/// docs/cluster.md ("A localize step"). The units' enumeration and
+/// assembly are tested cheaply by studies/tests/localize_units.rs.
 #[test]
-#[ignore = "about 12 minutes of CPU: cargo test -p palpate-studies --release --test shards -- --ignored localize"]
+#[ignore = "about 8 minutes of CPU: cargo test -p palpate-studies --release --test shards -- --ignored localize"]
 fn localize_fe_runs_and_posterior_are_shard_units_and_merge_to_the_single_run() {
     let dir = tempfile::tempdir().unwrap();
     let m = localize_manifest(dir.path());
