@@ -160,7 +160,7 @@ impl LocSetup {
     }
 
     /// Wheel positions of the nodule-free pass: the centre, then every
-    /// `step` to [`LocSetup::baseline_end`] past it.
+    /// `step` to the far end of the path from it.
     pub fn baseline_positions(&self) -> Vec<f64> {
         let n = (self.baseline_end() / self.step).round() as usize;
         (0..=n)
