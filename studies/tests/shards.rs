@@ -544,7 +544,8 @@ noise = 0.01
 /// far past the ~90 s of CPU an un-ignored test may take (one run of this
 /// step: 367 s of CPU in the dev profile). Measured in release on the
 /// 2-core machine shared with other jobs (load average 7.3 to 10.4): the
-/// whole test 499 s of CPU (user+sys), 819 s wall; per process in
+/// whole test 499 s of CPU (user+sys), 819 s wall (a second run: 703 s
+/// wall); per process in
 /// docs/cluster.md ("A localize step"). The units' enumeration and
 /// assembly are tested cheaply by studies/tests/localize_units.rs.
 #[test]
