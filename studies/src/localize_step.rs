@@ -12,28 +12,43 @@
 //! noise = 0.01                         # Gaussian noise SD, x the record's peak force
 //! ```
 //!
-//! Per RD: the localisation model (surrogate + nodule-free pass, from the
-//! surrogate cache, built on a miss), the FE record of the nodules at the
-//! finer mesh (cached likewise) with seeded noise, the posterior; written
-//! as `<name>-rd<RD>.json` (the `palpate localize --json` form),
-//! `<name>-rd<RD>.svg` (force against position with the fit, the true and
-//! located nodules, and each nodule's posterior) and report rows; plus the
-//! peak force against depth of one nodule (R2-1, the scan surrogate at
-//! offset 0) and the quadratic depth = a F^2 + b F + c per RD (Table III).
+//! Per RD: the localisation model (the scan surrogate + the nodule-free
+//! pass, `crate::localize`), the FE record of the nodules at the finer
+//! mesh with seeded noise, the posterior; written as `<name>-rd<RD>.json`
+//! (the `palpate localize --json` form), `<name>-rd<RD>.svg` (force against
+//! position with the fit, the true and located nodules, and each nodule's
+//! posterior), `<name>-rd<RD>-record.csv` and report rows; plus the peak
+//! force against depth of one nodule (R2-1, the scan surrogate at offset 0)
+//! and the quadratic depth = a F^2 + b F + c per RD (Table III).
+//!
+//! Units (shards, [`crate::shard`]), as in a sample step: first every FE
+//! run of every RD in RD order (per RD the nodule-free pass, each scan of
+//! the surrogate's design, [`ModelUnits`], then the record), cached in the
+//! run folder as its result under a key of its inputs and the code version;
+//! then each RD's posterior (cached as its result, plot and evaluation
+//! count), which needs all of that RD's FE runs: a shard lacking some
+//! counts it as waiting ([`Run::units_when`]), and a second pass of the
+//! shards or the merge computes it. Every process that needs an RD's model
+//! assembles it from the cached runs (the surrogate's GP fit: well under a
+//! second beside the FE runs). The FE runs do not use the surrogate cache
+//! of `palpate localize`: a study's units live in its run folder.
 
 use crate::cli::localize::plot_svg;
-use crate::localize::posterior::{localize, LocOptions};
+use crate::localize::posterior::{localize, LocOptions, Localisation};
 use crate::localize::record::Record;
+use crate::localize::units::{ModelRun, ModelUnits};
 use crate::localize::{LocModel, LocSetup};
 use crate::manifest::Manifest;
 use crate::output::{write_atomic, write_json};
+use crate::run_folder::RunFolder;
 use crate::runner::{Run, StepResult};
-use crate::surrogate::{default_cache_dir, load_or_compute};
+use crate::surrogate::code_version;
 use palpate_fe::r2::check_model;
+use palpate_fe::r2_scan::R2NoduleScan;
 use palpate_fe::{Nodule, R2Rolling};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use std::fmt::Write;
 use std::path::PathBuf;
 
@@ -68,7 +83,9 @@ pub struct LocalizeStep {
     pub record_step_mm: f64,
     #[serde(default = "default_noise")]
     pub noise: f64,
-    /// Surrogate cache folder (default: as `palpate localize`).
+    /// Refused with the reason (the FE runs are units of the run folder);
+    /// kept so that a manifest of an earlier palpate that set it is told
+    /// why rather than "unknown field".
     #[serde(default)]
     pub cache: Option<PathBuf>,
 }
@@ -97,6 +114,14 @@ impl LocalizeStep {
     pub fn validate(&self, _m: &Manifest, i: usize, where_: &str) -> anyhow::Result<()> {
         let at = format!("{where_}: steps[{i}].localize (\"{}\")", self.name);
         anyhow::ensure!(!self.rds.is_empty(), "{at}.rds = []: give at least one RD");
+        if let Some(c) = &self.cache {
+            anyhow::bail!(
+                "{at}.cache = {:?}: a study caches its FE runs in its run folder \
+                 (RUN_DIR/.palpate/cache, where its shards share them), not in a surrogate cache; \
+                 remove the field",
+                c.display().to_string()
+            );
+        }
         anyhow::ensure!(
             self.record_h_mm > 0.0 && self.record_h_mm.is_finite() && self.record_h_mm <= 30.0,
             "{at}.record_h_mm = {}: an element size in (0, 30] mm",
@@ -128,27 +153,175 @@ impl LocalizeStep {
     }
 }
 
+/// One FE run of the step, as cached: a unit of an RD's localisation
+/// model, or the RD's FE record (the force at each position).
+#[derive(Debug, Clone, Serialize, Deserialize)]
+enum FeRun {
+    Model(ModelRun),
+    Record(Vec<f64>),
+}
+
+/// The posterior of one RD, as cached: what the results, the plot and the
+/// report take from it.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct PosteriorRun {
+    result: Localisation,
+    /// `<name>-rd<RD>.svg`.
+    svg: String,
+    /// Log-density evaluations of the sampler.
+    evaluations: u64,
+}
+
+/// What one RD needs: its model's units, the record's FE model and
+/// positions.
+struct RdPlan {
+    rd: f64,
+    model: ModelUnits<R2NoduleScan>,
+    record: R2Rolling,
+    positions: Vec<f64>,
+}
+
 /// Runs the step.
 pub(crate) fn run_localize(
     run: &Run,
     step: &LocalizeStep,
     report: &mut String,
 ) -> anyhow::Result<StepResult> {
-    let cache = step.cache.clone().unwrap_or_else(default_cache_dir);
+    let at = format!("step `{}`", step.name);
+    let seed = run.manifest.study.seed;
+    let plans: Vec<RdPlan> = step
+        .rds
+        .iter()
+        .map(|&rd| -> anyhow::Result<RdPlan> {
+            let model =
+                ModelUnits::r2(&LocSetup::r2(rd)).map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+            let record = step
+                .record_model(rd)
+                .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+            let positions = record.pass_positions(step.record_step_mm);
+            Ok(RdPlan {
+                rd,
+                model,
+                record,
+                positions,
+            })
+        })
+        .collect::<anyhow::Result<_>>()?;
+    // First level: every FE run of every RD (the model's units, then the
+    // record), in RD order.
+    let mut which: Vec<(usize, Option<usize>)> = Vec::new();
+    let mut keys: Vec<String> = Vec::new();
+    for (i, p) in plans.iter().enumerate() {
+        for k in 0..p.model.len() {
+            which.push((i, Some(k)));
+            keys.push(RunFolder::key(&(
+                "localize FE run",
+                p.model.inputs(k),
+                code_version(),
+            )));
+        }
+        which.push((i, None));
+        keys.push(RunFolder::key(&(
+            "localize FE record",
+            format!("{:?}", p.record),
+            &p.positions,
+            code_version(),
+        )));
+    }
+    let label = format!("{}: FE runs", step.name);
+    let runs: Vec<Option<FeRun>> = run.units(&keys, &label, |u| {
+        let (i, k) = which[u];
+        let p = &plans[i];
+        Ok(match k {
+            Some(k) => FeRun::Model(
+                p.model
+                    .compute(k)
+                    .map_err(|e| anyhow::anyhow!("{at}: {e}"))?,
+            ),
+            None => FeRun::Record(record_force(p)?),
+        })
+    })?;
+    // The models and records of the RDs whose FE runs are all there.
+    let mut parts: Vec<Option<(LocModel, Vec<f64>)>> = Vec::new();
+    for (i, p) in plans.iter().enumerate() {
+        let mine: Vec<&Option<FeRun>> = which
+            .iter()
+            .zip(&runs)
+            .filter(|((j, _), _)| *j == i)
+            .map(|(_, r)| r)
+            .collect();
+        if mine.iter().any(|r| r.is_none()) {
+            parts.push(None);
+            continue;
+        }
+        let mut model_runs = Vec::new();
+        let mut force = Vec::new();
+        for r in mine.into_iter().flatten() {
+            match r {
+                FeRun::Model(m) => model_runs.push(m.clone()),
+                FeRun::Record(f) => force = f.clone(),
+            }
+        }
+        let model = p
+            .model
+            .assemble(model_runs)
+            .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+        parts.push(Some((model, force)));
+    }
+    // Second level: each RD's posterior, once its FE runs are all there.
+    let post_keys: Vec<String> = plans
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            let fe: Vec<&String> = which
+                .iter()
+                .zip(&keys)
+                .filter(|((j, _), _)| *j == i)
+                .map(|(_, k)| k)
+                .collect();
+            RunFolder::key(&(
+                "localize posterior",
+                &step.name,
+                p.rd,
+                fe,
+                step.noise.to_bits(),
+                seed,
+            ))
+        })
+        .collect();
+    let ready: Vec<bool> = parts.iter().map(Option::is_some).collect();
+    let label = format!("{}: posteriors (one per RD)", step.name);
+    let posteriors: Vec<Option<PosteriorRun>> =
+        run.units_when(&post_keys, &ready, &label, |i| {
+            let (model, force) = parts[i].as_ref().ok_or_else(|| {
+                anyhow::anyhow!(
+                    "{at}: the posterior at RD {} before its FE runs",
+                    plans[i].rd
+                )
+            })?;
+            posterior(step, &plans[i], model, force, seed)
+        })?;
+    if posteriors.iter().any(Option::is_none) {
+        // Units of other shards: the runner defers the step.
+        return Ok(StepResult::Localize {
+            name: step.name.clone(),
+            results: Vec::new(),
+        });
+    }
+
     let mut results = Vec::new();
     let _ = writeln!(report, "## Localisation `{}`\n", step.name);
     let _ = writeln!(
         report,
-        "FE records of the nodules `{}` at h = {} mm every {} mm, Gaussian noise SD {} % of the peak force (seed {}); posterior on the localisation model (studies/src/localize).\n",
+        "FE records of the nodules `{}` at h = {} mm every {} mm, Gaussian noise SD {} % of the peak force (seed {seed}); posterior on the localisation model (studies/src/localize).\n",
         step.nodules,
         step.record_h_mm,
         step.record_step_mm,
         100.0 * step.noise,
-        run.manifest.study.seed
     );
     let _ = writeln!(
         report,
-        "| RD mm | nodule (true x:depth) | x mm mean [94 % HDI] | depth mm mean [94 % HDI] | identifiable | R-hat max | posterior s |\n|---|---|---|---|---|---|---|"
+        "| RD mm | nodule (true x:depth) | x mm mean [94 % HDI] | depth mm mean [94 % HDI] | identifiable | R-hat max | posterior evaluations |\n|---|---|---|---|---|---|---|"
     );
     let mut table3 = String::from(
         "\nPeak force of one nodule against depth (R2-1, the scan surrogate at offset 0), and depth = a F^2 + b F + c:\n\n| RD mm |",
@@ -161,63 +334,31 @@ pub(crate) fn run_localize(
         table3.push_str("---|");
     }
     table3.push('\n');
-    for &rd in &step.rds {
-        let model = LocModel::load_or_build(&LocSetup::r2(rd), &cache)?;
-        let fe = step.record_model(rd).map_err(|e| anyhow::anyhow!("{e}"))?;
-        let positions = fe.pass_positions(step.record_step_mm);
-        let desc = format!("{fe:?}; positions {positions:?}");
-        let (force, _): (Vec<f64>, _) = load_or_compute("r2-record", &desc, &cache, || {
-            let bar = crate::limits::Progress::new(
-                positions.len() as u64,
-                &format!("FE record, RD {rd}"),
-                "{msg} [{bar:40}] {pos}/{len} positions ({elapsed}, eta {eta})",
-            );
-            let tick = || bar.inc(1);
-            let r = fe.rolled_pass(&R2Rolling::BENCHMARK_PARAMS, &positions, 2, Some(&tick));
-            bar.finish();
-            Ok(
-                r.map_err(|e| anyhow::anyhow!("the FE record at RD {rd}: {e}"))?
-                    .0
-                    .iter()
-                    .map(|r| r[0])
-                    .collect(),
-            )
-        })?;
-        let peak = force.iter().cloned().fold(0.0, f64::max);
-        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(run.manifest.study.seed);
-        let normal = Normal::new(0.0, (step.noise * peak).max(1e-300))?;
-        let y: Vec<f64> = force.iter().map(|f| f + normal.sample(&mut rng)).collect();
-        let record = Record {
-            file: PathBuf::from(format!("{}-rd{rd}-record.csv", step.name)),
-            positions: positions.clone(),
-            force: y.clone(),
+    for ((p, part), post) in plans.iter().zip(parts).zip(posteriors) {
+        let rd = p.rd;
+        let (Some((model, force)), Some(post)) = (part, post) else {
+            anyhow::bail!("{at}: the results at RD {rd} before its FE runs and posterior");
         };
+        let record = noisy_record(step, p, &force, seed)?;
         let mut csv = String::from("position_mm,force_N,force_fe_N\n");
-        for i in 0..positions.len() {
-            let _ = writeln!(csv, "{},{:.9e},{:.9e}", positions[i], y[i], force[i]);
+        for ((x, y), f) in record.positions.iter().zip(&record.force).zip(&force) {
+            let _ = writeln!(csv, "{x},{y:.9e},{f:.9e}");
         }
         write_atomic(&run.out.join(&record.file), csv.as_bytes())?;
-        let truth: Vec<(f64, f64)> = fe.nodules.iter().map(|n| (n.x, n.depth)).collect();
-        let opts = LocOptions {
-            nodules: truth.len(),
-            seed: run.manifest.study.seed,
-            ..Default::default()
-        };
-        let loc = localize(&model, &positions, &y, &opts, None)?;
         write_json(
             &run.out.join(format!("{}-rd{rd}.json", step.name)),
-            &loc.result,
+            &post.result,
         )?;
         write_atomic(
             &run.out.join(format!("{}-rd{rd}.svg", step.name)),
-            plot_svg(&model, &record, &loc, Some(&truth)).as_bytes(),
+            post.svg.as_bytes(),
         )?;
-        for (e, t) in loc.result.nodules.iter().zip(&truth) {
+        for (e, t) in post.result.nodules.iter().zip(&p.record.nodules) {
             let _ = writeln!(
                 report,
-                "| {rd} | {}:{} | {:.2} [{:.2}, {:.2}] | {:.2} [{:.2}, {:.2}] | {} | {:.3} | {:.2} |",
-                t.0,
-                t.1,
+                "| {rd} | {}:{} | {:.2} [{:.2}, {:.2}] | {:.2} [{:.2}, {:.2}] | {} | {:.3} | {} |",
+                t.x,
+                t.depth,
                 e.x_mm.mean,
                 e.x_mm.hdi_3,
                 e.x_mm.hdi_97,
@@ -225,8 +366,8 @@ pub(crate) fn run_localize(
                 e.depth_mm.hdi_3,
                 e.depth_mm.hdi_97,
                 if e.identifiable { "yes" } else { "NI" },
-                loc.result.rhat_max,
-                loc.wall_s
+                post.result.rhat_max,
+                post.evaluations
             );
         }
         // Table III from the scan surrogate at offset 0
@@ -247,7 +388,7 @@ pub(crate) fn run_localize(
         let _ = writeln!(table3, " {:.5} | {:.5} | {:.4} |", q[0], q[1], q[2]);
         results.push(serde_json::json!({
             "rd_mm": rd,
-            "localisation": loc.result,
+            "localisation": post.result,
             "peak_force_vs_depth": { "depth_mm": R2_1_DEPTHS, "force_N": f, "quadratic_abc": q },
             "surrogate_max_rel_error": model.scan.validation().max_relative_error,
         }));
@@ -257,6 +398,62 @@ pub(crate) fn run_localize(
     Ok(StepResult::Localize {
         name: step.name.clone(),
         results,
+    })
+}
+
+/// The FE record of an RD: the force of the nodules' model at the record's
+/// positions (2 segments whatever the thread count, as the baseline).
+fn record_force(p: &RdPlan) -> anyhow::Result<Vec<f64>> {
+    let rd = p.rd;
+    let r = p
+        .record
+        .rolled_pass(&R2Rolling::BENCHMARK_PARAMS, &p.positions, 2, None);
+    Ok(
+        r.map_err(|e| anyhow::anyhow!("the FE record at RD {rd}: {e}"))?
+            .0
+            .iter()
+            .map(|r| r[0])
+            .collect(),
+    )
+}
+
+/// The record with the study's seeded noise (SD `noise` x its peak force).
+fn noisy_record(
+    step: &LocalizeStep,
+    p: &RdPlan,
+    force: &[f64],
+    seed: u64,
+) -> anyhow::Result<Record> {
+    let peak = force.iter().cloned().fold(0.0, f64::max);
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let normal = Normal::new(0.0, (step.noise * peak).max(1e-300))?;
+    Ok(Record {
+        file: PathBuf::from(format!("{}-rd{}-record.csv", step.name, p.rd)),
+        positions: p.positions.clone(),
+        force: force.iter().map(|f| f + normal.sample(&mut rng)).collect(),
+    })
+}
+
+/// The posterior of an RD's nodules on its model, given the FE record.
+fn posterior(
+    step: &LocalizeStep,
+    p: &RdPlan,
+    model: &LocModel,
+    force: &[f64],
+    seed: u64,
+) -> anyhow::Result<PosteriorRun> {
+    let record = noisy_record(step, p, force, seed)?;
+    let truth: Vec<(f64, f64)> = p.record.nodules.iter().map(|n| (n.x, n.depth)).collect();
+    let opts = LocOptions {
+        nodules: truth.len(),
+        seed,
+        ..Default::default()
+    };
+    let loc = localize(model, &record.positions, &record.force, &opts, None)?;
+    Ok(PosteriorRun {
+        svg: plot_svg(model, &record, &loc, Some(&truth)),
+        result: loc.result,
+        evaluations: loc.evaluations,
     })
 }
 

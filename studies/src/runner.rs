@@ -296,7 +296,7 @@ pub fn run_study_counted(
             // Steps on the results of other steps wait until those are whole;
             // steps without units of their own are left to the merge.
             let waits = matches!(step, Step::Predict(_) | Step::Anova(_)) && !deferred.is_empty();
-            if waits || matches!(step, Step::Anova(_) | Step::Localize(_)) {
+            if waits || matches!(step, Step::Anova(_)) {
                 observer.message(&format!(
                     "{}: left to {} (shard {shard})",
                     step.name(),
@@ -486,6 +486,86 @@ impl Run<'_> {
             &self.others
         };
         counter.fetch_add(1, Ordering::Relaxed);
+    }
+
+    /// The units of `keys` (in order, each claimed once): cached ones read,
+    /// this process's computed in parallel (`compute(k)`), each cached as
+    /// soon as it is done, others' `None`.
+    pub(crate) fn units<T>(
+        &self,
+        keys: &[String],
+        label: &str,
+        compute: impl Fn(usize) -> anyhow::Result<T> + Sync,
+    ) -> anyhow::Result<Vec<Option<T>>>
+    where
+        T: Serialize + serde::de::DeserializeOwned + Send,
+    {
+        self.units_when(keys, &vec![true; keys.len()], label, compute)
+    }
+
+    /// [`Run::units`] for units of a second level: unit k can be computed
+    /// only when `ready[k]` (the units it needs are all there); one not
+    /// ready is counted with [`Run::wait`] at its place and is `None`. Every
+    /// process meets the units in the same order, ready or not, so they
+    /// agree on each unit's owner.
+    pub(crate) fn units_when<T>(
+        &self,
+        keys: &[String],
+        ready: &[bool],
+        label: &str,
+        compute: impl Fn(usize) -> anyhow::Result<T> + Sync,
+    ) -> anyhow::Result<Vec<Option<T>>>
+    where
+        T: Serialize + serde::de::DeserializeOwned + Send,
+    {
+        use rayon::prelude::*;
+        let claims: Vec<Option<Option<bool>>> = keys
+            .iter()
+            .zip(ready)
+            .map(|(k, &r)| {
+                if r {
+                    Some(self.claim(k))
+                } else {
+                    self.wait(k);
+                    None
+                }
+            })
+            .collect();
+        let mut out: Vec<Option<T>> = keys
+            .iter()
+            .zip(&claims)
+            .map(|(k, c)| c.and_then(|_| self.folder.cached(k)))
+            .collect();
+        let cached = out.iter().filter(|u| u.is_some()).count();
+        if cached > 0 {
+            self.observer
+                .message(&format!("{label}: {cached} of {} cached", keys.len()));
+        }
+        let todo: Vec<usize> = (0..keys.len())
+            .filter(|&k| out[k].is_none() && matches!(claims[k], Some(c) if c != Some(false)))
+            .collect();
+        if !todo.is_empty() {
+            self.observer.message(&format!(
+                "{label}: computing {} of {}",
+                todo.len(),
+                keys.len()
+            ));
+            // Each unit is cached as soon as it is computed: a kill (or a
+            // failed unit) keeps the others (FE runs of minutes each).
+            let folder = self.folder;
+            let done: Vec<anyhow::Result<T>> = todo
+                .par_iter()
+                .map(|&k| {
+                    let unit = compute(k)?;
+                    folder.store(&keys[k], &unit)?;
+                    Ok(unit)
+                })
+                .collect();
+            for (&k, r) in todo.iter().zip(done) {
+                out[k] = Some(r?);
+            }
+        }
+        Ok(out)
     }
 
     fn calibrate(&self, step: &CalibrateStep, report: &mut String) -> anyhow::Result<StepResult> {

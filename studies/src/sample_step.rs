@@ -46,7 +46,6 @@ use palpate_core::ForwardModel;
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, NoiseSd, Posterior, Prior};
 use palpate_uq::mcmc::{summarize, DemcSettings, EnsembleSettings, NutsSettings, Sampler, UnitRun};
 use palpate_uq::surrogate::{Surrogate, SurrogateOptions, SurrogateRequest};
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use serde_json::json;
 use std::collections::BTreeMap;
@@ -295,7 +294,7 @@ pub(crate) fn run_sample(
                 })
                 .collect();
             let label = format!("{}: FE runs of the surrogate", step.name);
-            let runs: Vec<Option<DesignRun>> = units(run, &keys, &label, |k| {
+            let runs: Vec<Option<DesignRun>> = run.units(&keys, &label, |k| {
                 Ok(DesignRun {
                     outputs: Surrogate::run_point(model.as_ref(), &rec.loading, &points[k]),
                 })
@@ -373,7 +372,7 @@ pub(crate) fn run_sample(
     let start = fit_and_laplace(&post)
         .map_err(|e| anyhow::anyhow!("{at}: finding the start of the chains: {e}"))?;
     let label = format!("{}: {} chains", step.name, sampler.unit_count());
-    let chains: Vec<Option<UnitRun>> = units(run, &chain_keys, &label, |c| {
+    let chains: Vec<Option<UnitRun>> = run.units(&chain_keys, &label, |c| {
         sampler
             .run_unit(&post, &start.start, seed, c)
             .map_err(|e| anyhow::anyhow!("{at}: chain {c}: {e}"))
@@ -467,44 +466,6 @@ fn write_report(
         );
     }
     let _ = writeln!(r);
-}
-
-/// The units of `keys` (in order, each claimed once): cached ones read,
-/// this process's computed in parallel (`compute(k)`) and cached, others'
-/// `None`.
-fn units<T>(
-    run: &Run,
-    keys: &[String],
-    label: &str,
-    compute: impl Fn(usize) -> anyhow::Result<T> + Sync,
-) -> anyhow::Result<Vec<Option<T>>>
-where
-    T: Serialize + serde::de::DeserializeOwned + Send,
-{
-    let claims: Vec<Option<bool>> = keys.iter().map(|k| run.claim(k)).collect();
-    let mut out: Vec<Option<T>> = keys.iter().map(|k| run.folder.cached(k)).collect();
-    let cached = out.iter().filter(|u| u.is_some()).count();
-    if cached > 0 {
-        run.observer
-            .message(&format!("{label}: {cached} of {} cached", keys.len()));
-    }
-    let todo: Vec<usize> = (0..keys.len())
-        .filter(|&k| out[k].is_none() && claims[k] != Some(false))
-        .collect();
-    if !todo.is_empty() {
-        run.observer.message(&format!(
-            "{label}: computing {} of {}",
-            todo.len(),
-            keys.len()
-        ));
-        let done: Vec<anyhow::Result<T>> = todo.par_iter().map(|&k| compute(k)).collect();
-        for (&k, r) in todo.iter().zip(done) {
-            let unit = r?;
-            run.folder.store(&keys[k], &unit)?;
-            out[k] = Some(unit);
-        }
-    }
-    Ok(out)
 }
 
 #[cfg(test)]

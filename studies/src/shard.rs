@@ -1,10 +1,11 @@
 //! Shards of a study: `palpate run STUDY.toml --shard I/N` computes the
 //! I-th of N deterministic slices of the study's independent units (the
 //! fits of a calibrate step, the records of a diagnose step, the model runs
-//! of a predict step, a two-stage identification) into the run folder's
-//! cache ([`crate::run_folder`]); `palpate merge RUN_DIR` then runs the
-//! study over the filled cache and writes the same bytes as a run in one
-//! process (a unit's record is the same JSON whichever process computed
+//! of a predict step, a two-stage identification, the FE runs and chains of
+//! a sample step, the FE runs and posteriors of a localize step) into the
+//! run folder's cache ([`crate::run_folder`]); `palpate merge RUN_DIR` then
+//! runs the study over the filled cache and writes the same bytes as a run
+//! in one process (a unit's record is the same JSON whichever process computed
 //! it, and the results are assembled in the manifest's order).
 //!
 //! The slice: the k-th unit (in manifest order) of step s belongs to shard

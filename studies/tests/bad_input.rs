@@ -1060,8 +1060,9 @@ fn r2_geometry_is_checked_before_the_fe_run() {
     refused(&r2(&["--rd", "9"]), &["rd", "deeper"]);
 }
 
-/// `[steps.localize]`: a bad RD or nodule list is refused by `run --check`,
-/// naming the manifest field.
+/// `[steps.localize]`: a bad RD or nodule list, or the surrogate cache of
+/// an earlier palpate, is refused by `run --check`, naming the manifest
+/// field.
 #[test]
 fn localize_step_fields_are_checked() {
     let s = Scratch::new();
@@ -1081,6 +1082,15 @@ fn localize_step_fields_are_checked() {
         ),
         ("rds = [3]\nnodules = \"75:29\"", vec!["nodules", "depth"]),
         ("rds = [3]\nnoise = -1", vec!["noise = -1"]),
+        (
+            "rds = [3]\ncache = \"c\"",
+            vec![
+                "steps[0].localize",
+                "cache = \"c\"",
+                "run folder",
+                "remove the field",
+            ],
+        ),
     ] {
         let m = s.file("m.toml", &step(body));
         refused(&s.run(&["run", "--check", &m]), &needles);

@@ -3,7 +3,8 @@
 //! predict (FE, N1 coarse) -> anova chain, merged after one pass of the
 //! shards (the merge computes the deferred FE runs) and after two passes
 //! (the shards compute them, the merge only assembles). The same for two
-//! sample steps, whose chains and surrogate FE runs are units. Bad
+//! sample steps, whose chains and surrogate FE runs are units, and (ignored:
+//! minutes of CPU) a localize step, whose FE runs and posterior are. Bad
 //! `--shard` values and a merge with a shard missing are refused with the
 //! reason.
 
@@ -506,4 +507,94 @@ fn chains_and_surrogate_runs_are_shard_units_and_merge_to_the_single_run() {
         "{merged}"
     );
     assert_same(&single, &two);
+}
+
+/// The cheapest localize step the manifest allows: one RD (3 mm), one
+/// nodule (75:15), the record on a 3 mm mesh every 10 mm (14 positions).
+/// The localisation model is fixed by R2 (`LocSetup::r2`: 6 + 2 FE scans
+/// of 16 offsets at h = 2 mm, and the nodule-free pass of 34 positions).
+/// Units: 10 FE runs (the pass, 8 scans, the record), then 1 posterior.
+fn localize_manifest(dir: &Path) -> PathBuf {
+    let text = r#"
+[study]
+name = "localized"
+seed = 3
+
+[[steps]]
+[steps.localize]
+name = "r2"
+rds = [3]
+nodules = "75:15"
+record_h_mm = 3.0
+record_step_mm = 10.0
+noise = 0.01
+"#;
+    let path = dir.join("localized.toml");
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// A localize step's FE runs and its posterior are shard units: two
+/// passes of two shards (the first computes the 10 FE runs, 5 each; the
+/// second the posterior, which needs them all), then the merge, which only
+/// assembles; its files (results, report, the record, the localisation
+/// JSON and plot) are byte for byte those of a single run.
+///
+/// Cost: the single run and the shards each compute the 10 FE runs once,
+/// far past the ~90 s of CPU an un-ignored test may take (one run of this
+/// step: 367 s of CPU in the dev profile). Measured in release on the
+/// 2-core machine shared with other jobs (load average 7.3 to 10.4): the
+/// whole test 499 s of CPU (user+sys), 819 s wall (a second run: 703 s
+/// wall); per process in
+/// docs/cluster.md ("A localize step"). The units' enumeration and
+/// assembly are tested cheaply by studies/tests/localize_units.rs.
+#[test]
+#[ignore = "about 8 minutes of CPU: cargo test -p palpate-studies --release --test shards -- --ignored localize"]
+fn localize_fe_runs_and_posterior_are_shard_units_and_merge_to_the_single_run() {
+    let dir = tempfile::tempdir().unwrap();
+    let m = localize_manifest(dir.path());
+    let single = dir.path().join("single");
+    let said = ok(
+        palpate(&[
+            "run",
+            m.to_str().unwrap(),
+            "--out",
+            single.to_str().unwrap(),
+        ])
+        .output()
+        .unwrap(),
+        "single run",
+    );
+    let results: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(single.join("results.json")).unwrap()).unwrap();
+    let rd = &results["steps"][0]["localize"]["results"][0];
+    assert_eq!(rd["rd_mm"], 3.0, "{said}");
+    assert_eq!(rd["localisation"]["surrogate"]["fe_runs"], 9, "{rd}");
+
+    let sharded = dir.path().join("sharded");
+    let first = shards(&m, &sharded, 2);
+    let fe: Vec<usize> = first.iter().map(|s| count(s, "units computed")).collect();
+    assert_eq!(fe, [5, 5], "{first:?}");
+    assert!(!sharded.join("results.json").exists());
+    let second = shards(&m, &sharded, 2);
+    let post: Vec<usize> = second.iter().map(|s| count(s, "units computed")).collect();
+    assert_eq!(post.iter().sum::<usize>(), 1, "{second:?}");
+    let merged = ok(
+        palpate(&["merge", sharded.to_str().unwrap()])
+            .output()
+            .unwrap(),
+        "merge",
+    );
+    assert!(
+        merged.contains("11 units from the shards' cache, 0 computed here"),
+        "{merged}"
+    );
+    assert_same(&single, &sharded);
+    for f in ["r2-rd3-record.csv", "r2-rd3.json", "r2-rd3.svg"] {
+        let (x, y) = (
+            std::fs::read(single.join(f)).unwrap(),
+            std::fs::read(sharded.join(f)).unwrap(),
+        );
+        assert!(x == y, "{f} differs between the single run and the merge");
+    }
 }

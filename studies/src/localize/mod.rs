@@ -27,6 +27,7 @@
 
 pub mod posterior;
 pub mod record;
+pub mod units;
 
 use crate::surrogate::{load_or_build, load_or_compute, CacheStatus};
 use palpate_core::{Drive, ForwardModel, Loading};
@@ -131,6 +132,65 @@ impl LocSetup {
         (far / self.step).ceil() * self.step
     }
 
+    /// The FE model of the scan: one nodule at the block's centre, its
+    /// depth the parameter.
+    pub fn scan_model(&self) -> R2NoduleScan {
+        R2NoduleScan::new(self.template.clone(), false)
+    }
+
+    /// The scan's loading: the offsets from the nodule.
+    pub fn scan_loading(&self) -> Loading {
+        Loading::quasi_static(Drive::PositionMm, self.offsets())
+    }
+
+    /// The surrogate's box: every depth the mesh allows for `scan`.
+    pub fn scan_bounds(&self, scan: &dyn ForwardModel) -> anyhow::Result<ParamBox> {
+        let p = &scan.space().params[0];
+        ParamBox::new(scan.space(), &[p.lower], &[p.upper])
+            .map_err(|e| anyhow::anyhow!("depth box: {e}"))
+    }
+
+    /// The surrogate's design sizes.
+    pub fn scan_options(&self) -> SurrogateOptions {
+        SurrogateOptions {
+            training_runs: self.training,
+            validation_runs: self.holdout,
+            basis_tolerance: 1e-5,
+        }
+    }
+
+    /// Wheel positions of the nodule-free pass: the centre, then every
+    /// `step` to the far end of the path from it.
+    pub fn baseline_positions(&self) -> Vec<f64> {
+        let n = (self.baseline_end() / self.step).round() as usize;
+        (0..=n)
+            .map(|k| self.centre() + self.step * k as f64)
+            .collect()
+    }
+
+    /// The nodule-free FE pass from the centre. Always in 2 segments (not
+    /// one per thread): a segment's press differs from the rolled state in
+    /// the solver's last digits, and the force must not depend on the
+    /// machine's thread count (a study's shards and its single run agree
+    /// byte for byte). `tick` is called once per solved position.
+    pub fn baseline_pass(&self, tick: Option<&(dyn Fn() + Sync)>) -> anyhow::Result<Baseline> {
+        let t = &self.template;
+        let positions = self.baseline_positions();
+        let mut m = t.with_nodules(Vec::new());
+        m.press_x = self.centre();
+        m.roll_to = self.centre() + self.baseline_end();
+        let t0 = std::time::Instant::now();
+        let (rows, _) = m
+            .rolled_pass(&R2Rolling::BENCHMARK_PARAMS, &positions, 2, tick)
+            .map_err(|e| anyhow::anyhow!("the nodule-free R2 pass at RD {}: {e}", t.rd))?;
+        Ok(Baseline {
+            centre: self.centre(),
+            step: self.step,
+            force: rows.iter().map(|r| r[0]).collect(),
+            time_s: t0.elapsed().as_secs_f64(),
+        })
+    }
+
     /// Everything that defines the cached FE results (the code version is
     /// added by the cache).
     pub fn description(&self) -> String {
@@ -198,56 +258,27 @@ impl LocModel {
         setup
             .check()
             .map_err(|(f, r)| anyhow::anyhow!("{f} {}: {r}", setup.template.rd))?;
-        let t = &setup.template;
-        let centre = setup.centre();
-        let step = setup.step;
-        let end = setup.baseline_end();
-        let theta = R2Rolling::BENCHMARK_PARAMS;
         let (baseline, baseline_status) =
             load_or_compute("r2-baseline", &setup.description(), cache, || {
-                let n = (end / step).round() as usize;
-                let positions: Vec<f64> = (0..=n).map(|k| centre + step * k as f64).collect();
-                let mut m = t.with_nodules(Vec::new());
-                m.press_x = centre;
-                m.roll_to = centre + end;
                 let bar = crate::limits::Progress::new(
-                    positions.len() as u64,
+                    setup.baseline_positions().len() as u64,
                     "nodule-free FE pass",
                     "{msg} [{bar:40}] {pos}/{len} positions ({elapsed}, eta {eta})",
                 );
                 let tick = || bar.inc(1);
-                let t0 = std::time::Instant::now();
-                let segments = rayon::current_num_threads().clamp(1, 2);
-                let r = m.rolled_pass(&theta, &positions, segments, Some(&tick));
+                let b = setup.baseline_pass(Some(&tick));
                 bar.finish();
-                let (rows, _) =
-                    r.map_err(|e| anyhow::anyhow!("the nodule-free R2 pass at RD {}: {e}", t.rd))?;
-                Ok(Baseline {
-                    centre,
-                    step,
-                    force: rows.iter().map(|r| r[0]).collect(),
-                    time_s: t0.elapsed().as_secs_f64(),
-                })
+                b
             })?;
-        let scan = R2NoduleScan::new(t.clone(), false);
-        let lo = scan.space().params[0].lower;
-        let hi = scan.space().params[0].upper;
-        let bounds = ParamBox::new(scan.space(), &[lo], &[hi])
-            .map_err(|e| anyhow::anyhow!("depth box: {e}"))?;
-        let loading = Loading::quasi_static(Drive::PositionMm, setup.offsets());
-        let options = SurrogateOptions {
-            training_runs: setup.training,
-            validation_runs: setup.holdout,
-            basis_tolerance: 1e-5,
-        };
+        let scan = setup.scan_model();
         let (s, status) = load_or_build(
             &scan,
-            &loading,
-            bounds,
-            options,
+            &setup.scan_loading(),
+            setup.scan_bounds(&scan)?,
+            setup.scan_options(),
             &setup.description(),
             cache,
-            &format!("R2 scan surrogate, RD {}", t.rd),
+            &format!("R2 scan surrogate, RD {}", setup.template.rd),
         )?;
         Self::from_parts(setup, s, baseline, Some(status), Some(baseline_status))
     }

@@ -1,0 +1,156 @@
+//! The FE runs behind the localisation model of one RD as independent
+//! units, what the shards of a study's localize step compute
+//! (`crate::localize_step`, `crate::shard`): unit 0 the nodule-free pass
+//! F0 ([`LocSetup::baseline_pass`]), then one unit per scan of the
+//! surrogate's design (the depths [`Surrogate::design`] gives for
+//! [`LocSetup::scan_model`]: the training ones, then the held-out ones).
+//! Each unit is computed alone ([`ModelUnits::compute`]), anywhere, and the
+//! model is assembled once all are there ([`ModelUnits::assemble`], the
+//! surrogate by [`Surrogate::from_runs`]): the model
+//! [`LocModel::load_or_build`] makes in one process, but for the build
+//! times (tested in `studies/tests/localize_units.rs`).
+//!
+//! The scan model is a type parameter so that the enumeration and the
+//! assembly can be tested on a cheap stand-in for the FE scan; a study
+//! uses [`ModelUnits::r2`].
+
+use super::{Baseline, LocModel, LocSetup};
+use crate::surrogate::code_version;
+use palpate_core::{ForwardModel, Loading};
+use palpate_fe::r2_scan::R2NoduleScan;
+use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateRequest};
+use serde::{Deserialize, Serialize};
+
+/// The result of one unit, as a run folder caches it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub enum ModelRun {
+    /// Unit 0: the nodule-free pass.
+    Baseline(Baseline),
+    /// A scan of the design: the force at the offsets, or why the FE run
+    /// failed (the surrogate leaves a failed run out, as `Surrogate::build`).
+    Scan(Result<Vec<f64>, String>),
+}
+
+/// The units of one RD's localisation model.
+pub struct ModelUnits<M> {
+    setup: LocSetup,
+    scan: M,
+    loading: Loading,
+    bounds: ParamBox,
+    /// The scan depths, training then held-out.
+    points: Vec<Vec<f64>>,
+}
+
+impl ModelUnits<R2NoduleScan> {
+    /// The units of `setup`'s model (checked: RD, scan and design).
+    pub fn r2(setup: &LocSetup) -> anyhow::Result<Self> {
+        setup
+            .check()
+            .map_err(|(f, r)| anyhow::anyhow!("{f} {}: {r}", setup.template.rd))?;
+        Self::new(setup, setup.scan_model())
+    }
+}
+
+impl<M: ForwardModel> ModelUnits<M> {
+    /// The units of `setup` with `scan` as the scanned model (depth ->
+    /// force at `setup.offsets()`).
+    pub fn new(setup: &LocSetup, scan: M) -> anyhow::Result<Self> {
+        let bounds = setup.scan_bounds(&scan)?;
+        let mut u = ModelUnits {
+            setup: setup.clone(),
+            scan,
+            loading: setup.scan_loading(),
+            bounds,
+            points: Vec::new(),
+        };
+        u.points = Surrogate::design(&u.request())
+            .map_err(|e| anyhow::anyhow!("the design of the R2 scan surrogate: {e}"))?;
+        Ok(u)
+    }
+
+    /// The surrogate's request; its description is `palpate localize`'s
+    /// (the setup and the code version), so the assembled surrogate has
+    /// the key of the one [`LocModel::load_or_build`] caches.
+    pub fn request(&self) -> SurrogateRequest<'_> {
+        SurrogateRequest {
+            model: &self.scan,
+            loading: &self.loading,
+            bounds: self.bounds.clone(),
+            options: self.setup.scan_options(),
+            description: format!("{}; {}", self.setup.description(), code_version()),
+        }
+    }
+
+    /// Number of units: the baseline and the design's scans.
+    pub fn len(&self) -> usize {
+        1 + self.points.len()
+    }
+
+    /// Never empty (the baseline is always a unit).
+    pub fn is_empty(&self) -> bool {
+        false
+    }
+
+    /// Everything unit `k`'s result depends on but the code version (a
+    /// study adds it to the cache key): the setup (RD, laws, mesh, block,
+    /// path, scan), and for a scan the model, the offsets and the depth.
+    pub fn inputs(&self, k: usize) -> String {
+        let setup = self.setup.description();
+        match k {
+            0 => format!("R2 localisation baseline; {setup}"),
+            _ => format!(
+                "R2 localisation scan; {setup}; {}; offsets {:?}; depth {:?}",
+                self.scan.name(),
+                self.loading.drive,
+                self.points[k - 1]
+            ),
+        }
+    }
+
+    /// Computes unit `k` (an FE run: seconds to minutes). A failed scan
+    /// is a result (the surrogate leaves it out); a failed baseline is an
+    /// error, as the model cannot do without it.
+    pub fn compute(&self, k: usize) -> anyhow::Result<ModelRun> {
+        anyhow::ensure!(
+            k < self.len(),
+            "unit {k} of a localisation model of {} units",
+            self.len()
+        );
+        Ok(match k {
+            0 => ModelRun::Baseline(self.setup.baseline_pass(None)?),
+            _ => ModelRun::Scan(Surrogate::run_point(
+                &self.scan,
+                &self.loading,
+                &self.points[k - 1],
+            )),
+        })
+    }
+
+    /// The model from every unit's result, in unit order.
+    pub fn assemble(&self, runs: Vec<ModelRun>) -> anyhow::Result<LocModel> {
+        let rd = self.setup.template.rd;
+        anyhow::ensure!(
+            runs.len() == self.len(),
+            "{} results for the {} units of the localisation model at RD {rd}",
+            runs.len(),
+            self.len()
+        );
+        let mut runs = runs.into_iter();
+        let Some(ModelRun::Baseline(baseline)) = runs.next() else {
+            anyhow::bail!("unit 0 of the localisation model at RD {rd} is not the baseline");
+        };
+        let scans = runs
+            .enumerate()
+            .map(|(k, r)| match r {
+                ModelRun::Scan(s) => Ok(s),
+                ModelRun::Baseline(_) => Err(anyhow::anyhow!(
+                    "unit {} of the localisation model at RD {rd} is not a scan",
+                    k + 1
+                )),
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let s = Surrogate::from_runs(&self.request(), scans)
+            .map_err(|e| anyhow::anyhow!("building the surrogate of {}: {e}", self.scan.name()))?;
+        LocModel::from_parts(&self.setup, s, baseline, None, None)
+    }
+}
