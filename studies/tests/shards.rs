@@ -220,24 +220,32 @@ fn shards_then_merge_write_the_bytes_of_a_single_run() {
 
     // Two passes of 2 shards: the second spreads the FE runs; the merge
     // only assembles.
-    let two = dir.path().join("two-passes");
-    let first = shards(&m, &two, 2);
-    let second = shards(&m, &two, 2);
-    let computed: usize = first
+    two_passes_then_merge(&m, &dir.path().join("two-passes"), &single, 6);
+}
+
+/// Two passes of 2 shards into `two` (the second computes what waited on
+/// the first), which compute `units` units between them; the merge then
+/// only assembles, and the run folder equals the single run's `single`.
+fn two_passes_then_merge(m: &Path, two: &Path, single: &Path, units: usize) {
+    let first = shards(m, two, 2);
+    let second = shards(m, two, 2);
+    let total: usize = first
         .iter()
         .chain(&second)
         .map(|s| count(s, "units computed"))
         .sum();
-    assert_eq!(computed, 6, "{first:?} {second:?}");
+    assert_eq!(total, units, "{first:?} {second:?}");
     let merged = ok(
         palpate(&["merge", two.to_str().unwrap()]).output().unwrap(),
         "merge",
     );
     assert!(
-        merged.contains("6 units from the shards' cache, 0 computed here"),
+        merged.contains(&format!(
+            "{units} units from the shards' cache, 0 computed here"
+        )),
         "{merged}"
     );
-    assert_same(&single, &two);
+    assert_same(single, two);
 }
 
 /// The number before `what` in a line of output.
@@ -489,24 +497,7 @@ fn chains_and_surrogate_runs_are_shard_units_and_merge_to_the_single_run() {
 
     // Two passes of 2 shards: the second pass runs the N1 chains on the
     // surrogate the first pass's FE runs make; the merge only assembles.
-    let two = dir.path().join("two-passes");
-    let first = shards(&m, &two, 2);
-    let second = shards(&m, &two, 2);
-    let total: usize = first
-        .iter()
-        .chain(&second)
-        .map(|s| count(s, "units computed"))
-        .sum();
-    assert_eq!(total, 12, "{first:?} {second:?}");
-    let merged = ok(
-        palpate(&["merge", two.to_str().unwrap()]).output().unwrap(),
-        "merge",
-    );
-    assert!(
-        merged.contains("12 units from the shards' cache, 0 computed here"),
-        "{merged}"
-    );
-    assert_same(&single, &two);
+    two_passes_then_merge(&m, &dir.path().join("two-passes"), &single, 12);
 }
 
 /// The cheapest localize step the manifest allows: one RD (3 mm), one
