@@ -248,6 +248,20 @@ fn two_passes_then_merge(m: &Path, two: &Path, single: &Path, units: usize) {
     assert_same(single, two);
 }
 
+/// A run of the manifest `m` in one process into `out`: what it printed
+/// and its results.json.
+fn single_run(m: &Path, out: &Path) -> (String, serde_json::Value) {
+    let said = ok(
+        palpate(&["run", m.to_str().unwrap(), "--out", out.to_str().unwrap()])
+            .output()
+            .unwrap(),
+        "single run",
+    );
+    let results =
+        serde_json::from_slice(&std::fs::read(out.join("results.json")).unwrap()).unwrap();
+    (said, results)
+}
+
 /// The number before `what` in a line of output.
 fn count(text: &str, what: &str) -> usize {
     let at = text
@@ -449,19 +463,7 @@ fn chains_and_surrogate_runs_are_shard_units_and_merge_to_the_single_run() {
     let dir = tempfile::tempdir().unwrap();
     let m = sample_manifest(dir.path());
     let single = dir.path().join("single");
-    let said = ok(
-        palpate(&[
-            "run",
-            m.to_str().unwrap(),
-            "--out",
-            single.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap(),
-        "single run",
-    );
-    let results: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(single.join("results.json")).unwrap()).unwrap();
+    let (said, results) = single_run(&m, &single);
     let steps = results["steps"].as_array().unwrap();
     let c1 = &steps[0]["sample"]["result"];
     assert_eq!(c1["chains"], 4, "{said}");
@@ -545,19 +547,7 @@ fn localize_fe_runs_and_posterior_are_shard_units_and_merge_to_the_single_run() 
     let dir = tempfile::tempdir().unwrap();
     let m = localize_manifest(dir.path());
     let single = dir.path().join("single");
-    let said = ok(
-        palpate(&[
-            "run",
-            m.to_str().unwrap(),
-            "--out",
-            single.to_str().unwrap(),
-        ])
-        .output()
-        .unwrap(),
-        "single run",
-    );
-    let results: serde_json::Value =
-        serde_json::from_slice(&std::fs::read(single.join("results.json")).unwrap()).unwrap();
+    let (said, results) = single_run(&m, &single);
     let rd = &results["steps"][0]["localize"]["results"][0];
     assert_eq!(rd["rd_mm"], 3.0, "{said}");
     assert_eq!(rd["localisation"]["surrogate"]["fe_runs"], 9, "{rd}");
