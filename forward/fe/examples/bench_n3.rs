@@ -9,7 +9,11 @@
 //!
 //! `cargo run --release -p palpate-fe --example bench_n3 -- [level ...]
 //!  [--depth D] [--law nh|rp2|both] [--friction 0|0.8|both] [--grading h,zone,growth]
-//!  [--mesh ogrid|box] [--core N] [--max-step S] [--bulk K/mu]`
+//!  [--mesh ogrid|box] [--element hex8|hex27] [--core N] [--max-step S] [--bulk K/mu]
+//!  [--reuse N] [--contact gauss|nodes]`
+//! (`--reuse`: GMRES iterations allowed on kept factors before a new
+//! factorisation, `SolverOptions::preconditioner_reuse`; 0 factorises at
+//! every full Newton iteration)
 //! (`--bulk`: compressible with K = ratio x mu instead of exactly
 //! incompressible, as CalculiX's K = 1000 mu; to 1 mm or less every force
 //! is printed)
@@ -18,7 +22,7 @@ use std::time::Instant;
 
 use palpate_core::{Drive, ForwardError, Loading};
 use palpate_fe::mesh::Grading;
-use palpate_fe::{N3Mesh, N3Needle};
+use palpate_fe::{N3Element, N3Mesh, N3Needle};
 
 #[path = "common/cpu.rs"]
 mod cpu;
@@ -46,6 +50,9 @@ fn main() {
     let mut core: Option<usize> = None;
     let mut solver = String::from("default");
     let mut bulk: Option<f64> = None;
+    let mut element = N3Element::Hex8;
+    let mut reuse: Option<usize> = None;
+    let mut nodal_contact = false;
     let mut it = args.iter();
     while let Some(a) = it.next() {
         let mut value = || it.next().expect("a value after the option").clone();
@@ -58,6 +65,14 @@ fn main() {
                 })
             }
             "--solver" => solver = value(),
+            "--contact" => nodal_contact = value() == "nodes",
+            "--reuse" => reuse = Some(value().parse().expect("GMRES iterations")),
+            "--element" => {
+                element = match value().as_str() {
+                    "hex27" => N3Element::Hex27,
+                    _ => N3Element::Hex8,
+                }
+            }
             "--bulk" => bulk = Some(value().parse().expect("K/mu")),
             "--core" => core = Some(value().parse().expect("core cells")),
             "--max-step" => max_step = Some(value().parse().expect("max step")),
@@ -112,6 +127,13 @@ fn main() {
                     m.mesh = l;
                 }
                 let layout = m.mesh;
+                m.element = element;
+                if nodal_contact {
+                    m.contact_points = palpate_fe::contact::ContactPoints::Nodes;
+                }
+                if let Some(r) = reuse {
+                    m.options.preconditioner_reuse = r;
+                }
                 m.core_cells = core;
                 if let Some(r) = bulk {
                     m.bulk = palpate_fe::Bulk::Ratio(r);
@@ -130,19 +152,25 @@ fn main() {
                     m.options.max_step = s;
                 }
                 let label = match grading {
-                    Some(g) => format!("{layout:?} {}/{}/{}", g.h_fine, g.fine_length, g.growth),
-                    None => format!("{layout:?} level {level}"),
+                    Some(g) => format!(
+                        "{layout:?} {element:?} {}/{}/{}",
+                        g.h_fine, g.fine_length, g.growth
+                    ),
+                    None => format!("{layout:?} {element:?} level {level}"),
                 };
                 let (t, c) = (Instant::now(), cpu_seconds(false));
                 let result = m.simulate(&theta, &loading, None);
                 let (wall, cpu) = (t.elapsed().as_secs_f64(), cpu_seconds(false) - c);
-                let mut linear = String::new();
+                let linear;
                 let (forces, stats, cells, unknowns, reached) = match result {
                     Ok((sim, sys)) => {
                         let (gs, gi, gf, lf, len) = sys.linear_solver_stats();
                         linear = format!(
-                            "  gmres {gs} solves {gi} iterations {gf} to LU; ldlt->LU {lf}; L entries {}",
-                            len.map_or("-".into(), |l| l.to_string())
+                            "  gmres {gs} solves {gi} iterations {gf} to LU; ldlt->LU {lf}; L entries {}; {} steps on kept factors; assembly {:.1} s, linear solves {:.1} s",
+                            len.map_or("-".into(), |l| l.to_string()),
+                            sim.stats.reused_factors,
+                            sim.stats.assembly_seconds,
+                            sim.stats.solve_seconds
                         );
                         (
                             sim.forces,
@@ -152,7 +180,10 @@ fn main() {
                             depth,
                         )
                     }
-                    Err(ForwardError::NotConverged { completed, .. }) => {
+                    Err(ForwardError::NotConverged {
+                        completed, reason, ..
+                    }) => {
+                        linear = format!("  stopped: {reason}");
                         let r = 0.25 * completed.len() as f64;
                         (completed, None, 0, 0, r)
                     }

@@ -317,7 +317,7 @@ fn contact_points(
                 }
             }
         }
-        (ct @ (CellType::Line3 | CellType::Quad4), mode) => {
+        (ct @ (CellType::Line3 | CellType::Quad4 | CellType::Quad9), mode) => {
             // facet quadrature: shape functions N_a and the area element
             let rule = QuadratureRule::for_cell(ct);
             let mut tributary = std::collections::BTreeMap::<usize, f64>::new();
@@ -355,7 +355,7 @@ fn contact_points(
 }
 
 /// Shape functions (first `nodes` entries) and the length or area element
-/// of a Line3 or Quad4 facet at reference point `xi`.
+/// of a Line3, Quad4 or Quad9 facet at reference point `xi`.
 fn facet_shape(ct: CellType, xi: &[f64; 3], x: &[[f64; 3]]) -> ([f64; MAX_NODES], f64) {
     let mut n = [0.0; MAX_NODES];
     match ct {
@@ -371,14 +371,22 @@ fn facet_shape(ct: CellType, xi: &[f64; 3], x: &[[f64; 3]]) -> ([f64; MAX_NODES]
             (n, (t[0] * t[0] + t[1] * t[1] + t[2] * t[2]).sqrt())
         }
         _ => {
-            let (s, d) = crate::shape::quad4(xi);
             let (mut t1, mut t2) = ([0.0; 3], [0.0; 3]);
-            for a in 0..4 {
-                n[a] = s[a];
-                for i in 0..3 {
-                    t1[i] += d[a][0] * x[a][i];
-                    t2[i] += d[a][1] * x[a][i];
+            let mut tangents = |s: &[f64], d: &[[f64; 2]]| {
+                for a in 0..s.len() {
+                    n[a] = s[a];
+                    for i in 0..3 {
+                        t1[i] += d[a][0] * x[a][i];
+                        t2[i] += d[a][1] * x[a][i];
+                    }
                 }
+            };
+            if ct == CellType::Quad9 {
+                let (s, d) = crate::shape::quad9(xi);
+                tangents(&s, &d);
+            } else {
+                let (s, d) = crate::shape::quad4(xi);
+                tangents(&s, &d);
             }
             let c = [
                 t1[1] * t2[2] - t1[2] * t2[1],

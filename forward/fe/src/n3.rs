@@ -65,6 +65,21 @@ pub enum N3Mesh {
     Box,
 }
 
+/// The element of the N3 mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum N3Element {
+    /// 8-node hexahedra with a constant pressure per cell (Q1/P0, the
+    /// mean-dilatation element).
+    Hex8,
+    /// 27-node hexahedra with a discontinuous linear pressure (Q2/P1, 4
+    /// pressure unknowns per cell; Sussman & Bathe 1987, stable: Boffi,
+    /// Brezzi & Fortin 2013, 8.6.3), on the same grading's cells made
+    /// triquadratic ([`Mesh::to_triquadratic`]), so the nodes are twice as
+    /// dense as the cells.
+    Hex27,
+}
+
 /// The number of O-grid core cells per side for elements of `h_fine` mm:
 /// a core of about 2.4 mm (`round(2.4 / h)`, at least 2: 3 per 0.8 mm, so
 /// levels 1, 2, 3 have 3, 6, 9 and the cells around a ring are refined with
@@ -72,6 +87,10 @@ pub enum N3Mesh {
 pub fn n3_core_cells(h_fine: f64) -> usize {
     ((2.4 / h_fine).round() as usize).max(2)
 }
+
+/// GMRES iterations allowed on an earlier tangent's factors before N3
+/// factorises again ([`SolverOptions::preconditioner_reuse`]).
+pub const PRECONDITIONER_REUSE: usize = 20;
 
 /// The N3 model.
 #[derive(Debug, Clone, PartialEq)]
@@ -86,6 +105,8 @@ pub struct N3Needle {
     /// the O-grid is 2.5-8x smaller for the same element size under the
     /// needle but, at level 1, 1.2 % stiffer at 10 mm: docs/validation/fe.md, N3).
     pub mesh: N3Mesh,
+    /// The element (default Q1/P0 hexahedra).
+    pub element: N3Element,
     /// When set, this grading (radial and z from the needle) replaces the
     /// one of `level`.
     pub grading: Option<Grading>,
@@ -123,6 +144,7 @@ impl N3Needle {
             tool: ToolShape::n1_needle(),
             level: 1,
             mesh: N3Mesh::Box,
+            element: N3Element::Hex8,
             grading: None,
             core_cells: None,
             size: [35.0, 40.0, 80.0],
@@ -135,6 +157,7 @@ impl N3Needle {
                 first_step: 0.05,
                 max_augmentations: 0,
                 gmres: true,
+                preconditioner_reuse: PRECONDITIONER_REUSE,
                 ..SolverOptions::default()
             },
             friction_is_parameter: false,
@@ -178,11 +201,24 @@ impl N3Needle {
                 )
             }
         };
-        let nodes = plane_nodes * nz;
         let cells = plane_cells * (nz - 1);
+        let (plane_nodes, sym_nodes, nz, pressures) = match self.element {
+            N3Element::Hex8 => (plane_nodes, sym_nodes, nz, 1),
+            // a planar quadrilateral mesh has V + F - 1 edges (Euler), each
+            // gaining a mid-node, and each cell a centre; lines of k nodes
+            // become 2k - 1
+            N3Element::Hex27 => (
+                2 * plane_nodes + 2 * plane_cells - 1,
+                2 * sym_nodes - 2,
+                2 * nz - 1,
+                4,
+            ),
+        };
+        let nodes = plane_nodes * nz;
         // displacements less the fixed ones (bottom, two symmetry planes),
-        // plus one pressure per cell
-        let equations = (3 * nodes).saturating_sub(3 * plane_nodes + sym_nodes * (nz - 1)) + cells;
+        // plus the pressures of each cell
+        let equations =
+            (3 * nodes).saturating_sub(3 * plane_nodes + sym_nodes * (nz - 1)) + pressures * cells;
         Ok((nodes, cells, equations))
     }
 
@@ -198,17 +234,25 @@ impl N3Needle {
     pub fn memory_estimate(&self) -> Result<f64, FeError> {
         let (_, _, equations) = self.mesh_size()?;
         let e = equations as f64;
-        Ok(match self.mesh {
-            N3Mesh::OGrid => 0.6 * GIB * (e / 30_500.0).powf(1.25),
-            N3Mesh::Box => 1.6 * GIB * (e / 24_500.0).powf(1.8),
-        })
+        // 27-node cells couple 125 nodes per node, not 27: their factors
+        // fill about twice as much per equation (O-grid, 1.6 and 1.2 mm
+        // cells: 155 and 301 MiB at 5,808 and 10,538 equations)
+        let fill = match self.element {
+            N3Element::Hex8 => 1.0,
+            N3Element::Hex27 => 2.0,
+        };
+        Ok(fill
+            * match self.mesh {
+                N3Mesh::OGrid => 0.6 * GIB * (e / 30_500.0).powf(1.25),
+                N3Mesh::Box => 1.6 * GIB * (e / 24_500.0).powf(1.8),
+            })
     }
 
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
         let [lx, ly, lz] = self.size;
-        match self.mesh {
+        let linear = match self.mesh {
             N3Mesh::Box => Mesh::graded_box(lx, ly, lz, g, g, g),
             N3Mesh::OGrid => Mesh::quarter_ogrid(
                 lx,
@@ -219,6 +263,20 @@ impl N3Needle {
                 self.effective_core_cells(),
                 self.circle_radius(),
             ),
+        }?;
+        match self.element {
+            N3Element::Hex8 => Ok(linear),
+            N3Element::Hex27 => linear.to_triquadratic(),
+        }
+    }
+
+    /// The spacing of the nodes under the needle (mm): the grading's fine
+    /// element size, halved for 27-node cells.
+    fn node_spacing(&self) -> f64 {
+        let h = self.effective_grading().h_fine;
+        match self.element {
+            N3Element::Hex8 => h,
+            N3Element::Hex27 => 0.5 * h,
         }
     }
 
@@ -338,7 +396,10 @@ impl Setup for N3Needle {
             "body",
             &mesh,
             &["body"],
-            kernel_for(CellType::Hex8, kin, PressureSpace::P0)?,
+            match self.element {
+                N3Element::Hex8 => kernel_for(CellType::Hex8, kin, PressureSpace::P0)?,
+                N3Element::Hex27 => kernel_for(CellType::Hex27, kin, PressureSpace::P1)?,
+            },
             self.bulk.exact(),
         )?;
         let mut bcs: Vec<Dirichlet> = (0..3).map(|k| Dirichlet::fixed("bottom", k)).collect();
@@ -374,7 +435,7 @@ impl Setup for N3Needle {
         extra: &[f64],
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
-        let h = self.effective_grading().h_fine;
+        let h = self.node_spacing();
         sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
         sys.part_mut::<SolidBody>(0)?
             .set_material("body", material)?;

@@ -78,7 +78,7 @@ impl QuadratureRule {
     /// integration (2 points per direction for linear cells, 3 for quadratic).
     pub fn for_cell(cell: CellType) -> QuadratureRule {
         match cell {
-            CellType::Line3 | CellType::Quad9 => Self::gauss(cell, 3),
+            CellType::Line3 | CellType::Quad9 | CellType::Hex27 => Self::gauss(cell, 3),
             _ => Self::gauss(cell, 2),
         }
     }

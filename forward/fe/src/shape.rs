@@ -39,6 +39,70 @@ pub const HEX8_NODES: [[f64; 3]; 8] = [
     [-1.0, 1.0, 1.0],
 ];
 
+/// Reference coordinates of the nodes of the 27-node hexahedron, in VTK's
+/// order (VTK_TRIQUADRATIC_HEXAHEDRON, `vtkTriQuadraticHexahedron`): the
+/// corners as [`HEX8_NODES`]; the mid-edge nodes of the edges 0-1, 1-2,
+/// 2-3, 3-0, 4-5, 5-6, 6-7, 7-4, 0-4, 1-5, 2-6, 3-7; the face centres of
+/// the faces -x, +x, -y, +y, -z, +z; the cell centre. (Gmsh's 27-node
+/// order differs in the edges and faces.)
+pub const HEX27_NODES: [[f64; 3]; 27] = [
+    [-1.0, -1.0, -1.0],
+    [1.0, -1.0, -1.0],
+    [1.0, 1.0, -1.0],
+    [-1.0, 1.0, -1.0],
+    [-1.0, -1.0, 1.0],
+    [1.0, -1.0, 1.0],
+    [1.0, 1.0, 1.0],
+    [-1.0, 1.0, 1.0],
+    [0.0, -1.0, -1.0],
+    [1.0, 0.0, -1.0],
+    [0.0, 1.0, -1.0],
+    [-1.0, 0.0, -1.0],
+    [0.0, -1.0, 1.0],
+    [1.0, 0.0, 1.0],
+    [0.0, 1.0, 1.0],
+    [-1.0, 0.0, 1.0],
+    [-1.0, -1.0, 0.0],
+    [1.0, -1.0, 0.0],
+    [1.0, 1.0, 0.0],
+    [-1.0, 1.0, 0.0],
+    [-1.0, 0.0, 0.0],
+    [1.0, 0.0, 0.0],
+    [0.0, -1.0, 0.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 0.0, -1.0],
+    [0.0, 0.0, 1.0],
+    [0.0, 0.0, 0.0],
+];
+
+/// The corner pairs of the 12 edges of a hexahedron, in the order of the
+/// mid-edge nodes 8-19 of [`HEX27_NODES`].
+pub const HEX_EDGES: [[usize; 2]; 12] = [
+    [0, 1],
+    [1, 2],
+    [2, 3],
+    [3, 0],
+    [4, 5],
+    [5, 6],
+    [6, 7],
+    [7, 4],
+    [0, 4],
+    [1, 5],
+    [2, 6],
+    [3, 7],
+];
+
+/// The corners of the 6 faces of a hexahedron (each a closed loop), in the
+/// order of the face centres 20-25 of [`HEX27_NODES`]: -x, +x, -y, +y, -z, +z.
+pub const HEX_FACES: [[usize; 4]; 6] = [
+    [0, 4, 7, 3],
+    [1, 2, 6, 5],
+    [0, 1, 5, 4],
+    [3, 7, 6, 2],
+    [0, 3, 2, 1],
+    [4, 5, 6, 7],
+];
+
 /// Bilinear quadrilateral: `N_a = (1 + s s_a)(1 + t t_a) / 4`.
 pub fn quad4(xi: &[f64; 3]) -> ShapeEval<4, 2> {
     let (s, t) = (xi[0], xi[1]);
@@ -108,6 +172,30 @@ pub fn hex8(xi: &[f64; 3]) -> ShapeEval<8, 3> {
     (n, d)
 }
 
+/// Triquadratic (Lagrange) hexahedron: products of 1D quadratics, nodes in
+/// the order of [`HEX27_NODES`].
+pub fn hex27(xi: &[f64; 3]) -> ShapeEval<27, 3> {
+    let (lr, dr) = lagrange2(xi[0]);
+    let (ls, ds) = lagrange2(xi[1]);
+    let (lt, dt) = lagrange2(xi[2]);
+    let mut n = [0.0; 27];
+    let mut d = [[0.0; 3]; 27];
+    for (a, p) in HEX27_NODES.iter().enumerate() {
+        let (i, j, k) = (
+            lagrange_index(p[0]),
+            lagrange_index(p[1]),
+            lagrange_index(p[2]),
+        );
+        n[a] = lr[i] * ls[j] * lt[k];
+        d[a] = [
+            dr[i] * ls[j] * lt[k],
+            lr[i] * ds[j] * lt[k],
+            lr[i] * ls[j] * dt[k],
+        ];
+    }
+    (n, d)
+}
+
 /// Linear line: nodes at -1 and 1.
 pub fn line2(xi: &[f64; 3]) -> ShapeEval<2, 1> {
     let s = xi[0];
@@ -153,12 +241,37 @@ mod tests {
         }
     }
 
+    /// The 27-node table is consistent with its edge and face lists: each
+    /// mid-edge node is the mean of its two corners, each face centre the
+    /// mean of its four, and every node is distinct.
+    #[test]
+    fn hex27_nodes_match_the_edge_and_face_lists() {
+        for (k, [a, b]) in HEX_EDGES.iter().enumerate() {
+            for i in 0..3 {
+                let mid = 0.5 * (HEX27_NODES[*a][i] + HEX27_NODES[*b][i]);
+                assert_eq!(HEX27_NODES[8 + k][i], mid, "edge {k}");
+            }
+        }
+        for (k, f) in HEX_FACES.iter().enumerate() {
+            for i in 0..3 {
+                let c: f64 = f.iter().map(|&a| HEX27_NODES[a][i]).sum::<f64>() / 4.0;
+                assert_eq!(HEX27_NODES[20 + k][i], c, "face {k}");
+            }
+        }
+        for a in 0..27 {
+            for b in a + 1..27 {
+                assert_ne!(HEX27_NODES[a], HEX27_NODES[b]);
+            }
+        }
+    }
+
     #[test]
     fn shape_functions_interpolate_and_differentiate() {
         let to3 = |p: &[f64]| [p[0], *p.get(1).unwrap_or(&0.0), *p.get(2).unwrap_or(&0.0)];
         check(quad4, &QUAD4_NODES.map(|p| to3(&p)));
         check(quad9, &QUAD9_NODES.map(|p| to3(&p)));
         check(hex8, &HEX8_NODES.map(|p| to3(&p)));
+        check(hex27, &HEX27_NODES);
         check(line2, &[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0]]);
         check(line3, &[[-1.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]);
     }

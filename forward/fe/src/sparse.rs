@@ -138,6 +138,8 @@ pub struct SparseLu {
     pub gmres_solves: usize,
     pub gmres_iterations: usize,
     pub gmres_fallbacks: usize,
+    /// Solves of [`SparseLu::solve_reusing`] done on kept factors.
+    pub reused_solves: usize,
 }
 
 /// The LU's symbolic analysis and its scratch.
@@ -149,6 +151,7 @@ struct LuSymbolic {
 
 /// GMRES relative residual target and iteration limit (one restart cycle).
 const GMRES_TOLERANCE: f64 = 1e-10;
+
 const GMRES_MAX_ITERATIONS: usize = 80;
 
 /// A sparse LDL^T factorisation (faer's supernodal Cholesky without
@@ -189,6 +192,7 @@ impl SparseLu {
             gmres_solves: 0,
             gmres_iterations: 0,
             gmres_fallbacks: 0,
+            reused_solves: 0,
         })
     }
 
@@ -392,37 +396,8 @@ impl SparseLu {
         }
         if self.ldlt_factored && self.mode == Some(true) {
             self.gmres_solves += 1;
-            let l = self.ldlt.as_mut().expect("factored");
-            let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), &self.values);
             let b = rhs.to_vec();
-            let outcome = gmres(
-                |x: &[f64], y: &mut [f64]| {
-                    y.iter_mut().for_each(|v| *v = 0.0);
-                    for c in 0..mat.ncols() {
-                        let xc = x[c];
-                        if xc == 0.0 {
-                            continue;
-                        }
-                        let (rows, vals) = (mat.row_idx_of_col_raw(c), mat.val_of_col(c));
-                        for (&r, &v) in rows.iter().zip(vals) {
-                            y[r] += v * xc;
-                        }
-                    }
-                },
-                |z: &mut [f64]| {
-                    LdltRef::new(&l.symbolic, &l.l_values).solve_in_place_with_conj(
-                        Conj::No,
-                        faer::ColMut::from_slice_mut(z).as_mat_mut(),
-                        Par::Seq,
-                        MemStack::new(&mut l.solve_scratch),
-                    )
-                },
-                &b,
-                rhs,
-                GMRES_TOLERANCE,
-                GMRES_MAX_ITERATIONS,
-            );
-            match outcome {
+            match self.gmres_on_factors(&b, rhs, GMRES_MAX_ITERATIONS) {
                 GmresOutcome::Converged { iterations } => {
                     self.gmres_iterations += iterations;
                 }
@@ -452,6 +427,87 @@ impl SparseLu {
             _ => self.solve_lu(rhs)?,
         }
         check_finite(rhs)
+    }
+
+    /// GMRES on the matrix `self.values` preconditioned with the kept
+    /// LDL^T factors, from `x = 0`, at most `max_iterations`.
+    fn gmres_on_factors(
+        &mut self,
+        b: &[f64],
+        x: &mut [f64],
+        max_iterations: usize,
+    ) -> GmresOutcome {
+        let l = self.ldlt.as_mut().expect("factored");
+        let mat = SparseColMatRef::new(self.symbolic_mat.as_ref(), &self.values);
+        gmres(
+            |x: &[f64], y: &mut [f64]| {
+                y.iter_mut().for_each(|v| *v = 0.0);
+                for c in 0..mat.ncols() {
+                    let xc = x[c];
+                    if xc == 0.0 {
+                        continue;
+                    }
+                    let (rows, vals) = (mat.row_idx_of_col_raw(c), mat.val_of_col(c));
+                    for (&r, &v) in rows.iter().zip(vals) {
+                        y[r] += v * xc;
+                    }
+                }
+            },
+            |z: &mut [f64]| {
+                LdltRef::new(&l.symbolic, &l.l_values).solve_in_place_with_conj(
+                    Conj::No,
+                    faer::ColMut::from_slice_mut(z).as_mat_mut(),
+                    Par::Seq,
+                    MemStack::new(&mut l.solve_scratch),
+                )
+            },
+            b,
+            x,
+            GMRES_TOLERANCE,
+            max_iterations,
+        )
+    }
+
+    /// Solves the matrix with values `values` (pattern order), overwriting
+    /// `rhs`, by GMRES preconditioned with the LDL^T factors kept from an
+    /// earlier matrix (a stale preconditioner: the Newton step is still the
+    /// exact one, to GMRES's tolerance, with no new factorisation) when that
+    /// converges within `limit` iterations; otherwise factorises `values`
+    /// and solves as [`SparseLu::solve`]. Returns whether it factorised.
+    /// Only in GMRES mode ([`SparseLu::set_gmres`]) with factors at hand;
+    /// otherwise it is [`SparseLu::solve`].
+    ///
+    /// Refactorising only when the preconditioner has drifted is the
+    /// "frozen preconditioner" inexact Newton of Knoll & Keyes (2004, J.
+    /// Comput. Phys. 193:357, section 3.2): the factorisation, the dominant
+    /// cost of a 3D solve, is then paid once per several Newton iterations
+    /// or increments instead of once per iteration.
+    pub fn solve_reusing(
+        &mut self,
+        values: &[f64],
+        rhs: &mut [f64],
+        limit: usize,
+    ) -> Result<bool, FeError> {
+        if self.mode == Some(true) && self.ldlt_factored && limit > 0 {
+            self.values.clear();
+            self.values.extend_from_slice(values);
+            let b = rhs.to_vec();
+            match self.gmres_on_factors(&b, rhs, limit) {
+                GmresOutcome::Converged { iterations } if check_finite(rhs).is_ok() => {
+                    self.gmres_solves += 1;
+                    self.gmres_iterations += iterations;
+                    self.reused_solves += 1;
+                    return Ok(false);
+                }
+                GmresOutcome::Converged { iterations }
+                | GmresOutcome::NotConverged { iterations } => {
+                    self.gmres_iterations += iterations;
+                    rhs.copy_from_slice(&b);
+                }
+            }
+        }
+        self.solve(values, rhs)?;
+        Ok(true)
     }
 
     fn solve_lu(&mut self, rhs: &mut [f64]) -> Result<(), FeError> {
@@ -713,6 +769,41 @@ mod tests {
             let last = e[..e.len() - 1].iter().map(|&r| inv[r]).max().unwrap();
             assert!(inv[nu + j] > last, "pressure {j}");
         }
+        // Kept factors: the perturbed system solved by GMRES on the
+        // symmetric system's factors gives the LU's solution with no new
+        // factorisation; with too few iterations allowed it factorises.
+        let mut lu = SparseLu::new(&p).unwrap();
+        lu.set_first_owned(nu);
+        lu.set_gmres(true).unwrap();
+        let mut x = rhs.clone();
+        assert!(
+            lu.solve_reusing(&vals, &mut x, 30).unwrap(),
+            "no factors yet"
+        );
+        let mut x = rhs.clone();
+        assert!(!lu.solve_reusing(&skew, &mut x, 30).unwrap());
+        assert_eq!((lu.factorisations, lu.reused_solves), (1, 1));
+        for i in 0..n {
+            assert!((x_lu2[i] - x[i]).abs() < 1e-8, "{i}");
+        }
+        let mut far = skew.clone();
+        far.iter_mut().for_each(|v| *v *= 1.0 + 0.5 * v.signum());
+        let mut x = rhs.clone();
+        assert!(
+            lu.solve_reusing(&far, &mut x, 1).unwrap(),
+            "one iteration is not enough"
+        );
+        assert_eq!((lu.factorisations, lu.reused_solves), (2, 1));
+        let mut x_far = rhs.clone();
+        solve_lu_of(&p, &far, &mut x_far);
+        for i in 0..n {
+            assert!((x_far[i] - x[i]).abs() < 1e-8, "{i}");
+        }
+    }
+
+    fn solve_lu_of(p: &Pattern, vals: &[f64], x: &mut [f64]) {
+        let mut lu = SparseLu::new(p).unwrap();
+        lu.solve(vals, x).unwrap();
     }
 
     fn p_symbolic(p: &Pattern) -> SymbolicSparseColMat<usize> {

@@ -47,6 +47,14 @@ pub struct SolverOptions {
     /// symmetric factorisation. Ignored when `symmetric` is set. Default
     /// `false`.
     pub gmres: bool,
+    /// With `gmres`: solve a Newton system on the factors of an earlier
+    /// tangent (kept across iterations and increments) when GMRES
+    /// converges on them within this many iterations, and factorise only
+    /// when it does not ([`crate::sparse::SparseLu::solve_reusing`]). The
+    /// Newton steps are the same (to GMRES's tolerance); only the number of
+    /// factorisations changes. 0 (default): factorise at every full Newton
+    /// iteration.
+    pub preconditioner_reuse: usize,
     /// For timed histories: the largest time increment (s). `None`: time
     /// does not limit increments (rate-independent materials: a hold at
     /// constant drive costs no increment, and `dt` still reaches the
@@ -74,6 +82,7 @@ impl Default for SolverOptions {
             reuse_factorisation: true,
             symmetric: false,
             gmres: false,
+            preconditioner_reuse: 0,
             max_time_step: None,
             max_update: None,
         }
@@ -90,6 +99,9 @@ pub struct RunStats {
     pub factorisations: usize,
     /// Newton iterations that reused an earlier factorisation (chord steps).
     pub chord_steps: usize,
+    /// Full Newton steps solved by GMRES on an earlier tangent's factors
+    /// ([`SolverOptions::preconditioner_reuse`]), with no factorisation.
+    pub reused_factors: usize,
     /// Increments accepted at the stagnation tolerance.
     pub loose: usize,
     /// Wall time in assembly and in factorise-and-solve (s).
@@ -469,11 +481,19 @@ impl System {
             du.iter_mut().zip(&self.residual).for_each(|(d, r)| *d = -r);
             let values = std::mem::take(&mut self.values);
             let t0 = std::time::Instant::now();
-            let solved = self.lu.solve(&values, &mut du);
+            let solved = if opts.gmres && !opts.symmetric && opts.preconditioner_reuse > 0 {
+                self.lu
+                    .solve_reusing(&values, &mut du, opts.preconditioner_reuse)
+            } else {
+                self.lu.solve(&values, &mut du).map(|()| true)
+            };
             self.stats.solve_seconds += t0.elapsed().as_secs_f64();
             self.values = values;
-            solved?;
-            self.stats.factorisations += 1;
+            if solved? {
+                self.stats.factorisations += 1;
+            } else {
+                self.stats.reused_factors += 1;
+            }
             if let Some(cap) = opts.max_update {
                 let big = du.iter().fold(0.0f64, |m, v| m.max(v.abs()));
                 if big > cap {

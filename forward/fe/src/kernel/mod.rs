@@ -177,6 +177,12 @@ pub fn kernel_for(
             kinematics,
             pressure,
         )?)),
+        (CellType::Hex27, Kinematics::ThreeD) => Ok(Box::new(SolidKernel::<27, 3>::new(
+            cell,
+            crate::shape::hex27,
+            kinematics,
+            pressure,
+        )?)),
         _ => Err(bad(format!(
             "no element for {cell:?} cells in {kinematics:?} kinematics"
         ))),

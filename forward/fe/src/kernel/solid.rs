@@ -390,7 +390,7 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
     /// the corner polygon's area in 2D, cube root of the volume in 3D).
     fn centre_and_size(&self, x: &[[f64; 3]]) -> ([f64; 3], f64) {
         let corners = match self.cell {
-            CellType::Hex8 => 8,
+            CellType::Hex8 | CellType::Hex27 => 8,
             _ => 4,
         };
         let mut c = [0.0; 3];
@@ -446,7 +446,7 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
 /// the corner hexahedron, by the divergence theorem on its faces (3D).
 pub fn cell_size(cell: CellType, x: &[[f64; 3]]) -> f64 {
     match cell {
-        CellType::Hex8 => {
+        CellType::Hex8 | CellType::Hex27 => {
             // volume of the trilinear hexahedron = sum of 6 tetrahedra on the diagonal 0-6
             let tet = |a: usize, b: usize| {
                 let d = |p: usize| [x[p][0] - x[0][0], x[p][1] - x[0][1], x[p][2] - x[0][2]];
@@ -641,6 +641,33 @@ mod tests {
         x
     }
 
+    /// A distorted 27-node hexahedron: the corners of `hex8_x`, the other
+    /// nodes at the trilinear positions of their reference points, moved a
+    /// little (curved edges and faces).
+    fn hex27_x() -> Vec<[f64; 3]> {
+        let c = hex8_x();
+        crate::shape::HEX27_NODES
+            .iter()
+            .enumerate()
+            .map(|(a, xi)| {
+                let (n, _) = crate::shape::hex8(xi);
+                let mut p = [0.0; 3];
+                for (k, corner) in c.iter().enumerate() {
+                    for i in 0..3 {
+                        p[i] += n[k] * corner[i];
+                    }
+                }
+                if a >= 8 {
+                    let s = a as f64;
+                    p[0] += 0.02 * (1.7 * s).sin();
+                    p[1] += 0.02 * (0.9 * s).cos();
+                    p[2] -= 0.015 * (1.3 * s).sin();
+                }
+                p
+            })
+            .collect()
+    }
+
     fn displacements(x: &[[f64; 3]], dim: usize) -> Vec<[f64; 3]> {
         x.iter()
             .enumerate()
@@ -670,6 +697,7 @@ mod tests {
         let x = match cell {
             CellType::Quad4 => quad4_x(),
             CellType::Quad9 => quad9_x(),
+            CellType::Hex27 => hex27_x(),
             _ => hex8_x(),
         };
         let dim = kin.dim();
@@ -751,6 +779,13 @@ mod tests {
                     CellType::Hex8,
                     Kinematics::ThreeD,
                     PressureSpace::P0,
+                    vol,
+                    mat,
+                );
+                check_fd(
+                    CellType::Hex27,
+                    Kinematics::ThreeD,
+                    PressureSpace::P1,
                     vol,
                     mat,
                 );

@@ -68,6 +68,24 @@ pub fn corner_jacobians(cell_type: CellType, x: &[[f64; 3]]) -> Vec<f64> {
                 d[0][0] * d[1][1] - d[0][1] * d[1][0]
             })
             .collect(),
+        CellType::Hex27 => crate::shape::HEX8_NODES
+            .iter()
+            .map(|xi| {
+                // dx/dxi from all 27 shape functions at the corner
+                let (_, d) = crate::shape::hex27(xi);
+                let mut j = [[0.0; 3]; 3];
+                for (a, p) in x.iter().enumerate().take(27) {
+                    for i in 0..3 {
+                        for k in 0..3 {
+                            j[i][k] += p[i] * d[a][k];
+                        }
+                    }
+                }
+                j[0][0] * (j[1][1] * j[2][2] - j[1][2] * j[2][1])
+                    - j[0][1] * (j[1][0] * j[2][2] - j[1][2] * j[2][0])
+                    + j[0][2] * (j[1][0] * j[2][1] - j[1][1] * j[2][0])
+            })
+            .collect(),
         CellType::Hex8 => (0..8)
             .map(|k| {
                 let d: Vec<[f64; 3]> = (0..3)

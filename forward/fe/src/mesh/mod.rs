@@ -5,7 +5,8 @@
 //! `[x, y, z]` with `z = 0` in 2D (the axisymmetric half-section is `(r, z) =
 //! (x, y)`). A region is a named list of cells; a material is given per
 //! region, so a stiff inclusion is data. Node numbering follows Gmsh and VTK
-//! (corners counter-clockwise, then edge mid-nodes, then the centre).
+//! (corners counter-clockwise, then edge mid-nodes, then the centre); the
+//! 27-node hexahedron follows VTK's order (Gmsh's differs).
 //!
 //! * [`grading`] — graded spacings along one coordinate.
 //! * [`structured`] — tensor-product generators for the reference problems.
@@ -13,7 +14,8 @@
 //!   regions, facet sets and node sets).
 //! * [`jacobian`] — corner Jacobian determinants (the inversion test).
 //! * [`ogrid`] — the quarter O-grid of hexahedra around a tool's axis (N3).
-//! * [`quadratic`] — order elevation, 4-node to 9-node quadrilaterals.
+//! * [`quadratic`] — order elevation, 4-node to 9-node quadrilaterals and
+//!   8-node to 27-node hexahedra.
 //! * [`vtu`] — VTK XML UnstructuredGrid output of a mesh or a facet set,
 //!   any cell type, with point and cell data.
 //!
@@ -55,6 +57,9 @@ pub enum CellType {
     /// 8-node hexahedron: bottom face 0-1-2-3 counter-clockwise seen from
     /// above, then the top face 4-5-6-7 over it (Gmsh and VTK order).
     Hex8,
+    /// 27-node hexahedron in VTK's order ([`crate::shape::HEX27_NODES`]):
+    /// corners as Hex8, mid-edge nodes, face centres, the cell centre.
+    Hex27,
 }
 
 impl CellType {
@@ -66,6 +71,7 @@ impl CellType {
             CellType::Quad4 => 4,
             CellType::Quad9 => 9,
             CellType::Hex8 => 8,
+            CellType::Hex27 => 27,
         }
     }
 
@@ -74,7 +80,7 @@ impl CellType {
         match self {
             CellType::Line2 | CellType::Line3 => 1,
             CellType::Quad4 | CellType::Quad9 => 2,
-            CellType::Hex8 => 3,
+            CellType::Hex8 | CellType::Hex27 => 3,
         }
     }
 
@@ -84,6 +90,7 @@ impl CellType {
             CellType::Quad4 => Some(CellType::Line2),
             CellType::Quad9 => Some(CellType::Line3),
             CellType::Hex8 => Some(CellType::Quad4),
+            CellType::Hex27 => Some(CellType::Quad9),
             CellType::Line2 | CellType::Line3 => None,
         }
     }
@@ -205,7 +212,7 @@ impl Mesh {
         let corners: &[(usize, usize)] = match self.cell_type {
             CellType::Line2 | CellType::Line3 => &[(0, 1)],
             CellType::Quad4 | CellType::Quad9 => &[(0, 1), (1, 2), (2, 3), (3, 0)],
-            CellType::Hex8 => &[
+            CellType::Hex8 | CellType::Hex27 => &[
                 (0, 1),
                 (1, 2),
                 (2, 3),

@@ -1,11 +1,16 @@
-//! Order elevation of a mesh: 4-node to 9-node quadrilaterals.
+//! Order elevation of a mesh: 4-node to 9-node quadrilaterals, 8-node to
+//! 27-node hexahedra.
 //!
 //! The original nodes keep their indices; new nodes are appended in cell
 //! order, each cell adding the mid-nodes of its edges not seen before (edge
-//! 0-1, 1-2, 2-3, 3-0) and then its centre. Mid-nodes sit at the edge
-//! midpoints and the centre at the mean of the corners, so the geometry is
-//! the bilinear one: curved boundaries stay polygonal (read a second-order
-//! Gmsh mesh for those). Node order is Gmsh/VTK (see [`CellType::Quad9`]).
+//! 0-1, 1-2, 2-3, 3-0; in 3D the twelve edges of
+//! [`crate::shape::HEX_EDGES`]), then in 3D the centres of its faces not
+//! seen before ([`crate::shape::HEX_FACES`]), then its centre. Mid-nodes sit
+//! at the edge midpoints, face and cell centres at the mean of their
+//! corners, so the geometry is the bilinear (trilinear) one: curved
+//! boundaries stay polygonal (read a second-order Gmsh mesh for those).
+//! Node order is Gmsh/VTK for [`CellType::Quad9`], VTK for
+//! [`CellType::Hex27`].
 
 use std::collections::{BTreeMap, HashMap, HashSet};
 
@@ -24,20 +29,18 @@ impl Mesh {
     ///   edges whose both ends it holds, in node order.
     /// * Regions are unchanged (cells keep their indices).
     ///
-    /// Only Quad4 meshes are supported (Hex8 is not yet).
+    /// Hex8 meshes become Hex27 ([`Mesh::to_triquadratic`]); other cell
+    /// types are refused.
     pub fn to_quadratic(&self) -> Result<Mesh, FeError> {
         match self.cell_type {
             CellType::Quad4 => {}
-            CellType::Hex8 => {
-                return Err(FeError::InvalidMesh {
-                    field: "cell_type".into(),
-                    reason: "quadratic hexahedra are not supported yet".into(),
-                })
-            }
+            CellType::Hex8 => return self.to_triquadratic(),
             other => {
                 return Err(FeError::InvalidMesh {
                     field: "cell_type".into(),
-                    reason: format!("{other:?} cells cannot be made quadratic (need Quad4)"),
+                    reason: format!(
+                        "{other:?} cells cannot be made quadratic (need Quad4 or Hex8)"
+                    ),
                 })
             }
         }
@@ -133,6 +136,135 @@ impl Mesh {
             regions: self.regions.clone(),
         })
     }
+
+    /// The same Hex8 mesh with 27-node hexahedra (see the
+    /// [module docs](self)).
+    ///
+    /// * Quad4 facet sets become Quad9: the corners as before, the
+    ///   mid-nodes of the facet's edges 0-1, 1-2, 2-3, 3-0, its centre; a
+    ///   facet that is not a cell face is an error.
+    /// * A node set with a facet set of the same name keeps its nodes in
+    ///   their old order, followed by the new nodes of the set's facets in
+    ///   facet order; any other node set gains every new node (mid-edge,
+    ///   face or cell centre) whose corners it all holds, in node order.
+    /// * Regions are unchanged (cells keep their indices).
+    pub fn to_triquadratic(&self) -> Result<Mesh, FeError> {
+        use crate::shape::{HEX_EDGES, HEX_FACES};
+        if self.cell_type != CellType::Hex8 {
+            return Err(FeError::InvalidMesh {
+                field: "cell_type".into(),
+                reason: format!(
+                    "{:?} cells cannot be made triquadratic (need Hex8)",
+                    self.cell_type
+                ),
+            });
+        }
+        self.validate()?;
+        let mut nodes = self.nodes.clone();
+        // each new node with the (sorted) corners it is the centre of
+        let mut made: HashMap<Vec<usize>, usize> = HashMap::new();
+        let mut parents: Vec<Vec<usize>> = Vec::new();
+        let mut centre_of = |corners: Vec<usize>, nodes: &mut Vec<[f64; 3]>| -> usize {
+            let mut key = corners;
+            key.sort_unstable();
+            if let Some(&n) = made.get(&key) {
+                return n;
+            }
+            let mut p = [0.0; 3];
+            for &c in &key {
+                for i in 0..3 {
+                    p[i] += nodes[c][i] / key.len() as f64;
+                }
+            }
+            nodes.push(p);
+            let n = nodes.len() - 1;
+            made.insert(key.clone(), n);
+            parents.push(key);
+            n
+        };
+        let mut cells = Vec::with_capacity(27 * self.cell_count());
+        for c in self.cells() {
+            let mut cell = [0usize; 27];
+            cell[..8].copy_from_slice(c);
+            for (k, [a, b]) in HEX_EDGES.iter().enumerate() {
+                cell[8 + k] = centre_of(vec![c[*a], c[*b]], &mut nodes);
+            }
+            for (k, f) in HEX_FACES.iter().enumerate() {
+                cell[20 + k] = centre_of(f.iter().map(|&a| c[a]).collect(), &mut nodes);
+            }
+            cell[26] = centre_of(c.to_vec(), &mut nodes);
+            cells.extend_from_slice(&cell);
+        }
+        let find = |corners: &[usize]| {
+            let mut key = corners.to_vec();
+            key.sort_unstable();
+            made.get(&key).copied()
+        };
+
+        let mut facet_sets = BTreeMap::new();
+        for (name, set) in &self.facet_sets {
+            if set.cell_type != CellType::Quad4 {
+                return Err(FeError::InvalidMesh {
+                    field: format!("facet set `{name}`"),
+                    reason: format!("{:?} facets in a Hex8 mesh", set.cell_type),
+                });
+            }
+            let mut out = Vec::with_capacity(9 * set.len());
+            for (k, f) in set.iter().enumerate() {
+                let missing = || FeError::InvalidMesh {
+                    field: format!("facet set `{name}`"),
+                    reason: format!("facet {k} {f:?} is not a face of any cell"),
+                };
+                let centre = find(f).ok_or_else(missing)?;
+                out.extend_from_slice(f);
+                for e in 0..4 {
+                    out.push(find(&[f[e], f[(e + 1) % 4]]).ok_or_else(missing)?);
+                }
+                out.push(centre);
+            }
+            facet_sets.insert(
+                name.clone(),
+                FacetSet {
+                    cell_type: CellType::Quad9,
+                    nodes: out,
+                },
+            );
+        }
+
+        let first_new = self.nodes.len();
+        let mut node_sets = BTreeMap::new();
+        for (name, set) in &self.node_sets {
+            let mut out = set.clone();
+            let mut have: HashSet<usize> = set.iter().copied().collect();
+            if let Some(fs) = facet_sets.get(name) {
+                for f in fs.iter() {
+                    for &n in &f[4..] {
+                        if have.insert(n) {
+                            out.push(n);
+                        }
+                    }
+                }
+            } else {
+                for (k, p) in parents.iter().enumerate() {
+                    if p.iter().all(|n| have.contains(n)) {
+                        out.push(first_new + k);
+                    }
+                }
+                have.clear();
+            }
+            node_sets.insert(name.clone(), out);
+        }
+
+        Ok(Mesh {
+            dim: self.dim,
+            nodes,
+            cell_type: CellType::Hex27,
+            cells,
+            node_sets,
+            facet_sets,
+            regions: self.regions.clone(),
+        })
+    }
 }
 
 #[cfg(test)]
@@ -186,16 +318,89 @@ mod tests {
         assert_eq!(m.regions, q.regions);
     }
 
+    /// A 2 x 2 x 1 box of hexahedra: shared edge, face and cell nodes made
+    /// once, at the right places; facet and node sets gain their new nodes;
+    /// the elements are valid and fill the box's volume.
+    #[test]
+    fn two_by_two_by_one_box_of_hexahedra() {
+        use crate::kernel::{kernel_for, PressureSpace};
+        use crate::kinematics::Kinematics;
+        let g = super::super::Grading::uniform(2.0, 2);
+        let gz = super::super::Grading::uniform(1.0, 1);
+        let h8 = Mesh::graded_box(2.0, 2.0, 1.0, g, g, gz).unwrap();
+        assert_eq!((h8.nodes.len(), h8.cell_count()), (18, 4));
+        let m = h8.to_quadratic().unwrap();
+        m.validate().unwrap();
+        assert_eq!(m.cell_type, CellType::Hex27);
+        // a 5 x 5 x 3 lattice of nodes
+        assert_eq!(m.nodes.len(), 75);
+        let mut seen = HashSet::new();
+        for p in &m.nodes {
+            assert!(
+                seen.insert(p.map(|v| (2.0 * v).round() as i64)),
+                "{p:?} twice"
+            );
+            for v in p {
+                assert_eq!(2.0 * v, (2.0 * v).round());
+            }
+        }
+        let kernel = kernel_for(CellType::Hex27, Kinematics::ThreeD, PressureSpace::P1).unwrap();
+        let mut volume = 0.0;
+        for c in m.cells() {
+            let x: Vec<[f64; 3]> = c.iter().map(|&n| m.nodes[n]).collect();
+            // every node at its reference position in the unit cell
+            for (a, xi) in crate::shape::HEX27_NODES.iter().enumerate() {
+                for i in 0..3 {
+                    let lo = x[0][i];
+                    let size = x[6][i] - x[0][i];
+                    assert!((x[a][i] - (lo + 0.5 * (xi[i] + 1.0) * size)).abs() < 1e-12);
+                }
+            }
+            assert!(corner_jacobians(CellType::Hex27, &x)
+                .iter()
+                .all(|&j| j > 0.0));
+            volume += kernel.reference_volume(&x).unwrap();
+        }
+        assert!((volume - 4.0).abs() < 1e-12, "{volume}");
+        let top = m.facet_set("top").unwrap();
+        assert_eq!((top.cell_type, top.len()), (CellType::Quad9, 4));
+        for f in top.iter() {
+            assert!(f.iter().all(|&n| m.nodes[n][2] == 1.0));
+            // the facet's own corner order: mid-nodes between consecutive corners
+            for e in 0..4 {
+                let (a, b, mid) = (m.nodes[f[e]], m.nodes[f[(e + 1) % 4]], m.nodes[f[4 + e]]);
+                for i in 0..3 {
+                    assert_eq!(mid[i], 0.5 * (a[i] + b[i]));
+                }
+            }
+        }
+        // node sets: the top plane's 25 nodes, x0's 15
+        let set = m.node_set("top").unwrap();
+        assert_eq!(set.len(), 25);
+        assert_eq!(&set[..9], h8.node_set("top").unwrap());
+        assert!(set.iter().all(|&n| m.nodes[n][2] == 1.0));
+        let x0 = m.node_set("x0").unwrap();
+        assert_eq!(x0.len(), 15);
+        assert!(x0.iter().all(|&n| m.nodes[n][0] == 0.0));
+        assert_eq!(m.regions, h8.regions);
+    }
+
     #[test]
     fn refuses_what_it_cannot_elevate() {
         let q = Mesh::tensor(&[0.0, 1.0], &[0.0, 1.0]);
         let m = q.to_quadratic().unwrap();
         assert!(m.to_quadratic().is_err());
         let g = super::super::Grading::uniform(1.0, 1);
-        assert!(Mesh::graded_box(1.0, 1.0, 1.0, g, g, g)
+        let hex = Mesh::graded_box(1.0, 1.0, 1.0, g, g, g)
             .unwrap()
             .to_quadratic()
-            .is_err());
+            .unwrap();
+        assert_eq!(hex.cell_type, CellType::Hex27);
+        assert!(hex.to_quadratic().is_err());
+        let mut bad = Mesh::graded_box(1.0, 1.0, 1.0, g, g, g).unwrap();
+        let top = bad.facet_sets.get_mut("top").unwrap();
+        top.nodes.swap(1, 2); // a diagonal is not an edge
+        assert!(bad.to_quadratic().is_err());
         let mut bad = q.clone();
         bad.facet_sets.get_mut("top").unwrap().nodes = vec![0, 3];
         match bad.to_quadratic() {

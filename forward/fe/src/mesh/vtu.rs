@@ -6,8 +6,9 @@
 //! `Cells` with `connectivity`, `offsets` (end of each cell's node list) and
 //! `types`. VTK cell types: Line2 3 (VTK_LINE), Line3 21
 //! (VTK_QUADRATIC_EDGE), Quad4 9 (VTK_QUAD), Quad9 28
-//! (VTK_BIQUADRATIC_QUAD), Hex8 12 (VTK_HEXAHEDRON); their node orders are
-//! Gmsh's, so connectivity is written as stored.
+//! (VTK_BIQUADRATIC_QUAD), Hex8 12 (VTK_HEXAHEDRON), Hex27 29
+//! (VTK_TRIQUADRATIC_HEXAHEDRON); their node orders are VTK's, so
+//! connectivity is written as stored.
 //!
 //! Every cell also gets the Int32 cell-data field `region`: the index, in
 //! name order (the `BTreeMap` order of [`Mesh::regions`]), of the first
@@ -37,6 +38,7 @@ pub const fn vtk_cell_type(t: CellType) -> u8 {
         CellType::Quad4 => 9,
         CellType::Quad9 => 28,
         CellType::Hex8 => 12,
+        CellType::Hex27 => 29,
     }
 }
 
