@@ -88,10 +88,6 @@ pub fn n3_core_cells(h_fine: f64) -> usize {
     ((2.4 / h_fine).round() as usize).max(2)
 }
 
-/// GMRES iterations allowed on an earlier tangent's factors before N3
-/// factorises again ([`SolverOptions::preconditioner_reuse`]).
-pub const PRECONDITIONER_REUSE: usize = 20;
-
 /// The N3 model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct N3Needle {
@@ -157,7 +153,6 @@ impl N3Needle {
                 first_step: 0.05,
                 max_augmentations: 0,
                 gmres: true,
-                preconditioner_reuse: PRECONDITIONER_REUSE,
                 ..SolverOptions::default()
             },
             friction_is_parameter: false,
