@@ -69,8 +69,8 @@ use palpate_analytic::{
 };
 use palpate_core::{Effect, ForwardModel};
 use palpate_fe::{
-    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Needle, Nodule, Platens, Prony, Q1Punch,
-    R2Rolling, ToolShape,
+    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Element, N3Mesh, N3Needle, Nodule,
+    Platens, Prony, Q1Punch, R2Rolling, ToolShape,
 };
 use palpate_material::Law;
 use serde::Deserialize;
@@ -295,6 +295,10 @@ pub struct N3NeedleSpec {
     /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
     #[serde(default)]
     pub tool: Option<String>,
+    /// `hex8` (default: 8-node Q1/P0 hexahedra on the box) or `hex27`
+    /// (27-node Q2/P1 hexahedra on the quarter O-grid, cells of 1.6/N mm).
+    #[serde(default)]
+    pub element: Option<String>,
 }
 
 /// The default N3 mesh: level 1 (the box of 0.8 mm hexahedra, 2,340 cells,
@@ -575,6 +579,21 @@ impl ModelSpec {
                 m.level = level;
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
+                match s.element.as_deref().unwrap_or("hex8") {
+                    "hex8" => {}
+                    "hex27" => {
+                        m.element = N3Element::Hex27;
+                        m.mesh = N3Mesh::OGrid;
+                    }
+                    other => {
+                        return Err(ModelError::new(
+                            K,
+                            "element",
+                            other,
+                            "expected hex8 or hex27",
+                        ))
+                    }
+                }
                 Model::N3Needle(m)
             }
             ModelSpec::R2(s) => Model::R2(r2_model(s, law)?),
@@ -1016,6 +1035,11 @@ mod tests {
             "{e}"
         );
         assert!(n3(|s| s.tool = Some("cone".into())).starts_with("n3_needle.tool"));
+        assert!(n3(|s| s.element = Some("hex20".into())).starts_with("n3_needle.element"));
+        let s: ModelSpec =
+            toml::from_str("[n3_needle]\nlaw = \"neo-hookean\"\nelement = \"hex27\"\n").unwrap();
+        assert!(matches!(s.validate(),
+            Ok(Model::N3Needle(m)) if m.element == N3Element::Hex27 && m.mesh == N3Mesh::OGrid && m.level == 1));
     }
 
     #[test]

@@ -74,7 +74,7 @@ pub use error::FeError;
 pub use material::LawMaterial;
 pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Element, N1Needle};
-pub use n3::{n3_core_cells, n3_grading, N3Element, N3Mesh, N3Needle};
+pub use n3::{n3_core_cells, n3_grading, n3_quadratic_grading, N3Element, N3Mesh, N3Needle};
 pub use q1::Q1Punch;
 pub use q1_viscous::Q1Viscous;
 pub use r2::{r2_element_size, Nodule, R2Rolling};
