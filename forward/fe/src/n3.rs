@@ -57,11 +57,11 @@ pub fn n3_grading(level: usize) -> Grading {
 /// that with their mid-nodes the nodes are as dense as [`n3_grading`]'s of
 /// the same level. Level 1 on the O-grid: 192 cells, 5,808 equations.
 pub fn n3_quadratic_grading(level: usize) -> Grading {
-    let n = level.max(1) as f64;
+    let g = n3_grading(level);
     Grading {
-        h_fine: 1.6 / n,
-        fine_length: 4.0,
-        growth: 1.0 + 0.8 / n,
+        h_fine: 2.0 * g.h_fine,
+        growth: 1.0 + 2.0 * (g.growth - 1.0),
+        ..g
     }
 }
 
