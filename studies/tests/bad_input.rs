@@ -889,6 +889,30 @@ fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
     refused(&build("g1=0.3,tau1=0", "1"), &["--prony", "tau1"]);
     refused(&build("g1=0.3,tau1=-2", "1"), &["--prony", "tau1"]);
     refused(&build("g1=0.3,tau1=1", "0"), &["--depth-max 0"]);
+    // friction is the needle's: refused for the frictionless punch, and a
+    // negative coefficient for N1
+    let with_friction = |benchmark: &str, mu: &str| {
+        s.run(&[
+            "surrogate",
+            "build",
+            "--benchmark",
+            benchmark,
+            "--friction",
+            mu,
+            "--law",
+            "neo-hookean",
+            "--param",
+            "C10=0.0016",
+            "--prony",
+            "g1=0.3,tau1=1",
+            "--depth-max",
+            "1",
+            "--out",
+            &s.path("rt.json").display().to_string(),
+        ])
+    };
+    refused(&with_friction("Q1", "0"), &["--friction", "N1 only"]);
+    refused(&with_friction("N1", "-0.2"), &["--friction -0.2", ">= 0"]);
     assert!(!s.path("rt.json").exists());
     // a hold shorter than one step of the ramp
     let o = s.run(&[
