@@ -32,7 +32,13 @@ fn main() {
     let n = (depth / 0.25).round() as usize;
     let drive: Vec<f64> = (1..=n).map(|k| 0.25 * k as f64).collect();
     let loading = Loading::quasi_static(Drive::DisplacementMm, drive);
-    let (sim, sys) = m.simulate(&[1101.295e-6], &loading, None).expect("solve");
+    let (sim, sys) = match m.simulate(&[1101.295e-6], &loading, None) {
+        Ok(r) => r,
+        Err(e) => {
+            println!("stopped: {e}");
+            return;
+        }
+    };
     println!("F = {:?}", sim.forces.last());
     std::fs::write(&out, palpate_fe::vtu::to_vtu(&sys).expect("vtu")).expect("write");
     let mesh = &sys.mesh;
