@@ -113,6 +113,24 @@ fn patch_3d() -> Mesh {
     m
 }
 
+/// [`patch_3d`] with 27-node cells whose new interior nodes are moved off
+/// their midpoints too (curved edges and faces inside the patch).
+fn patch_3d_quadratic() -> Mesh {
+    let mut m = patch_3d().to_quadratic().unwrap();
+    let mut seed = 5;
+    for n in 64..m.nodes.len() {
+        let p = m.nodes[n];
+        let inside = p.iter().all(|&v| v != 0.0 && v != 3.0);
+        for c in 0..3 {
+            let d = 0.06 * jitter(&mut seed);
+            if inside {
+                m.nodes[n][c] += d;
+            }
+        }
+    }
+    m
+}
+
 /// `F` scaled to `det F = 1`.
 fn isochoric<const D: usize>(f: [[f64; D]; D]) -> [[f64; D]; D] {
     let det = if D == 2 {
@@ -336,15 +354,16 @@ fn patch_three_d() {
         } else {
             (F3, Free::Nothing)
         };
-        let err = patch(
-            patch_3d(),
-            Kinematics::ThreeD,
-            PressureSpace::P0,
-            vol,
-            free,
-            f,
-        );
-        assert_patch(err, &format!("3D Hex8 {vol:?}"));
+        // Hex8 with a constant pressure, Hex27 (the same cells made
+        // triquadratic, interior mid-nodes moved) with a linear one
+        for (mesh, pressure) in [
+            (patch_3d(), PressureSpace::P0),
+            (patch_3d_quadratic(), PressureSpace::P1),
+        ] {
+            let cell = mesh.cell_type;
+            let err = patch(mesh, Kinematics::ThreeD, pressure, vol, free, f);
+            assert_patch(err, &format!("3D {cell:?} {vol:?}"));
+        }
     }
 }
 
