@@ -45,35 +45,7 @@ pub const HEX8_NODES: [[f64; 3]; 8] = [
 /// 2-3, 3-0, 4-5, 5-6, 6-7, 7-4, 0-4, 1-5, 2-6, 3-7; the face centres of
 /// the faces -x, +x, -y, +y, -z, +z; the cell centre. (Gmsh's 27-node
 /// order differs in the edges and faces.)
-pub const HEX27_NODES: [[f64; 3]; 27] = [
-    [-1.0, -1.0, -1.0],
-    [1.0, -1.0, -1.0],
-    [1.0, 1.0, -1.0],
-    [-1.0, 1.0, -1.0],
-    [-1.0, -1.0, 1.0],
-    [1.0, -1.0, 1.0],
-    [1.0, 1.0, 1.0],
-    [-1.0, 1.0, 1.0],
-    [0.0, -1.0, -1.0],
-    [1.0, 0.0, -1.0],
-    [0.0, 1.0, -1.0],
-    [-1.0, 0.0, -1.0],
-    [0.0, -1.0, 1.0],
-    [1.0, 0.0, 1.0],
-    [0.0, 1.0, 1.0],
-    [-1.0, 0.0, 1.0],
-    [-1.0, -1.0, 0.0],
-    [1.0, -1.0, 0.0],
-    [1.0, 1.0, 0.0],
-    [-1.0, 1.0, 0.0],
-    [-1.0, 0.0, 0.0],
-    [1.0, 0.0, 0.0],
-    [0.0, -1.0, 0.0],
-    [0.0, 1.0, 0.0],
-    [0.0, 0.0, -1.0],
-    [0.0, 0.0, 1.0],
-    [0.0, 0.0, 0.0],
-];
+pub const HEX27_NODES: [[f64; 3]; 27] = hex27_nodes();
 
 /// The corner pairs of the 12 edges of a hexahedron, in the order of the
 /// mid-edge nodes 8-19 of [`HEX27_NODES`].
@@ -102,6 +74,43 @@ pub const HEX_FACES: [[usize; 4]; 6] = [
     [0, 3, 2, 1],
     [4, 5, 6, 7],
 ];
+
+/// [`HEX27_NODES`] from the corners of [`HEX8_NODES`]: each mid-edge node
+/// and face centre the mean of its corners ([`HEX_EDGES`], [`HEX_FACES`]),
+/// then the origin.
+const fn hex27_nodes() -> [[f64; 3]; 27] {
+    let mut x = [[0.0; 3]; 27];
+    let mut a = 0;
+    while a < 8 {
+        x[a] = HEX8_NODES[a];
+        a += 1;
+    }
+    let mut e = 0;
+    while e < 12 {
+        let [p, q] = HEX_EDGES[e];
+        let mut i = 0;
+        while i < 3 {
+            x[8 + e][i] = 0.5 * (HEX8_NODES[p][i] + HEX8_NODES[q][i]);
+            i += 1;
+        }
+        e += 1;
+    }
+    let mut f = 0;
+    while f < 6 {
+        let c = HEX_FACES[f];
+        let mut i = 0;
+        while i < 3 {
+            x[20 + f][i] = 0.25
+                * (HEX8_NODES[c[0]][i]
+                    + HEX8_NODES[c[1]][i]
+                    + HEX8_NODES[c[2]][i]
+                    + HEX8_NODES[c[3]][i]);
+            i += 1;
+        }
+        f += 1;
+    }
+    x
+}
 
 /// Bilinear quadrilateral: `N_a = (1 + s s_a)(1 + t t_a) / 4`.
 pub fn quad4(xi: &[f64; 3]) -> ShapeEval<4, 2> {
@@ -241,23 +250,28 @@ mod tests {
         }
     }
 
-    /// The 27-node table is consistent with its edge and face lists: each
-    /// mid-edge node is the mean of its two corners, each face centre the
-    /// mean of its four, and every node is distinct.
+    /// The 27-node table is VTK's (vtkTriQuadraticHexahedron): spot checks
+    /// of mid-edge nodes, every face centre and the centre against VTK's
+    /// order, and all 27 nodes distinct.
     #[test]
-    fn hex27_nodes_match_the_edge_and_face_lists() {
-        for (k, [a, b]) in HEX_EDGES.iter().enumerate() {
-            for i in 0..3 {
-                let mid = 0.5 * (HEX27_NODES[*a][i] + HEX27_NODES[*b][i]);
-                assert_eq!(HEX27_NODES[8 + k][i], mid, "edge {k}");
-            }
+    fn hex27_nodes_are_in_vtk_order() {
+        let expect: [(usize, [f64; 3]); 10] = [
+            (8, [0.0, -1.0, -1.0]),
+            (11, [-1.0, 0.0, -1.0]),
+            (15, [-1.0, 0.0, 1.0]),
+            (19, [-1.0, 1.0, 0.0]),
+            (20, [-1.0, 0.0, 0.0]),
+            (21, [1.0, 0.0, 0.0]),
+            (22, [0.0, -1.0, 0.0]),
+            (23, [0.0, 1.0, 0.0]),
+            (24, [0.0, 0.0, -1.0]),
+            (26, [0.0, 0.0, 0.0]),
+        ];
+        for (a, x) in expect {
+            assert_eq!(HEX27_NODES[a], x, "node {a}");
         }
-        for (k, f) in HEX_FACES.iter().enumerate() {
-            for i in 0..3 {
-                let c: f64 = f.iter().map(|&a| HEX27_NODES[a][i]).sum::<f64>() / 4.0;
-                assert_eq!(HEX27_NODES[20 + k][i], c, "face {k}");
-            }
-        }
+        assert_eq!(HEX27_NODES[25], [0.0, 0.0, 1.0]);
+        assert_eq!(&HEX27_NODES[..8], &HEX8_NODES[..]);
         for a in 0..27 {
             for b in a + 1..27 {
                 assert_ne!(HEX27_NODES[a], HEX27_NODES[b]);

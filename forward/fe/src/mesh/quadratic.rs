@@ -74,33 +74,10 @@ impl Mesh {
             cells.extend_from_slice(&cell);
         }
 
-        let mut facet_sets = BTreeMap::new();
-        for (name, set) in &self.facet_sets {
-            if set.cell_type != CellType::Line2 {
-                return Err(FeError::InvalidMesh {
-                    field: format!("facet set `{name}`"),
-                    reason: format!("{:?} facets in a Quad4 mesh", set.cell_type),
-                });
-            }
-            let mut out = Vec::with_capacity(3 * set.len());
-            for (k, f) in set.iter().enumerate() {
-                let (a, b) = (f[0], f[1]);
-                let &mid = mids
-                    .get(&(a.min(b), a.max(b)))
-                    .ok_or_else(|| FeError::InvalidMesh {
-                        field: format!("facet set `{name}`"),
-                        reason: format!("facet {k} ({a}, {b}) is not an edge of any cell"),
-                    })?;
-                out.extend([a, b, mid]);
-            }
-            facet_sets.insert(
-                name.clone(),
-                FacetSet {
-                    cell_type: CellType::Line3,
-                    nodes: out,
-                },
-            );
-        }
+        let facet_sets = self.elevated_facet_sets(CellType::Line2, CellType::Line3, |f| {
+            let (a, b) = (f[0], f[1]);
+            mids.get(&(a.min(b), a.max(b))).map(|&m| vec![m])
+        })?;
 
         // Edges in the order their mid-nodes were made.
         let mut edges: Vec<(usize, usize, usize)> =
@@ -201,35 +178,14 @@ impl Mesh {
             made.get(&key).copied()
         };
 
-        let mut facet_sets = BTreeMap::new();
-        for (name, set) in &self.facet_sets {
-            if set.cell_type != CellType::Quad4 {
-                return Err(FeError::InvalidMesh {
-                    field: format!("facet set `{name}`"),
-                    reason: format!("{:?} facets in a Hex8 mesh", set.cell_type),
-                });
-            }
-            let mut out = Vec::with_capacity(9 * set.len());
-            for (k, f) in set.iter().enumerate() {
-                let missing = || FeError::InvalidMesh {
-                    field: format!("facet set `{name}`"),
-                    reason: format!("facet {k} {f:?} is not a face of any cell"),
-                };
-                let centre = find(f).ok_or_else(missing)?;
-                out.extend_from_slice(f);
-                for e in 0..4 {
-                    out.push(find(&[f[e], f[(e + 1) % 4]]).ok_or_else(missing)?);
-                }
-                out.push(centre);
-            }
-            facet_sets.insert(
-                name.clone(),
-                FacetSet {
-                    cell_type: CellType::Quad9,
-                    nodes: out,
-                },
-            );
-        }
+        let facet_sets = self.elevated_facet_sets(CellType::Quad4, CellType::Quad9, |f| {
+            // mid-nodes of the edges 0-1, 1-2, 2-3, 3-0, then the centre
+            let mut new: Vec<usize> = (0..4)
+                .map(|e| find(&[f[e], f[(e + 1) % 4]]))
+                .collect::<Option<_>>()?;
+            new.push(find(f)?);
+            Some(new)
+        })?;
 
         let first_new = self.nodes.len();
         let mut node_sets = BTreeMap::new();
@@ -264,6 +220,45 @@ impl Mesh {
             facet_sets,
             regions: self.regions.clone(),
         })
+    }
+
+    /// The facet sets of `from` facets made `to` facets: each facet's nodes
+    /// followed by the new nodes `new_nodes` gives it (`None`: the facet is
+    /// not a facet of any cell, an error naming the set and the facet).
+    fn elevated_facet_sets(
+        &self,
+        from: CellType,
+        to: CellType,
+        new_nodes: impl Fn(&[usize]) -> Option<Vec<usize>>,
+    ) -> Result<BTreeMap<String, FacetSet>, FeError> {
+        let mut facet_sets = BTreeMap::new();
+        for (name, set) in &self.facet_sets {
+            let bad = |reason: String| FeError::InvalidMesh {
+                field: format!("facet set `{name}`"),
+                reason,
+            };
+            if set.cell_type != from {
+                return Err(bad(format!(
+                    "{:?} facets in a {:?} mesh",
+                    set.cell_type, self.cell_type
+                )));
+            }
+            let mut out = Vec::with_capacity(to.nodes() * set.len());
+            for (k, f) in set.iter().enumerate() {
+                let new = new_nodes(f)
+                    .ok_or_else(|| bad(format!("facet {k} {f:?} is not a facet of any cell")))?;
+                out.extend_from_slice(f);
+                out.extend(new);
+            }
+            facet_sets.insert(
+                name.clone(),
+                FacetSet {
+                    cell_type: to,
+                    nodes: out,
+                },
+            );
+        }
+        Ok(facet_sets)
     }
 }
 
