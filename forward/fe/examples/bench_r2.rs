@@ -67,6 +67,13 @@ fn main() {
             "--max-step" => model.options.max_step = value().parse().expect("mm"),
             "--first-step" => model.options.first_step = value().parse().expect("mm"),
             "--symmetric" => model.options.symmetric = value().parse().expect("true|false"),
+            "--line-search" => {
+                model.options.line_search = match value().as_str() {
+                    "slope" => palpate_fe::LineSearch::Slope,
+                    "residual" => palpate_fe::LineSearch::Residual,
+                    v => panic!("--line-search slope|residual, not {v}"),
+                }
+            }
             "--chord" => model.options.reuse_factorisation = value().parse().expect("true|false"),
             "--augment" => {
                 model.pure_penalty = false;
@@ -95,6 +102,12 @@ fn main() {
     }
     let positions = model.pass_positions(step);
     let cores = std::thread::available_parallelism().map_or(0, |n| n.get());
+    let mesh = model.build_mesh().expect("the R2 mesh");
+    println!(
+        "mesh: {} cells, {} nodes",
+        mesh.cells.len(),
+        mesh.nodes.len()
+    );
     println!(
         "R2 full pass: x {}..{} mm every {step} mm ({} positions), RD {rd}, nodules 37.5:10,75:15,112.5:20, level {} (h = {} mm), {segments} segments, {cores} cores",
         model.press_x,

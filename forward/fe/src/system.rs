@@ -5,6 +5,7 @@
 
 use crate::contribution::{Assembly, AssemblyContext, Contribution};
 use crate::dofs::{DofMap, DofValue};
+use crate::line_search::{slope_search, LineSearch};
 use crate::mesh::Mesh;
 use crate::sparse::{Pattern, SparseLu, NONE};
 use crate::FeError;
@@ -67,6 +68,9 @@ pub struct SolverOptions {
     /// into the material, R2), where the first tangent can send the body
     /// millimetres through the tool. `None` (default): no limit.
     pub max_update: Option<f64>,
+    /// How far along each full Newton update to step
+    /// ([`crate::line_search`]). Default [`LineSearch::Residual`].
+    pub line_search: LineSearch,
 }
 
 impl Default for SolverOptions {
@@ -85,6 +89,7 @@ impl Default for SolverOptions {
             preconditioner_reuse: 0,
             max_time_step: None,
             max_update: None,
+            line_search: LineSearch::Residual,
         }
     }
 }
@@ -502,6 +507,18 @@ impl System {
                 }
             }
             let u0 = self.u.clone();
+            let g0: f64 = du.iter().zip(&self.residual).map(|(d, r)| d * r).sum();
+            if opts.line_search == LineSearch::Slope && g0 < 0.0 {
+                let alpha = slope_search(g0, |alpha| {
+                    self.apply(&du, alpha, &u0);
+                    let t = self.assemble(target, alpha == 1.0)?;
+                    a = t;
+                    Ok(du.iter().zip(&self.residual).map(|(d, r)| d * r).sum())
+                })?;
+                have_tangent = alpha == 1.0;
+                chord = opts.reuse_factorisation && a.norm <= 0.1 * norm0;
+                continue;
+            }
             let mut alpha = 1.0;
             let mut last_err = None;
             let mut accepted = None;
