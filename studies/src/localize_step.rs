@@ -10,7 +10,14 @@
 //! record_h_mm = 1.5                    # its FE mesh, finer than the surrogate's 2 mm
 //! record_step_mm = 1.0
 //! noise = 0.01                         # Gaussian noise SD, x the record's peak force
+//! sampler = "nuts"                     # or "ensemble"
 //! ```
+//!
+//! The noise of each RD's record is its own seeded stream, from the study's
+//! seed and the RD ([`noise_stream`]), so the RDs are independent
+//! experiments (before session 9 every RD's record carried the same noise
+//! pattern, and a nodule misread by one realisation was misread alike at
+//! every RD).
 //!
 //! Per RD: the localisation model (the scan surrogate + the nodule-free
 //! pass, `crate::localize`), the FE record of the nodules at the finer
@@ -34,7 +41,7 @@
 //! of `palpate localize`: a study's units live in its run folder.
 
 use crate::cli::localize::plot_svg;
-use crate::localize::posterior::{localize, LocOptions, Localisation};
+use crate::localize::posterior::{localize, LocOptions, LocSampler, Localisation};
 use crate::localize::record::Record;
 use crate::localize::units::{ModelRun, ModelUnits};
 use crate::localize::{LocModel, LocSetup};
@@ -83,6 +90,9 @@ pub struct LocalizeStep {
     pub record_step_mm: f64,
     #[serde(default = "default_noise")]
     pub noise: f64,
+    /// The posterior's sampler (`nuts`, default, or `ensemble`).
+    #[serde(default)]
+    pub sampler: LocSampler,
     /// Refused with the reason (the FE runs are units of the run folder);
     /// kept so that a manifest of an earlier palpate that set it is told
     /// why rather than "unknown field".
@@ -280,12 +290,13 @@ pub(crate) fn run_localize(
                 .map(|(_, k)| k)
                 .collect();
             RunFolder::key(&(
-                "localize posterior",
+                "localize posterior (noise per RD)",
                 &step.name,
                 p.rd,
                 fe,
                 step.noise.to_bits(),
                 seed,
+                step.sampler,
             ))
         })
         .collect();
@@ -417,7 +428,16 @@ fn record_force(p: &RdPlan) -> anyhow::Result<Vec<f64>> {
     )
 }
 
-/// The record with the study's seeded noise (SD `noise` x its peak force).
+/// The seed of the noise of the record at `rd`: the study's seed mixed with
+/// the RD (in micrometres) by the golden-ratio multiplier of SplitMix64, so
+/// each RD draws its own stream (`seed_from_u64` then scrambles it further).
+pub fn noise_stream(seed: u64, rd: f64) -> u64 {
+    let rd_um = (rd * 1000.0).round() as u64;
+    seed ^ rd_um.wrapping_mul(0x9E37_79B9_7F4A_7C15)
+}
+
+/// The record with the study's seeded noise (SD `noise` x its peak force),
+/// drawn from the RD's own stream ([`noise_stream`]).
 fn noisy_record(
     step: &LocalizeStep,
     p: &RdPlan,
@@ -425,7 +445,7 @@ fn noisy_record(
     seed: u64,
 ) -> anyhow::Result<Record> {
     let peak = force.iter().cloned().fold(0.0, f64::max);
-    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(noise_stream(seed, p.rd));
     let normal = Normal::new(0.0, (step.noise * peak).max(1e-300))?;
     Ok(Record {
         file: PathBuf::from(format!("{}-rd{}-record.csv", step.name, p.rd)),
@@ -447,6 +467,7 @@ fn posterior(
     let opts = LocOptions {
         nodules: truth.len(),
         seed,
+        sampler: step.sampler,
         ..Default::default()
     };
     let loc = localize(model, &record.positions, &record.force, &opts, None)?;
@@ -469,4 +490,27 @@ pub fn quadratic(f: &[f64], d: &[f64]) -> [f64; 3] {
     a.lu()
         .solve(&r)
         .map_or([f64::NAN; 3], |s| [s[0], s[1], s[2]])
+}
+
+#[cfg(test)]
+mod tests {
+    use super::noise_stream;
+
+    /// Each RD draws its own noise: different RDs (and seeds) give
+    /// different streams, the same (seed, RD) the same one.
+    #[test]
+    fn every_rd_has_its_own_noise_stream() {
+        let s: Vec<u64> = [3.0, 4.0, 5.0, 6.0]
+            .iter()
+            .map(|&rd| noise_stream(11, rd))
+            .collect();
+        for i in 0..s.len() {
+            for j in i + 1..s.len() {
+                assert_ne!(s[i], s[j], "RDs {i} and {j}");
+            }
+        }
+        assert_eq!(noise_stream(11, 6.0), noise_stream(11, 6.0));
+        assert_ne!(noise_stream(11, 6.0), noise_stream(12, 6.0));
+        assert_ne!(noise_stream(11, 6.0), noise_stream(11, 6.001));
+    }
 }

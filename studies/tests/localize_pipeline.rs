@@ -11,12 +11,13 @@
 //!   identifiable, the truth within 4 posterior SDs;
 //! * an invisible (deep) nodule's depth is `identifiable: false` (NI),
 //!   while the visible one beside it stays identifiable;
-//! * the JSON has exactly the keys of issue 11.
+//! * the JSON has exactly the keys of issue 11;
+//! * NUTS (the default sampler) reaches R-hat < 1.01 within its cap.
 
 use palpate_core::{
     Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
-use palpate_studies::localize::posterior::{localize, LocOptions};
+use palpate_studies::localize::posterior::{localize, LocOptions, LocSampler};
 use palpate_studies::localize::{Baseline, LocModel, LocSetup};
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use rand::SeedableRng;
@@ -105,7 +106,8 @@ fn opts(n: usize) -> LocOptions {
         seed: 3,
         tune: 400,
         draws: 400,
-        max_draws: 800,
+        max_draws: 1600,
+        sampler: LocSampler::Nuts,
     }
 }
 
@@ -130,7 +132,14 @@ fn visible_nodules_are_located_within_the_targets() {
         "{}",
         run.result.noise_sd
     );
-    assert!(run.result.rhat_max < 1.2, "{}", run.result.rhat_max);
+    // NUTS, the default, converges here (the ensemble sampler stopped at
+    // its cap near R-hat 1.03 on the FE records, session 8)
+    assert!(
+        run.converged && run.result.rhat_max < 1.01,
+        "{} {}",
+        run.converged,
+        run.result.rhat_max
+    );
     let json = serde_json::to_value(&run.result).unwrap();
     let keys: Vec<&String> = json.as_object().unwrap().keys().collect();
     assert_eq!(

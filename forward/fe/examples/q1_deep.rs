@@ -7,7 +7,8 @@
 //! `cargo run --release -p palpate-fe --example q1_deep -- LEVEL DEPTH [EDGE] [C10] [OUT.vtu]`
 //! (env `STEP=` sample spacing in mm, default 0.05; `SMOOTH=` the contact
 //! smoothing as a fraction of the element size; `NODES=1` contact at the
-//! nodes; `HOLD=` seconds: viscoelastic ramp in 0.5 s and hold; `SELF=0` without the
+//! nodes; `LINE=slope` the slope line search; `STAG=` the relative
+//! residual at which a stagnating increment is accepted; `HOLD=` seconds: viscoelastic ramp in 0.5 s and hold; `SELF=0` without the
 //! surface's self-contact).
 use palpate_core::{Drive, ForwardError, Loading};
 use palpate_fe::mesh::jacobian::corner_jacobians;
@@ -37,6 +38,12 @@ fn main() {
         if v == "1" {
             m.contact_points = palpate_fe::ContactPoints::Nodes;
         }
+    }
+    if let Ok(v) = std::env::var("STAG") {
+        m.options.stagnation_tolerance = v.parse().unwrap();
+    }
+    if std::env::var("LINE").as_deref() == Ok("slope") {
+        m.options.line_search = palpate_fe::LineSearch::Slope;
     }
     m.self_contact = std::env::var("SELF").map(|v| v != "0").unwrap_or(true);
     let n = (depth / step).round().max(1.0) as usize;

@@ -64,6 +64,10 @@ pub struct Args {
     /// Random seed of the sampler.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// MCMC sampler: nuts (4 chains, default) or ensemble (the
+    /// affine-invariant ensemble; slower to reach R-hat < 1.01 here).
+    #[arg(long, default_value = "nuts", value_parser = ["nuts", "ensemble"])]
+    pub sampler: String,
 }
 
 /// Runs `palpate localize`.
@@ -101,6 +105,10 @@ pub fn run(a: Args) -> anyhow::Result<()> {
     let opts = LocOptions {
         nodules: a.nodules,
         seed: a.seed,
+        sampler: a
+            .sampler
+            .parse()
+            .map_err(|e: String| anyhow::anyhow!("--sampler: {e}"))?,
         ..Default::default()
     };
     let run = localize(&model, &record.positions, &record.force, &opts, None)?;

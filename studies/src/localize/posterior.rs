@@ -1,7 +1,14 @@
 //! The posterior of the nodules' positions and depths given an R2 record,
-//! sampled by palpate-uq's affine-invariant ensemble sampler
-//! (`palpate_uq::mcmc`, extended until R-hat < 1.01 and bulk ESS >= 400 or
-//! a draw cap), on the model of [`super::LocModel`].
+//! sampled by palpate-uq's NUTS (default) or its affine-invariant ensemble
+//! sampler (`palpate_uq::mcmc`, extended until R-hat < 1.01 and bulk ESS >=
+//! 400 or a draw cap), on the model of [`super::LocModel`].
+//!
+//! Why NUTS by default: on the RD 6 three-nodule record (8 parameters) the
+//! ensemble sampler stopped at its draw cap with R-hat 1.03-1.04 on every
+//! record tried (session 8, 50 seeds), in 10-60 s; NUTS (4 chains, gradients
+//! by finite differences of the surrogate's density) converges to R-hat
+//! 1.005 with the same means and SDs to 0.01 mm, in 4.7 s for the whole
+//! study step (docs/validation/r2-localisation.md).
 //!
 //! Parameters: per nodule x_n (uniform on the rolled path) and d_n (uniform
 //! on the surrogate's depth box), the modulus scale s (log-uniform on
@@ -24,8 +31,8 @@
 
 use super::LocModel;
 use palpate_uq::mcmc::{
-    sample_until_converged, summarize, Chains, Convergence, EnsembleSettings, FnDensity, Sampler,
-    Start,
+    sample_until_converged, summarize, Chains, Convergence, EnsembleSettings, FnDensity,
+    NutsSettings, Sampler, Start,
 };
 use serde::{Deserialize, Serialize};
 
@@ -75,6 +82,30 @@ pub struct LocOptions {
     pub max_draws: usize,
     pub tune: usize,
     pub draws: usize,
+    pub sampler: LocSampler,
+}
+
+/// The MCMC sampler of a localisation.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LocSampler {
+    /// NUTS, 4 chains (`tune` and `draws` per chain).
+    #[default]
+    Nuts,
+    /// The affine-invariant ensemble sampler, 2 ensembles of 2 x dim
+    /// walkers (`tune` and `draws` per walker).
+    Ensemble,
+}
+
+impl std::str::FromStr for LocSampler {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "nuts" => Ok(LocSampler::Nuts),
+            "ensemble" => Ok(LocSampler::Ensemble),
+            other => Err(format!("sampler `{other}`: expected nuts or ensemble")),
+        }
+    }
 }
 
 impl Default for LocOptions {
@@ -85,6 +116,7 @@ impl Default for LocOptions {
             max_draws: 4000,
             tune: 600,
             draws: 500,
+            sampler: LocSampler::Nuts,
         }
     }
 }
@@ -365,14 +397,22 @@ pub fn localize(
         ll + b.log_jacobian(z)
     });
     let start = Start::ball(center, 0.01);
-    let sampler = Sampler::Ensemble(EnsembleSettings {
-        ensembles: 2,
-        walkers: 0,
-        tune: o.tune,
-        draws: o.draws,
-        thin: 1,
-        a: 2.0,
-    });
+    let sampler = match o.sampler {
+        LocSampler::Nuts => Sampler::Nuts(NutsSettings {
+            chains: 4,
+            tune: o.tune,
+            draws: o.draws,
+            ..Default::default()
+        }),
+        LocSampler::Ensemble => Sampler::Ensemble(EnsembleSettings {
+            ensembles: 2,
+            walkers: 0,
+            tune: o.tune,
+            draws: o.draws,
+            thin: 1,
+            a: 2.0,
+        }),
+    };
     let conv = Convergence {
         max_draws: o.max_draws.max(o.draws),
         ..Default::default()
