@@ -265,6 +265,31 @@ impl<const N: usize, const D: usize> SolidKernel<N, D> {
             });
             let at = folded.as_ref().unwrap_or(&amat);
             let split = split_of(np, exact);
+            if !split && self.kin != Kinematics::Axisymmetric {
+                // The common case (plane stress, plane strain, 3D; no
+                // pressure split): every B column of dof (b, d) is
+                // `dN_b/dX_l` at components `3 d + l`, so its product with
+                // a row is a dense sum over `l` on the shape gradients
+                // (the same sums as the general loop below, without its
+                // indirect indices; ~30 % of R2's time was that loop)
+                let dv = p.dv;
+                for a in 0..N {
+                    for c in 0..D {
+                        let i = a * D + c;
+                        let ta = row(&cols[a][c], at, comps);
+                        let trow = &mut out.tangent[i * nloc..i * nloc + nu];
+                        for (b, gb) in p.g.iter().enumerate().skip(a) {
+                            let d0 = if b == a { c } else { 0 };
+                            for d in d0..D {
+                                let t = &ta[3 * d..3 * d + D];
+                                let s: f64 = t.iter().zip(gb).map(|(x, g)| x * g).sum();
+                                trow[b * D + d] += s * dv;
+                            }
+                        }
+                    }
+                }
+                continue;
+            }
             for a in 0..N {
                 for c in 0..D {
                     let col = &cols[a][c];
