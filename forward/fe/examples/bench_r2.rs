@@ -105,7 +105,7 @@ fn main() {
     let mesh = model.build_mesh().expect("the R2 mesh");
     println!(
         "mesh: {} cells, {} nodes",
-        mesh.cells.len(),
+        mesh.cell_count(),
         mesh.nodes.len()
     );
     println!(
