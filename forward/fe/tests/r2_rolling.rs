@@ -57,6 +57,23 @@ fn press(m: &R2Rolling, x: f64) -> f64 {
     *f.last().unwrap()
 }
 
+/// The vertical forces of two passes agree at every position to `tol`
+/// relative.
+fn assert_same_forces(x: &[f64], a: (&str, &[[f64; 2]]), b: (&str, &[[f64; 2]]), tol: f64) {
+    for (k, (fa, fb)) in a.1.iter().zip(b.1).enumerate() {
+        let rel = (fa[0] - fb[0]).abs() / fa[0];
+        assert!(
+            rel < tol,
+            "x {}: {} {} N, {} {} N ({rel:e})",
+            x[k],
+            a.0,
+            fa[0],
+            b.0,
+            fb[0]
+        );
+    }
+}
+
 /// (a) Tolerance 1e-4 relative: the pressed and rolled states are the same
 /// discrete equilibrium (elastic bodies, frictionless pure-penalty contact,
 /// no history variable), reached along different paths; they differ only by
@@ -71,16 +88,7 @@ fn frictionless_press_at_x_equals_rolled_force_at_x() {
     let (whole, _) = m.rolled_pass(&THETA, &positions, 1, None).unwrap();
     let (split, _) = m.rolled_pass(&THETA, &positions, 2, None).unwrap();
     assert_eq!(whole.len(), positions.len());
-    for (k, (a, b)) in whole.iter().zip(&split).enumerate() {
-        let rel = (a[0] - b[0]).abs() / a[0];
-        assert!(
-            rel < 1e-4,
-            "x {}: one segment {} N, split {} N ({rel:e})",
-            positions[k],
-            a[0],
-            b[0]
-        );
-    }
+    assert_same_forces(&positions, ("one segment", &whole), ("split", &split), 1e-4);
     for x in [27.0, 30.0] {
         let k = positions.iter().position(|&p| p == x).unwrap();
         let pressed = press(&m, x);
@@ -112,16 +120,7 @@ fn slope_and_residual_line_searches_reach_the_same_forces() {
     let (slope, s_sys) = m.rolled_pass(&THETA, &positions, 1, None).unwrap();
     let (residual, r_sys) = r.rolled_pass(&THETA, &positions, 1, None).unwrap();
     let (s_stats, r_stats) = (s_sys.unwrap().stats, r_sys.unwrap().stats);
-    for (k, (a, b)) in slope.iter().zip(&residual).enumerate() {
-        let rel = (a[0] - b[0]).abs() / a[0];
-        assert!(
-            rel < 1e-5,
-            "x {}: slope {} N, residual {} N ({rel:e})",
-            positions[k],
-            a[0],
-            b[0]
-        );
-    }
+    assert_same_forces(&positions, ("slope", &slope), ("residual", &residual), 1e-5);
     assert!(
         s_stats.iterations <= r_stats.iterations,
         "slope {s_stats:?} against residual {r_stats:?}"
