@@ -382,14 +382,9 @@ pub(crate) fn run_localize(
             );
         }
         // Table III from the scan surrogate at offset 0
-        let mut grid = vec![0.0; model.scan.loading().len()];
         let mut f = Vec::new();
         for d in R2_1_DEPTHS {
-            model
-                .scan
-                .predict_outputs(&[d], &mut grid)
-                .map_err(|e| anyhow::anyhow!("{e}"))?;
-            f.push(grid[0]);
+            f.push(model.peak_force(d)?);
         }
         let q = quadratic(&f, &R2_1_DEPTHS);
         let _ = write!(table3, "| {rd} |");
@@ -401,7 +396,7 @@ pub(crate) fn run_localize(
             "rd_mm": rd,
             "localisation": post.result,
             "peak_force_vs_depth": { "depth_mm": R2_1_DEPTHS, "force_N": f, "quadratic_abc": q },
-            "surrogate_max_rel_error": model.scan.validation().max_relative_error,
+            "surrogate_max_rel_error": model.max_rel_error(),
         }));
     }
     report.push_str(&table3);

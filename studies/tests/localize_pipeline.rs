@@ -18,6 +18,7 @@ use palpate_core::{
     Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
 use palpate_studies::localize::posterior::{localize, LocOptions, LocSampler};
+use palpate_studies::localize::units::ModelUnits;
 use palpate_studies::localize::{Baseline, LocModel, LocSetup};
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use rand::SeedableRng;
@@ -172,4 +173,121 @@ fn an_invisible_deep_nodule_is_not_identifiable() {
     assert_eq!(seen.len(), 1, "{n:?}");
     assert!((seen[0].x_mm.mean - 45.0).abs() < 1.0, "{n:?}");
     assert!((seen[0].depth_mm.mean - 9.0).abs() < 0.5, "{n:?}");
+}
+
+/// The lean of the analytic excess towards the nearer block end (mm), as
+/// the FE excess leans (examples/r2_excess_shape.rs): a nodule at x peaks
+/// at x - lean(x) left of the centre, mirrored right of it.
+fn lean(x: f64) -> f64 {
+    let d = x.min(150.0 - x);
+    let l = 1.0 * (-(d - 10.0) / 15.0).exp();
+    if x <= 75.0 {
+        -l
+    } else {
+        l
+    }
+}
+
+fn excess_along(o: f64, d: f64, x: f64) -> f64 {
+    excess(o - lean(x), d)
+}
+
+struct ScanAlong(ParamSpace);
+struct EvalAlong;
+impl Evaluator for EvalAlong {
+    fn predict_into(&mut self, t: &[f64], l: &Loading, o: &mut [f64]) -> Result<(), ForwardError> {
+        for (o, off) in o.iter_mut().zip(&l.drive) {
+            *o = F0 + excess_along(*off, t[0], t[1].exp());
+        }
+        Ok(())
+    }
+}
+impl ForwardModel for ScanAlong {
+    fn name(&self) -> String {
+        "analytic nodule scan along the block".into()
+    }
+    fn space(&self) -> &ParamSpace {
+        &self.0
+    }
+    fn observable(&self) -> Observable {
+        Observable::ForceN
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(EvalAlong)
+    }
+}
+
+/// The scan along the block ([`LocSetup::r2`]'s default) keeps what the
+/// block's ends do to the excess; the scan at the centre cannot. Analytic
+/// excesses that lean up to 1 mm towards the nearer end: nodules 25 mm from
+/// either end are placed by the model along the block (its
+/// mirror image for the right one) within 3 posterior SDs, and the
+/// centre-only model puts them the lean (0.37 mm) further towards the end.
+#[test]
+fn the_scan_along_the_block_removes_the_end_bias_that_the_centre_scan_has() {
+    let setup = LocSetup::r2_along(6.0);
+    assert!(setup.along_block);
+    let space = ParamSpace::new(vec![
+        ParamSpec::new("depth", "mm", 6.0, 24.0, 15.0),
+        ParamSpec::new("ln_x", "ln mm", 10f64.ln(), 75f64.ln(), 75f64.ln()),
+    ]);
+    // the product's path (`LocModel::load_or_build` along the block): the
+    // scans as units, their excess over the centre model's as the
+    // surrogate, the centre model inside
+    let units = ModelUnits::new(&setup, ScanAlong(space)).unwrap();
+    let runs: Vec<_> = (1..units.len()).map(|k| units.scan_run(k)).collect();
+    let baseline = Baseline {
+        centre: setup.centre(),
+        step: setup.step,
+        force: vec![F0; 40],
+        time_s: 0.0,
+    };
+    let centre = model();
+    let s = units.surrogate(&baseline, runs, Some(&centre)).unwrap();
+    let mut along = LocModel::from_parts(&setup, s, baseline, None, None).unwrap();
+    along.centre_model = Some(Box::new(model()));
+    assert_eq!(along.fe_runs(), 20 + 21);
+    // the model reproduces the lean on both sides (mirror image right)
+    let (f, _) = along
+        .predict(&[24.63, 125.37], &[(25.0, 10.0), (125.0, 10.0)], 1.0)
+        .unwrap();
+    let peak = F0 + excess(0.0, 10.0);
+    assert!(
+        (f[0] - peak).abs() < 0.01 && (f[1] - peak).abs() < 0.01,
+        "{f:?} vs {peak}"
+    );
+
+    let truth = [(25.0, 10.0), (125.0, 10.0)];
+    let x: Vec<f64> = (0..=130).map(|k| 10.0 + k as f64).collect();
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(31);
+    let noise = Normal::new(0.0, 0.01 * F0).unwrap();
+    let y: Vec<f64> = x
+        .iter()
+        .map(|&p| {
+            F0 + truth
+                .iter()
+                .map(|&(xn, d)| excess_along(p - xn, d, xn))
+                .sum::<f64>()
+                + noise.sample(&mut rng)
+        })
+        .collect();
+    let a = localize(&along, &x, &y, &opts(2), None).unwrap();
+    let c = localize(&model(), &x, &y, &opts(2), None).unwrap();
+    for (k, &(tx, _)) in truth.iter().enumerate() {
+        let (ea, ec) = (&a.result.nodules[k], &c.result.nodules[k]);
+        assert!(ea.identifiable && ec.identifiable, "{ea:?} {ec:?}");
+        // along the block: the truth within 3 posterior SDs
+        assert!(
+            (ea.x_mm.mean - tx).abs() < 3.0 * ea.x_mm.sd,
+            "along: {ea:?} vs {tx}"
+        );
+        // on the same record the centre-only model sits the lean (0.37 mm)
+        // further towards the nearer end
+        let toward_end = (ea.x_mm.mean - ec.x_mm.mean) * if tx < 75.0 { 1.0 } else { -1.0 };
+        assert!(
+            (toward_end - lean(tx).abs()).abs() < 0.1,
+            "along {ea:?}, centre {ec:?}, lean {}",
+            lean(tx)
+        );
+    }
 }

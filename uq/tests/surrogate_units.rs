@@ -49,3 +49,76 @@ fn runs_one_at_a_time_assemble_to_the_built_surrogate() {
         .to_string();
     assert!(e.contains("15 model runs given for a design of 16"), "{e}");
 }
+
+/// Runs that leave outputs undefined (NaN; an R2 scan's wheel positions off
+/// the rolled path for a nodule near the block's end) give one trend + GP
+/// per output on the runs that define it: the defined outputs of held-out
+/// runs are predicted, the validation skips the undefined ones and its
+/// error variance is finite everywhere. Model: a bump
+/// exp(-(o - c)^2 / (2 w^2)) of amplitude a over offsets o = -5..5, whose
+/// outputs with o < -c are undefined (c in [1, 6]).
+#[test]
+fn runs_with_undefined_outputs_fit_one_gp_per_output() {
+    use palpate_core::{
+        Drive, Evaluator, ForwardError, Loading, Observable, ParamSpace, ParamSpec,
+    };
+    struct Bump(ParamSpace);
+    struct Eval;
+    impl Evaluator for Eval {
+        fn predict_into(
+            &mut self,
+            t: &[f64],
+            l: &Loading,
+            out: &mut [f64],
+        ) -> Result<(), ForwardError> {
+            let (a, c) = (t[0], t[1]);
+            for (y, o) in out.iter_mut().zip(&l.drive) {
+                *y = if *o < -c {
+                    f64::NAN
+                } else {
+                    a * (-(o - 0.1 * c).powi(2) / 8.0).exp()
+                };
+            }
+            Ok(())
+        }
+    }
+    impl ForwardModel for Bump {
+        fn name(&self) -> String {
+            "bump".into()
+        }
+        fn space(&self) -> &ParamSpace {
+            &self.0
+        }
+        fn observable(&self) -> Observable {
+            Observable::ForceN
+        }
+        fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+            Box::new(Eval)
+        }
+    }
+    let model = Bump(ParamSpace::new(vec![
+        ParamSpec::new("a", "N", 0.0, 10.0, 1.0),
+        ParamSpec::new("c", "mm", 0.0, 10.0, 3.0),
+    ]));
+    let loading = Loading::quasi_static(Drive::PositionMm, (-5..=5).map(f64::from).collect());
+    let request = SurrogateRequest {
+        model: &model,
+        loading: &loading,
+        bounds: ParamBox::new(model.space(), &[1.0, 1.0], &[3.0, 6.0]).unwrap(),
+        options: SurrogateOptions {
+            training_runs: 30,
+            validation_runs: 6,
+            ..Default::default()
+        },
+        description: "bump with undefined outputs".into(),
+    };
+    let s = Surrogate::build(&request, None).unwrap();
+    let v = s.validation();
+    assert_eq!(v.points, 6);
+    assert!(v.max_relative_error < 1e-2, "{v:?}");
+    assert!(v.error_variance.iter().all(|e| e.is_finite()), "{v:?}");
+    // a defined output between the design points
+    let f = s.predict(&[2.2, 4.3], &loading).unwrap();
+    let want = 2.2 * (-(0.0f64 - 0.43).powi(2) / 8.0).exp();
+    assert!((f[5] - want).abs() < 1e-2 * want, "{} vs {want}", f[5]);
+}

@@ -16,6 +16,14 @@ posterior (PALPATE_CODE_VERSION keeps the cache keys of one binary).
 
 `--start K` resumes at record K (out0, the trained model, must be there).
 
+Session 10: the records' FE passes do not depend on the localisation model,
+so another model is compared on the same records by localising each record
+again with `palpate localize` (its own surrogate cache), results in
+<work>/<tag>/r{k}.json:
+
+    python3 docs/validation/r2/coverage_records.py localise --work /tmp/cov50 --tag along --palpate target/release/palpate
+    python3 docs/validation/r2/coverage_records.py analyse --work /tmp/cov50 --tag along
+
 Session 9: ~97 s of wall time a record on 2 cores (3.5 min for the first).
 """
 import argparse
@@ -73,14 +81,42 @@ def run(a):
             print(f"record {k}: palpate failed\n{r.stderr}")
 
 
-def analyse(a):
+def records_done(a):
     done = set()
     for line in open(os.path.join(a.work, "times.txt")):
         w = line.split()
         if len(w) == 3 and w[1] == "0":
             done.add(int(w[0]))
-    rows = [(k, json.load(open(os.path.join(a.work, f"out{k}", "r2-rd6.json"))))
-            for k in sorted(done)]
+    return sorted(done)
+
+
+def localise(a):
+    out = os.path.join(a.work, a.tag)
+    os.makedirs(out, exist_ok=True)
+    for k in records_done(a):
+        js = os.path.join(out, f"r{k}.json")
+        if os.path.exists(js):
+            continue
+        t0 = time.time()
+        r = subprocess.run([a.palpate, "localize", "--benchmark", "R2", "--rd", "6",
+                            "--data", os.path.join(a.work, f"out{k}", "r2-rd6-record.csv"),
+                            "--nodules", "3", "--seed", str(2000 + k), "--json", js,
+                            "--cache", os.path.join(out, "cache")] + a.extra,
+                           capture_output=True, text=True)
+        with open(os.path.join(out, "times.txt"), "a") as f:
+            f.write(f"{k} {r.returncode} {time.time() - t0:.1f}\n")
+        if r.returncode != 0:
+            print(f"record {k}: palpate localize failed\n{r.stderr}")
+
+
+def analyse(a):
+    done = records_done(a)
+    if a.tag:
+        done = [k for k in done if os.path.exists(os.path.join(a.work, a.tag, f"r{k}.json"))]
+        path = lambda k: os.path.join(a.work, a.tag, f"r{k}.json")
+    else:
+        path = lambda k: os.path.join(a.work, f"out{k}", "r2-rd6.json")
+    rows = [(k, json.load(open(path(k)))) for k in done]
     n = len(rows)
     print(f"records {n}")
     if not rows:
@@ -124,15 +160,19 @@ def analyse(a):
 
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("what", choices=["run", "analyse"])
+    p.add_argument("what", choices=["run", "localise", "analyse"])
     p.add_argument("--work", required=True)
     p.add_argument("--palpate", default="target/release/palpate")
     p.add_argument("--records", type=int, default=50)
     p.add_argument("--start", type=int, default=0,
                    help="first record to run (resume; out0 must exist when > 0)")
     p.add_argument("--code-version", default="coverage-records")
+    p.add_argument("--tag", default="",
+                   help="localise/analyse: the folder under --work of a re-localisation")
+    p.add_argument("--extra", nargs="*", default=[],
+                   help="localise: more options for palpate localize (e.g. --scan centre)")
     a = p.parse_args()
-    run(a) if a.what == "run" else analyse(a)
+    {"run": run, "localise": localise, "analyse": analyse}[a.what](a)
 
 
 if __name__ == "__main__":

@@ -20,6 +20,21 @@
 //! and superposition hold is measured against FE in
 //! docs/validation/r2-localisation.md.
 //!
+//! Near the block's ends translation invariance fails (the end is more
+//! compliant: one nodule's excess leans towards the nearer end by up to
+//! ~0.3 mm within 25 mm of it, `examples/r2_excess_shape.rs`), so
+//! [`R2NoduleScan::along_block`] adds the nodule's position as a second
+//! parameter, `ln_x` = ln(x_n / 1 mm) on [ln(press_x), ln(centre)] (the
+//! logarithm spreads a space-filling design towards the end, where the
+//! excess changes fastest); its offsets are signed and run on both sides of
+//! the nodule. A nodule right of the centre is the mirror image of one left
+//! of it (the block and the path are symmetric), so the left half is
+//! enough. An offset whose wheel position falls outside the rolled path
+//! takes the force at the path's nearer end (the position clamped to the
+//! path), so every scan has the same outputs and each output is continuous
+//! in x_n (a mirror or nearest-offset fill jumps where the path's end
+//! crosses an offset, which a surrogate cannot fit).
+//!
 //! The material parameters are fixed (`material`, BENCHMARKS.md's by
 //! default); a common scale of both moduli scales every force exactly
 //! (Arruda-Boyce energies are linear in mu, and the contact penalty is
@@ -44,10 +59,14 @@ pub struct R2NoduleScan {
     pub centre: f64,
     /// Tissue then nodule law parameters (as [`R2Rolling`]'s theta).
     pub material: Vec<f64>,
-    /// Whether the second parameter is the ratio of the nodule's shear
-    /// modulus to the tissue's (the nodule's first law parameter is then
-    /// `ratio * material[0]`).
+    /// Whether a parameter (after the depth and `ln_x`) is the ratio of the
+    /// nodule's shear modulus to the tissue's (the nodule's first law
+    /// parameter is then `ratio * material[0]`).
     pub with_ratio: bool,
+    /// Whether the second parameter is `ln_x`, the log of the nodule's x
+    /// (mm; [`R2NoduleScan::along_block`]); otherwise the nodule sits at
+    /// `centre`.
+    pub with_position: bool,
     space: ParamSpace,
 }
 
@@ -74,28 +93,69 @@ impl R2NoduleScan {
             template,
             material,
             with_ratio,
+            with_position: false,
             space: ParamSpace::new(params),
+        }
+    }
+
+    /// The scan with the nodule's position as the second parameter, `ln_x`
+    /// on [ln(press_x), ln(centre)] (see the module docs); the offsets of
+    /// its loading are signed.
+    pub fn along_block(template: R2Rolling, with_ratio: bool) -> Self {
+        let mut s = Self::new(template, with_ratio);
+        let centre = s.centre;
+        let lo = s
+            .template
+            .press_x
+            .max(s.template.nodule_radius + MIN_CLEARANCE);
+        let mut params = s.space.params.clone();
+        params.insert(
+            1,
+            ParamSpec::new("ln_x", "ln mm", lo.ln(), centre.ln(), centre.ln()),
+        );
+        s.space = ParamSpace::new(params);
+        s.with_position = true;
+        s
+    }
+
+    /// The nodule's x at `theta`.
+    pub fn nodule_x(&self, theta: &[f64]) -> f64 {
+        if self.with_position {
+            theta[1].exp()
+        } else {
+            self.centre
         }
     }
 
     /// The one-nodule R2 model at `theta` and its law parameters.
     pub fn model_at(&self, theta: &[f64]) -> (R2Rolling, Vec<f64>) {
         let model = self.template.with_nodules(vec![Nodule {
-            x: self.centre,
+            x: self.nodule_x(theta),
             depth: theta[0],
         }]);
         let mut material = self.material.clone();
         if self.with_ratio {
-            material[2] = theta[1] * material[0];
+            material[2] = theta[1 + usize::from(self.with_position)] * material[0];
         }
         (model, material)
     }
 
-    /// The vertical force at `centre + offsets` (increasing), one rolled
-    /// segment pressed at the first.
+    /// The vertical force at `x_n + offsets` (increasing), one rolled
+    /// segment pressed at the first. With [`R2NoduleScan::with_position`]
+    /// the positions are clamped to the rolled path (module docs).
     pub fn scan(&self, theta: &[f64], offsets: &[f64]) -> Result<Vec<f64>, ForwardError> {
         let (mut model, material) = self.model_at(theta);
-        let positions: Vec<f64> = offsets.iter().map(|o| self.centre + o).collect();
+        let x = self.nodule_x(theta);
+        let (lo, hi) = (self.template.press_x, self.template.roll_to);
+        let at = |o: f64| {
+            if self.with_position {
+                (x + o).clamp(lo, hi)
+            } else {
+                x + o
+            }
+        };
+        let mut positions: Vec<f64> = offsets.iter().map(|&o| at(o)).collect();
+        positions.dedup_by(|a, b| (*a - *b).abs() <= 1e-9);
         let (first, last) = match (positions.first(), positions.last()) {
             (Some(a), Some(b)) => (*a, *b),
             _ => return Ok(Vec::new()),
@@ -104,9 +164,19 @@ impl R2NoduleScan {
         model.roll_to = model.roll_to.max(last);
         // One rolled path solved in this thread (scans already run in
         // parallel over the surrogate's design).
-        let loading = Loading::quasi_static(Drive::PositionMm, positions);
+        let loading = Loading::quasi_static(Drive::PositionMm, positions.clone());
         let (sim, _) = model.simulate(&material, &loading, None)?;
-        Ok(sim.outputs.iter().map(|r| r[0]).collect())
+        Ok(offsets
+            .iter()
+            .map(|&o| {
+                let p = at(o);
+                let k = positions
+                    .iter()
+                    .position(|q| (q - p).abs() <= 1e-9)
+                    .unwrap_or(0);
+                sim.outputs[k][0]
+            })
+            .collect())
     }
 }
 
@@ -136,8 +206,12 @@ impl Evaluator for ScanEvaluator<'_> {
 impl ForwardModel for R2NoduleScan {
     fn name(&self) -> String {
         format!(
-            "R2 nodule scan (one nodule at x = {} mm, wheel offsets from it), {}",
-            self.centre,
+            "R2 nodule scan (one nodule at {}, wheel offsets from it), {}",
+            if self.with_position {
+                "x = exp(ln_x) mm".to_string()
+            } else {
+                format!("x = {} mm", self.centre)
+            },
             self.template.with_nodules(Vec::new()).name()
         )
     }

@@ -326,3 +326,30 @@ fn frictional_pass_converges_and_barely_loads_a_rolling_wheel() {
         );
     }
 }
+
+/// The scan along the block (`R2NoduleScan::along_block`, the R2
+/// localisation's model): its second parameter is ln x of the nodule on
+/// [ln press_x, ln centre]; offsets on the path are the FE forces of a pass
+/// over that nodule, and an offset whose position is off the path takes
+/// the force at the path's start.
+#[test]
+fn the_scan_along_the_block_solves_the_path_and_clamps_what_is_off_it() {
+    use palpate_fe::r2_scan::R2NoduleScan;
+    let scan = R2NoduleScan::along_block(model(vec![]), false);
+    let space = scan.space();
+    assert_eq!(space.params[1].name, "ln_x");
+    assert!((space.params[1].lower - 20f64.ln()).abs() < 1e-12);
+    assert!((space.params[1].upper - 30f64.ln()).abs() < 1e-12);
+    let x: f64 = 21.0;
+    let f = scan.scan(&[10.0, x.ln()], &[-4.0, -2.0, 0.0, 2.0]).unwrap();
+    // positions 17 and 19 are off the path 20..40: both take the force at 20
+    assert_eq!(f[0].to_bits(), f[1].to_bits(), "{f:?}");
+    // the rolled pass over the nodule at x from the path's start
+    let mut m = model(vec![Nodule { x, depth: 10.0 }]);
+    m.press_x = 20.0;
+    let (rows, _) = m.rolled_pass(&THETA, &[20.0, x, x + 2.0], 1, None).unwrap();
+    for (got, want) in [f[1], f[2], f[3]].iter().zip(&rows) {
+        assert!((got - want[0]).abs() <= 1e-9 * want[0], "{f:?} vs {rows:?}");
+    }
+    assert!(f[2] > f[3], "the peak is over the nodule: {f:?}");
+}

@@ -17,8 +17,10 @@ use crate::surrogate::default_cache_dir;
 /// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record
 ///
 /// The force along the rolled pass is modelled as s [F0(x) + sum over the
-/// nodules of E(|x - x_n|; d_n)], with E from a surrogate of the FE model
-/// (one FE scan per training depth, trained once per --rd and cached), the
+/// nodules of E(x - x_n; d_n, x_n)], with E from a surrogate of the FE model
+/// (FE scans past one nodule at training depths, at the block's centre with
+/// E assumed independent of x_n, or along the block with --scan along;
+/// trained once per --rd and cached), the
 /// tissue-modulus scale s free and the noise inferred; the posterior of each
 /// nodule's position and depth is sampled by MCMC and reported with 94 %
 /// credible intervals. The surrogate's held-out error is printed and added
@@ -55,10 +57,11 @@ pub struct Args {
     /// Surrogate cache folder (default: $PALPATE_CACHE or ~/.cache/palpate/surrogates).
     #[arg(long)]
     pub cache: Option<PathBuf>,
-    /// Training FE scans of the surrogate (default 6).
+    /// Training FE scans of the surrogate (default 6 at the centre, 16
+    /// along the block).
     #[arg(long)]
     pub design: Option<usize>,
-    /// Held-out FE scans (default 2).
+    /// Held-out FE scans (default 2 at the centre, 4 along the block).
     #[arg(long)]
     pub holdout: Option<usize>,
     /// Random seed of the sampler.
@@ -68,11 +71,22 @@ pub struct Args {
     /// affine-invariant ensemble; slower to reach R-hat < 1.01 here).
     #[arg(long, default_value = "nuts", value_parser = ["nuts", "ensemble"])]
     pub sampler: String,
+    /// The surrogate's scan: centre (depth only, one nodule at the block's
+    /// centre, translation invariance assumed: shallow nodules within ~45
+    /// mm of an end read ~0.16 mm towards it) or along (depth and position
+    /// of the nodule, 20 FE scans instead of 8: removes most of that bias,
+    /// but its surrogate error is larger; docs/validation/r2-localisation.md).
+    #[arg(long, default_value = "centre", value_parser = ["centre", "along"])]
+    pub scan: String,
 }
 
 /// Runs `palpate localize`.
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let mut setup = LocSetup::r2(a.rd);
+    let mut setup = if a.scan == "along" {
+        LocSetup::r2_along(a.rd)
+    } else {
+        LocSetup::r2(a.rd)
+    };
     if let Some(n) = a.design {
         setup.training = n;
     }
@@ -157,6 +171,20 @@ pub fn report_model(model: &LocModel, elapsed: f64) {
                 .map(|c| format!(" ({c:.1} s CPU)"))
                 .unwrap_or_default()
         );
+    }
+    if let Some(c) = &model.centre_model {
+        let cv = c.scan.validation();
+        eprintln!(
+            "centre scan surrogate error on {} held-out FE scans: max {:.3e} of the peak force; \
+             correction along the block on {} held-out FE scans: max {:.3e} N \
+             ({:.3e} of the deepest nodule's peak excess); both added to the likelihood as variances",
+            cv.points,
+            cv.max_relative_error,
+            v.points,
+            v.max_abs_error.iter().fold(0.0f64, |a, b| a.max(*b)),
+            model.max_rel_error()
+        );
+        return;
     }
     eprintln!(
         "surrogate error on {} held-out FE scans: max {:.3e}, RMS {:.3e} of the peak force ({} basis vectors); added to the likelihood as a variance",

@@ -13,13 +13,30 @@
 //!
 //! E comes from the one surrogate of palpate (`palpate_uq::surrogate`, a
 //! reduced basis of the scanned curve with a GP per coefficient) of the FE
-//! model [`R2NoduleScan`] (depth -> force at offsets 0, step, ..,
-//! half-width from a nodule at the block's centre; the mesh and block are
-//! symmetric about the centre, so E(-o) = E(o)), minus F0 at the same
-//! positions; F0 is one nodule-free FE pass from the centre to the end of
-//! the path (also symmetric). Both are cached on disk per RD
-//! ([`crate::surrogate`]). The surrogate's held-out error variance, per
-//! offset, is added to the likelihood's noise variance (posterior.rs).
+//! model [`R2NoduleScan`], minus F0 at the same positions; F0 is one
+//! nodule-free FE pass from the centre to the end of the path (the block
+//! and path are symmetric about the centre). Two forms of the scan:
+//!
+//! * at the centre ([`LocSetup::r2`], the default): depth -> force at
+//!   offsets 0..half-width from a nodule at the block's centre, E(-o) =
+//!   E(o) by symmetry, and translation invariance assumed everywhere. Near
+//!   the block's ends the excess leans towards the nearer end, so shallow
+//!   nodules 25-45 mm from an end are placed ~0.16 mm towards it
+//!   (docs/validation/r2-localisation.md);
+//! * along the block ([`LocSetup::r2_along`], `--scan along`): (depth,
+//!   ln x_n) -> the excess E itself ([`LocSetup::excess_curve`]) at signed
+//!   offsets -half-width..half-width, for nodules left of the centre; a
+//!   nodule right of it is the mirror image, E(o; d, x) = E(-o; d, L - x).
+//!   Offsets off the rolled path are undefined, so the surrogate is one
+//!   trend + GP per offset. It removes most of that lean, but with 16 + 4
+//!   FE scans its held-out error is ~5 % of the peak excess against ~1 %
+//!   for the centre scan, and on the FE records its depth intervals cover
+//!   less often: not the default (session 10 measurements in the
+//!   validation doc).
+//!
+//! Both are cached on disk per RD ([`crate::surrogate`]). The surrogate's
+//! held-out error variance, per offset, is added to the likelihood's noise
+//! variance (posterior.rs).
 //!
 //! Between grid points E and F0 are interpolated by Catmull-Rom cubics
 //! (C1, so the log-posterior is smooth in x_n); E is tapered to zero over
@@ -50,14 +67,17 @@ pub struct LocSetup {
     /// Surrogate design: training and held-out FE scans.
     pub training: usize,
     pub holdout: usize,
+    /// Whether the scan has the nodule's position as a parameter (module
+    /// docs); otherwise translation invariance is assumed.
+    pub along_block: bool,
 }
 
 impl LocSetup {
     /// BENCHMARKS.md R2 at rolling depth `rd`: mesh level 1 (h = 2 mm, the
     /// accuracy level of docs/validation/fe.md R2), offsets 0..30 mm every
-    /// 2 mm, 6 training + 2 held-out scans (depth is one parameter; a scan
-    /// is ~70 s of CPU at RD 6, so this is what fits the 10-minute budget
-    /// on 2 cores).
+    /// 2 mm, 6 training + 2 held-out scans of depth at the block's centre
+    /// (a scan is ~35 s of CPU at RD 6, so this fits the 10-minute budget
+    /// on 2 cores), translation invariance assumed.
     pub fn r2(rd: f64) -> Self {
         LocSetup {
             template: R2Rolling::new(Law::ArrudaBoyce, Law::ArrudaBoyce, rd)
@@ -66,6 +86,30 @@ impl LocSetup {
             step: 2.0,
             training: 6,
             holdout: 2,
+            along_block: false,
+        }
+    }
+
+    /// The scan along the block (depth and ln x_n; module docs): offsets
+    /// -30..30 mm every 2 mm, 16 training + 4 held-out scans of up to 60
+    /// mm (~6 min of wall time on 2 cores at RD 6).
+    pub fn r2_along(rd: f64) -> Self {
+        LocSetup {
+            training: 16,
+            holdout: 4,
+            along_block: true,
+            ..Self::r2(rd)
+        }
+    }
+
+    /// The same model scanned at the block's centre only
+    /// ([`LocSetup::r2`]'s design).
+    pub fn at_centre(&self) -> LocSetup {
+        LocSetup {
+            training: 6,
+            holdout: 2,
+            along_block: false,
+            ..self.clone()
         }
     }
 
@@ -104,6 +148,15 @@ impl LocSetup {
                 ),
             ));
         }
+        if self.along_block && (t.press_x + t.roll_to - t.length).abs() > 1e-9 {
+            return Err((
+                "scan".into(),
+                format!(
+                    "the scan along the block mirrors nodules about its centre, so the path {}..{} mm must be symmetric on the {} mm block",
+                    t.press_x, t.roll_to, t.length
+                ),
+            ));
+        }
         if self.training < 3 || self.holdout < 1 {
             return Err((
                 "--design".into(),
@@ -116,10 +169,11 @@ impl LocSetup {
         Ok(())
     }
 
-    /// Offsets of the scan.
+    /// Offsets of the scan: signed along the block, else from 0.
     pub fn offsets(&self) -> Vec<f64> {
-        let n = (self.half_width / self.step).round() as usize;
-        (0..=n).map(|k| self.step * k as f64).collect()
+        let n = (self.half_width / self.step).round() as i64;
+        let first = if self.along_block { -n } else { 0 };
+        (first..=n).map(|k| self.step * k as f64).collect()
     }
 
     /// Farthest offset of the nodule-free pass from the centre: the path's
@@ -135,7 +189,11 @@ impl LocSetup {
     /// The FE model of the scan: one nodule at the block's centre, its
     /// depth the parameter.
     pub fn scan_model(&self) -> R2NoduleScan {
-        R2NoduleScan::new(self.template.clone(), false)
+        if self.along_block {
+            R2NoduleScan::along_block(self.template.clone(), false)
+        } else {
+            R2NoduleScan::new(self.template.clone(), false)
+        }
     }
 
     /// The scan's loading: the offsets from the nodule.
@@ -143,11 +201,13 @@ impl LocSetup {
         Loading::quasi_static(Drive::PositionMm, self.offsets())
     }
 
-    /// The surrogate's box: every depth the mesh allows for `scan`.
+    /// The surrogate's box: every depth the mesh allows for `scan` (and
+    /// every nodule position from the path's start to the centre).
     pub fn scan_bounds(&self, scan: &dyn ForwardModel) -> anyhow::Result<ParamBox> {
-        let p = &scan.space().params[0];
-        ParamBox::new(scan.space(), &[p.lower], &[p.upper])
-            .map_err(|e| anyhow::anyhow!("depth box: {e}"))
+        let ps = &scan.space().params;
+        let lower: Vec<f64> = ps.iter().map(|p| p.lower).collect();
+        let upper: Vec<f64> = ps.iter().map(|p| p.upper).collect();
+        ParamBox::new(scan.space(), &lower, &upper).map_err(|e| anyhow::anyhow!("scan box: {e}"))
     }
 
     /// The surrogate's design sizes.
@@ -191,12 +251,42 @@ impl LocSetup {
         })
     }
 
+    /// The excess E = F - F0 of a scan along the block at `theta` (depth,
+    /// ln x) from its forces at [`Self::offsets`]; undefined (NaN) where
+    /// x + o is off the rolled path (no data is ever there, and the
+    /// surrogate then fits each offset on the scans that reach it,
+    /// `palpate_uq::surrogate`). What the surrogate along the block is
+    /// fitted to: F0 near the ends is not invariant in x, and subtracting
+    /// it leaves the curves of different x alike.
+    pub fn excess_curve(&self, baseline: &Baseline, theta: &[f64], forces: &[f64]) -> Vec<f64> {
+        let x = theta.get(1).map_or(self.centre(), |l| l.exp());
+        let (lo, hi) = (self.template.press_x, self.template.roll_to);
+        self.offsets()
+            .iter()
+            .zip(forces)
+            .map(|(&o, f)| {
+                if x + o >= lo - 1e-9 && x + o <= hi + 1e-9 {
+                    f - baseline.at(x + o)
+                } else {
+                    f64::NAN
+                }
+            })
+            .collect()
+    }
+
     /// Everything that defines the cached FE results (the code version is
     /// added by the cache).
     pub fn description(&self) -> String {
         format!(
-            "R2 localisation; template {:?}; half-width {}; step {}",
-            self.template, self.half_width, self.step
+            "R2 localisation; template {:?}; half-width {}; step {}{}",
+            self.template,
+            self.half_width,
+            self.step,
+            if self.along_block {
+                "; scan along the block (depth, ln x)"
+            } else {
+                ""
+            }
         )
     }
 }
@@ -212,6 +302,16 @@ pub struct Baseline {
     pub time_s: f64,
 }
 
+impl Baseline {
+    /// F0 at `p` (Catmull-Rom between the grid points, even about the
+    /// centre, the last value past the end).
+    pub fn at(&self, p: f64) -> f64 {
+        let g = &self.force;
+        let last = *g.last().unwrap_or(&0.0);
+        catmull(g, (p - self.centre).abs() / self.step, |_| last)
+    }
+}
+
 /// The localisation model of one RD: scan surrogate plus baseline.
 pub struct LocModel {
     pub rd: f64,
@@ -221,11 +321,41 @@ pub struct LocModel {
     pub depth_box: (f64, f64),
     pub step: f64,
     pub half_width: f64,
+    /// Whether the scan is along the block ([`LocSetup::along_block`]).
+    pub along_block: bool,
+    /// The block's centre (mm): nodules right of it are mirrored.
+    pub centre: f64,
     pub scan: Surrogate,
+    /// Along the block: the model at the centre whose excess the scan's
+    /// surrogate corrects (E = E_centre + the surrogate's), or `None` when
+    /// the surrogate is of E itself.
+    pub centre_model: Option<Box<LocModel>>,
     pub baseline: Baseline,
     /// Where each came from (None for a model built in memory).
     pub scan_status: Option<CacheStatus>,
     pub baseline_status: Option<CacheStatus>,
+}
+
+/// Catmull-Rom interpolation of the uniform grid `g` (g[k] at u = k) at
+/// any u, zero outside the grid.
+fn catmull_zero_outside(g: &[f64], u: f64) -> f64 {
+    let n = g.len() as isize;
+    let at = |k: isize| {
+        if (0..n).contains(&k) {
+            g[k as usize]
+        } else {
+            0.0
+        }
+    };
+    let k = u.floor() as isize;
+    let t = u - k as f64;
+    let (p0, p1, p2, p3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
+    let t2 = t * t;
+    let t3 = t2 * t;
+    0.5 * (2.0 * p1
+        + (-p0 + p2) * t
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+        + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
 }
 
 /// Catmull-Rom interpolation of the uniform grid `g` (g[k] at u = k) at
@@ -258,6 +388,9 @@ impl LocModel {
         setup
             .check()
             .map_err(|(f, r)| anyhow::anyhow!("{f} {}: {r}", setup.template.rd))?;
+        if setup.along_block {
+            return Self::load_or_build_along(setup, cache);
+        }
         let (baseline, baseline_status) =
             load_or_compute("r2-baseline", &setup.description(), cache, || {
                 let bar = crate::limits::Progress::new(
@@ -283,8 +416,62 @@ impl LocModel {
         Self::from_parts(setup, s, baseline, Some(status), Some(baseline_status))
     }
 
+    /// The model along the block: the centre model of the same RD (its
+    /// scans and baseline, cached as `--scan centre`'s), the scans along
+    /// the block, and the surrogate of what they add to the centre's
+    /// excess (small and smooth in x: the centre scan keeps the accuracy
+    /// in depth).
+    fn load_or_build_along(setup: &LocSetup, cache: &Path) -> anyhow::Result<LocModel> {
+        let centre = Self::load_or_build(&setup.at_centre(), cache)?;
+        let baseline = centre.baseline.clone();
+        let baseline_status = centre.baseline_status.clone();
+        let units = units::ModelUnits::r2(setup)?;
+        let n = units.len() - 1;
+        let label = format!("R2 scan surrogate, RD {}", setup.template.rd);
+        // the FE scans are cached (not the surrogate: assembling it from
+        // them takes a second), with the time they took
+        let ((runs, time_s, cpu_s), status) = load_or_compute(
+            "r2-scan-runs",
+            &format!("{}; {:?}", setup.description(), setup.scan_options()),
+            cache,
+            || {
+                use rayon::prelude::*;
+                let (t0, c0) = (
+                    std::time::Instant::now(),
+                    palpate_uq::surrogate::cpu_seconds(),
+                );
+                let bar = crate::limits::Progress::new(
+                    n as u64,
+                    &label,
+                    "{msg} [{bar:40}] {pos}/{len} FE scans ({elapsed}, eta {eta})",
+                );
+                let runs: Vec<Result<Vec<f64>, String>> = (1..=n)
+                    .into_par_iter()
+                    .map(|k| {
+                        let r = units.scan_run(k);
+                        bar.inc(1);
+                        r
+                    })
+                    .collect();
+                bar.finish();
+                let cpu = palpate_uq::surrogate::cpu_seconds()
+                    .zip(c0)
+                    .map(|(a, b)| a - b);
+                Ok((runs, t0.elapsed().as_secs_f64(), cpu))
+            },
+        )?;
+        let mut s = units.surrogate(&baseline, runs, Some(&centre))?;
+        // the build time of the FE scans, not of the assembly alone
+        s.build_time_s += time_s;
+        s.build_cpu_s = s.build_cpu_s.zip(cpu_s).map(|(a, b)| a + b);
+        let mut m = Self::from_parts(setup, s, baseline, Some(status), baseline_status)?;
+        m.centre_model = Some(Box::new(centre));
+        Ok(m)
+    }
+
     /// The model from a surrogate of the scan (`depth` -> force at
-    /// `setup.offsets()`) and the baseline.
+    /// `setup.offsets()`; along the block (depth, ln x) -> the excess
+    /// force, [`LocSetup::excess_curve`]) and the baseline.
     pub fn from_parts(
         setup: &LocSetup,
         scan: Surrogate,
@@ -293,20 +480,34 @@ impl LocModel {
         baseline_status: Option<CacheStatus>,
     ) -> anyhow::Result<LocModel> {
         let n = setup.offsets().len();
+        let n_base = (setup.half_width / setup.step).round() as usize + 1;
         anyhow::ensure!(
-            scan.loading().len() == n && baseline.force.len() >= n,
-            "the scan surrogate has {} offsets and the baseline {} positions; the setup needs {n}",
+            scan.loading().len() == n && baseline.force.len() >= n_base,
+            "the scan surrogate has {} offsets and the baseline {} positions; the setup needs {n} and {n_base}",
             scan.loading().len(),
             baseline.force.len()
         );
         let b = scan.bounds();
+        anyhow::ensure!(
+            b.len() == 1 + usize::from(setup.along_block),
+            "the scan surrogate has {} parameters; the setup's scan {}",
+            b.len(),
+            if setup.along_block {
+                "is along the block (depth, ln x)"
+            } else {
+                "has the depth only"
+            }
+        );
         Ok(LocModel {
             rd: setup.template.rd,
             path: (setup.template.press_x, setup.template.roll_to),
             depth_box: (b.lower[0], b.upper[0]),
             step: setup.step,
             half_width: setup.half_width,
+            along_block: setup.along_block,
+            centre: setup.centre(),
             scan,
+            centre_model: None,
             baseline,
             scan_status,
             baseline_status,
@@ -315,29 +516,76 @@ impl LocModel {
 
     /// F0 at `p`.
     pub fn baseline_at(&self, p: f64) -> f64 {
-        let g = &self.baseline.force;
-        let last = *g.last().unwrap_or(&0.0);
-        catmull(
-            g,
-            (p - self.baseline.centre).abs() / self.baseline.step,
-            |_| last,
-        )
+        self.baseline.at(p)
     }
 
-    /// The excess E at the grid offsets for `depth` (refuses a depth outside
-    /// the surrogate's box).
-    pub fn excess_grid(&self, depth: f64, out: &mut [f64]) -> anyhow::Result<()> {
-        self.scan
-            .predict_outputs(&[depth], out)
-            .map_err(|e| anyhow::anyhow!("{e}"))?;
-        for (o, f0) in out.iter_mut().zip(&self.baseline.force) {
-            *o -= f0;
+    /// The excess E at the grid offsets of a nodule at `x` and `depth`
+    /// (refuses a depth outside the surrogate's box). Along the block the
+    /// grid is that of the nodule's mirror image when `x` is right of the
+    /// centre: the return value says so (pass it to [`Self::excess_at`] and
+    /// [`Self::error_variance_at`]); offsets whose position is off the
+    /// path continue the curve linearly.
+    pub fn excess_grid(&self, depth: f64, x: f64, out: &mut [f64]) -> anyhow::Result<bool> {
+        if !self.along_block {
+            self.scan
+                .predict_outputs(&[depth], out)
+                .map_err(|e| anyhow::anyhow!("{e}"))?;
+            for (o, f0) in out.iter_mut().zip(&self.baseline.force) {
+                *o -= f0;
+            }
+            return Ok(false);
         }
-        Ok(())
+        let mirrored = x > self.centre;
+        let xl = if mirrored { 2.0 * self.centre - x } else { x };
+        let b = self.scan.bounds();
+        let lnx = xl.max(1e-9).ln().clamp(b.lower[1], b.upper[1]);
+        // the surrogate along the block is one of the excess itself
+        // (`LocSetup::excess_curve`); offsets off the path (never a data
+        // position, but the interpolation's neighbours next to the path's
+        // end) continue the curve linearly from the first two on it
+        self.scan
+            .predict_outputs(&[depth, lnx], out)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        let n = out.len();
+        let half = (n - 1) / 2;
+        if let Some(c) = &self.centre_model {
+            // E = the centre's excess + this surrogate's correction
+            let mut grid = [0.0; 64];
+            let m = c.scan.loading().len();
+            anyhow::ensure!(m <= grid.len(), "a centre scan of {m} offsets");
+            c.excess_grid(depth, c.centre, &mut grid[..m])?;
+            for (j, v) in out.iter_mut().enumerate() {
+                *v += c.excess_at(&grid[..m], self.step * (j as f64 - half as f64), false);
+            }
+        }
+        let (lo, hi) = self.path;
+        let on = |j: usize| {
+            let p = xl + self.step * (j as f64 - half as f64);
+            p >= lo - 1e-9 && p <= hi + 1e-9
+        };
+        if let Some(first) = (0..n).find(|&j| on(j)) {
+            for j in (0..first).rev() {
+                out[j] = if j + 2 < n {
+                    2.0 * out[j + 1] - out[j + 2]
+                } else {
+                    out[j + 1]
+                };
+            }
+        }
+        Ok(mirrored)
     }
 
-    /// E at offset `o` from the excess grid `grid`.
-    pub fn excess_at(&self, grid: &[f64], o: f64) -> f64 {
+    /// E at offset `o` (wheel minus nodule) from the excess grid `grid` of
+    /// [`Self::excess_grid`].
+    pub fn excess_at(&self, grid: &[f64], o: f64, mirrored: bool) -> f64 {
+        if self.along_block {
+            let o = if mirrored { -o } else { o };
+            let u = (o + self.half_width) / self.step;
+            if u < -2.0 || u > grid.len() as f64 + 1.0 {
+                return 0.0;
+            }
+            return catmull_zero_outside(grid, u);
+        }
         let u = o.abs() / self.step;
         if u > grid.len() as f64 + 1.0 {
             return 0.0;
@@ -347,15 +595,57 @@ impl LocModel {
 
     /// The surrogate's error variance (N^2) at offset `o` (linear between
     /// grid points, zero past the scan).
-    pub fn error_variance_at(&self, o: f64) -> f64 {
+    pub fn error_variance_at(&self, o: f64, mirrored: bool) -> f64 {
+        let centre = self
+            .centre_model
+            .as_ref()
+            .map_or(0.0, |c| c.error_variance_at(o, false));
+        centre + self.own_error_variance_at(o, mirrored)
+    }
+
+    /// The error variance of this model's own surrogate at `o`.
+    fn own_error_variance_at(&self, o: f64, mirrored: bool) -> f64 {
         let v = &self.scan.validation().error_variance;
-        let u = o.abs() / self.step;
+        let u = if self.along_block {
+            let o = if mirrored { -o } else { o };
+            let u = (o + self.half_width) / self.step;
+            if u < 0.0 {
+                return 0.0;
+            }
+            u
+        } else {
+            o.abs() / self.step
+        };
         let k = u.floor() as usize;
         if k + 1 >= v.len() {
             return if k < v.len() { v[k] } else { 0.0 };
         }
         let t = u - k as f64;
         (1.0 - t) * v[k] + t * v[k + 1]
+    }
+
+    /// The force with the wheel over one nodule at the block's centre
+    /// (R2-1), at `depth`: the scan surrogate at offset 0.
+    pub fn peak_force(&self, depth: f64) -> anyhow::Result<f64> {
+        let mut grid = vec![0.0; self.scan.loading().len()];
+        if self.along_block {
+            // the surrogate along the block is of the excess
+            self.excess_grid(depth, self.centre, &mut grid)?;
+            return Ok(grid[self.zero_offset()] + self.baseline_at(self.centre));
+        }
+        self.scan
+            .predict_outputs(&[depth], &mut grid)
+            .map_err(|e| anyhow::anyhow!("{e}"))?;
+        Ok(grid[0])
+    }
+
+    /// Index of offset 0 in the scan's grid.
+    pub fn zero_offset(&self) -> usize {
+        if self.along_block {
+            (self.scan.loading().len() - 1) / 2
+        } else {
+            0
+        }
     }
 
     /// The model force at `positions` for nodules `(x, depth)` and scale
@@ -370,10 +660,10 @@ impl LocModel {
         let mut f: Vec<f64> = positions.iter().map(|&p| self.baseline_at(p)).collect();
         let mut v = vec![0.0; positions.len()];
         for &(x, d) in nodules {
-            self.excess_grid(d, &mut grid)?;
+            let m = self.excess_grid(d, x, &mut grid)?;
             for (i, &p) in positions.iter().enumerate() {
-                f[i] += self.excess_at(&grid, p - x);
-                v[i] += self.error_variance_at(p - x);
+                f[i] += self.excess_at(&grid, p - x, m);
+                v[i] += self.error_variance_at(p - x, m);
             }
         }
         for (fi, vi) in f.iter_mut().zip(v.iter_mut()) {
@@ -386,7 +676,30 @@ impl LocModel {
     /// FE runs behind the model: the surrogate's design and held-out scans,
     /// and the nodule-free pass.
     pub fn fe_runs(&self) -> usize {
-        self.scan.fe_runs + 1
+        self.scan.fe_runs + self.centre_model.as_ref().map_or(1, |c| c.fe_runs())
+    }
+
+    /// The surrogate's held-out error relative to the peak force of its
+    /// scans; along the block with a centre model, the larger of the
+    /// centre's and the correction's largest error over the centre's
+    /// smallest peak excess (the deepest nodule's).
+    pub fn max_rel_error(&self) -> f64 {
+        let own = self.scan.validation().max_relative_error;
+        let Some(c) = &self.centre_model else {
+            return own;
+        };
+        let abs = self
+            .scan
+            .validation()
+            .max_abs_error
+            .iter()
+            .fold(0.0f64, |a, b| a.max(*b));
+        let mut grid = vec![0.0; c.scan.loading().len()];
+        let peak = c
+            .excess_grid(c.depth_box.1, c.centre, &mut grid)
+            .map(|_| grid[0].abs())
+            .unwrap_or(0.0);
+        c.max_rel_error().max(abs / peak.max(1e-300))
     }
 }
 

@@ -204,15 +204,15 @@ fn log_likelihood(
     var.iter_mut().for_each(|v| *v = 0.0);
     for j in 0..n {
         let (xn, d) = (theta[2 * j], theta[2 * j + 1]);
-        if model.excess_grid(d, grid).is_err() {
+        let Ok(m) = model.excess_grid(d, xn, grid) else {
             return f64::NEG_INFINITY;
-        }
+        };
         let reach = model.half_width + 2.0 * model.step;
         for (i, &p) in x.iter().enumerate() {
             let o = p - xn;
             if o.abs() <= reach {
-                pred[i] += model.excess_at(grid, o);
-                var[i] += model.error_variance_at(o);
+                pred[i] += model.excess_at(grid, o, m);
+                var[i] += model.error_variance_at(o, m);
             }
         }
     }
@@ -229,11 +229,11 @@ fn sse(model: &LocModel, x: &[f64], y: &[f64], f0: &[f64], nod: &[(f64, f64)], s
     let mut grid = vec![0.0; model.scan.loading().len()];
     let mut pred = f0.to_vec();
     for &(xn, d) in nod {
-        if model.excess_grid(d, &mut grid).is_err() {
+        let Ok(m) = model.excess_grid(d, xn, &mut grid) else {
             return f64::INFINITY;
-        }
+        };
         for (i, &p) in x.iter().enumerate() {
-            pred[i] += model.excess_at(&grid, p - xn);
+            pred[i] += model.excess_at(&grid, p - xn, m);
         }
     }
     x.iter()
@@ -462,7 +462,7 @@ pub fn localize(
             noise_sd: summary[2 * n + 1].mean,
             surrogate: SurrogateInfo {
                 fe_runs: model.fe_runs(),
-                max_rel_error: model.scan.validation().max_relative_error,
+                max_rel_error: model.max_rel_error(),
             },
             rhat_max: run.worst.rhat_max,
             ess_bulk_min: run.worst.ess_bulk_min,

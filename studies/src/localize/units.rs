@@ -118,12 +118,51 @@ impl<M: ForwardModel> ModelUnits<M> {
         );
         Ok(match k {
             0 => ModelRun::Baseline(self.setup.baseline_pass(None)?),
-            _ => ModelRun::Scan(Surrogate::run_point(
-                &self.scan,
-                &self.loading,
-                &self.points[k - 1],
-            )),
+            _ => ModelRun::Scan(self.scan_run(k)),
         })
+    }
+
+    /// The FE scan of unit `k >= 1`: forces at the offsets, or why it
+    /// failed.
+    pub fn scan_run(&self, k: usize) -> Result<Vec<f64>, String> {
+        Surrogate::run_point(&self.scan, &self.loading, &self.points[k - 1])
+    }
+
+    /// The scan surrogate from the baseline and the scans (units 1..):
+    /// along the block, of the excess ([`LocSetup::excess_curve`]),
+    /// otherwise of the force.
+    ///
+    /// With `centre` (the model scanned at the centre) the surrogate along
+    /// the block is of what the scans add to the centre's excess.
+    pub fn surrogate(
+        &self,
+        baseline: &Baseline,
+        scans: Vec<Result<Vec<f64>, String>>,
+        centre: Option<&LocModel>,
+    ) -> anyhow::Result<Surrogate> {
+        let offsets = self.setup.offsets();
+        let scans = if self.setup.along_block {
+            scans
+                .into_iter()
+                .zip(&self.points)
+                .map(|(r, theta)| {
+                    let mut e = self.setup.excess_curve(baseline, theta, &r?);
+                    if let Some(c) = centre {
+                        let mut grid = vec![0.0; c.scan.loading().len()];
+                        c.excess_grid(theta[0], c.centre, &mut grid)
+                            .map_err(|err| err.to_string())?;
+                        for (v, &o) in e.iter_mut().zip(&offsets) {
+                            *v -= c.excess_at(&grid, o, false);
+                        }
+                    }
+                    Ok(e)
+                })
+                .collect()
+        } else {
+            scans
+        };
+        Surrogate::from_runs(&self.request(), scans)
+            .map_err(|e| anyhow::anyhow!("building the surrogate of {}: {e}", self.scan.name()))
     }
 
     /// The model from every unit's result, in unit order.
@@ -149,8 +188,7 @@ impl<M: ForwardModel> ModelUnits<M> {
                 )),
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
-        let s = Surrogate::from_runs(&self.request(), scans)
-            .map_err(|e| anyhow::anyhow!("building the surrogate of {}: {e}", self.scan.name()))?;
+        let s = self.surrogate(&baseline, scans, None)?;
         LocModel::from_parts(&self.setup, s, baseline, None, None)
     }
 }

@@ -57,7 +57,8 @@ pub mod realtime;
 
 pub use design::{halton_design, ParamBox};
 pub use model::{
-    FailedRun, Surrogate, SurrogateOptions, SurrogateRequest, Validation, SURROGATE_FORMAT,
+    cpu_seconds, FailedRun, Surrogate, SurrogateOptions, SurrogateRequest, Validation,
+    SURROGATE_FORMAT,
 };
 pub use realtime::{MonotoneCubic, RangeError, RealTimeSurrogate};
 

@@ -33,7 +33,7 @@
 use super::design::ParamBox;
 use super::gp::Gp;
 use super::SurrogateError;
-use nalgebra::DMatrix;
+use nalgebra::{DMatrix, DVector};
 use palpate_core::{
     Evaluator, ForwardError, ForwardModel, Loading, Observable, Output, ParamSpace,
 };
@@ -152,6 +152,11 @@ pub struct Surrogate {
     mean: Vec<f64>,
     basis: Vec<Vec<f64>>,
     gps: Vec<Gp>,
+    /// Per output, the coefficients of a quadratic trend in the unit-cube
+    /// parameters ([`quadratic_terms`]) added to `mean` (the per-output
+    /// form, [`fit_per_output`]); empty otherwise.
+    #[serde(default)]
+    trends: Vec<Vec<f64>>,
     validation: Validation,
     /// Model runs that converged: training + validation.
     pub fe_runs: usize,
@@ -193,7 +198,7 @@ fn run_all(
 }
 
 /// user + sys CPU time of this process (Linux /proc), for build reports.
-fn cpu_seconds() -> Option<f64> {
+pub fn cpu_seconds() -> Option<f64> {
     let s = std::fs::read_to_string("/proc/self/stat").ok()?;
     let rest = &s[s.rfind(')')? + 2..];
     let f: Vec<&str> = rest.split_whitespace().collect();
@@ -344,7 +349,14 @@ impl Surrogate {
                 reason: first.reason,
             });
         }
-        let (mean, basis, gps) = fit(&req.bounds, &design, &curves, o.basis_tolerance)?;
+        // a run may leave outputs undefined (NaN): one GP per output then
+        let missing = curves.iter().any(|c| c.iter().any(|v| !v.is_finite()));
+        let (mean, basis, gps, trends) = if missing {
+            fit_per_output(&req.bounds, &design, &curves)?
+        } else {
+            let (m, b, g) = fit(&req.bounds, &design, &curves, o.basis_tolerance)?;
+            (m, b, g, Vec::new())
+        };
         let mut s = Surrogate {
             format: SURROGATE_FORMAT,
             key: req.key(),
@@ -358,6 +370,7 @@ impl Surrogate {
             mean,
             basis,
             gps,
+            trends,
             validation: Validation {
                 points: 0,
                 max_relative_error: 0.0,
@@ -385,30 +398,41 @@ impl Surrogate {
         let mut ss_rel = 0.0;
         let mut max_abs = vec![0.0f64; k];
         let mut var = vec![0.0; m];
+        // runs that define each entry (a run may leave some undefined, NaN)
+        let mut defined = vec![0usize; m];
         let mut pred = vec![0.0; m];
         for (theta, y) in runs {
             self.evaluate(theta, &mut pred);
             for j in 0..k {
                 let peak = (0..m / k)
                     .map(|i| y[i * k + j].abs())
+                    .filter(|v| v.is_finite())
                     .fold(0.0f64, f64::max)
                     .max(1e-300);
                 for i in 0..m / k {
+                    if !y[i * k + j].is_finite() {
+                        continue;
+                    }
                     let e = pred[i * k + j] - y[i * k + j];
                     max_abs[j] = max_abs[j].max(e.abs());
                     max_rel = max_rel.max(e.abs() / peak);
                     ss_rel += (e / peak).powi(2);
                     var[i * k + j] += e * e;
+                    defined[i * k + j] += 1;
                 }
             }
         }
-        let n = runs.len().max(1) as f64;
+        let total: usize = defined.iter().sum();
         Validation {
             points: runs.len(),
             max_relative_error: max_rel,
-            rms_relative_error: (ss_rel / (n * m as f64)).sqrt(),
+            rms_relative_error: (ss_rel / total.max(1) as f64).sqrt(),
             max_abs_error: max_abs,
-            error_variance: var.into_iter().map(|v| v / n).collect(),
+            error_variance: var
+                .into_iter()
+                .zip(&defined)
+                .map(|(v, &c)| v / c.max(1) as f64)
+                .collect(),
         }
     }
 
@@ -431,6 +455,12 @@ impl Surrogate {
     fn evaluate(&self, theta: &[f64], out: &mut [f64]) {
         let u = self.bounds.to_unit(theta);
         out.copy_from_slice(&self.mean);
+        if !self.trends.is_empty() {
+            let q = quadratic_terms(&u);
+            for (o, t) in out.iter_mut().zip(&self.trends) {
+                *o += t.iter().zip(&q).map(|(a, b)| a * b).sum::<f64>();
+            }
+        }
         for (gp, v) in self.gps.iter().zip(&self.basis) {
             let c = gp.mean(&u);
             for (o, b) in out.iter_mut().zip(v) {
@@ -545,6 +575,87 @@ fn fit(
         basis.push(vt.row(k).iter().copied().collect());
     }
     Ok((mean, basis, gps))
+}
+
+/// The terms of a full quadratic in `u` without the constant: u_i, then
+/// u_i u_j (i <= j).
+pub fn quadratic_terms(u: &[f64]) -> Vec<f64> {
+    let mut q = u.to_vec();
+    for i in 0..u.len() {
+        for j in i..u.len() {
+            q.push(u[i] * u[j]);
+        }
+    }
+    q
+}
+
+/// Per-output trend and GP of [`fit_per_output`]: (mean, basis, GPs,
+/// trends).
+type PerOutput = (Vec<f64>, Vec<Vec<f64>>, Vec<Gp>, Vec<Vec<f64>>);
+
+/// The surrogate of runs that leave some outputs undefined (NaN; e.g. an R2
+/// scan whose wheel positions fall off the rolled path for nodules near the
+/// block's end): no common basis (a basis needs every output of every
+/// run), but per output a quadratic trend in the parameters (least squares,
+/// when the runs defining the output are at least twice its terms) and a GP
+/// of the residuals on the runs that define it (universal kriging with the
+/// trend fitted first; Rasmussen & Williams 2006, sec. 2.7); as the basis
+/// form with the identity basis. An output defined by fewer than 2 runs is
+/// their mean (0 when none). Outputs are undefined where the model is never
+/// asked for them, so each output is queried where its runs are.
+fn fit_per_output(
+    bounds: &ParamBox,
+    design: &[Vec<f64>],
+    curves: &[Vec<f64>],
+) -> Result<PerOutput, SurrogateError> {
+    let m = curves[0].len();
+    let units: Vec<Vec<f64>> = design.iter().map(|t| bounds.to_unit(t)).collect();
+    let nq = quadratic_terms(&units[0]).len();
+    let mut mean = vec![0.0; m];
+    let mut trends = vec![vec![0.0; nq]; m];
+    let mut basis = Vec::new();
+    let mut gps = Vec::new();
+    for j in 0..m {
+        let (inputs, y): (Vec<Vec<f64>>, Vec<f64>) = units
+            .iter()
+            .zip(curves)
+            .filter(|(_, c)| c[j].is_finite())
+            .map(|(u, c)| (u.clone(), c[j]))
+            .unzip();
+        if y.is_empty() {
+            continue;
+        }
+        let n = y.len();
+        mean[j] = y.iter().sum::<f64>() / n as f64;
+        if n < 2 {
+            continue;
+        }
+        let mut r: Vec<f64> = y.iter().map(|v| v - mean[j]).collect();
+        if n >= 2 * (nq + 1) {
+            // least squares [1, q(u)] c = y by SVD
+            let a = DMatrix::from_fn(n, nq + 1, |i, k| {
+                if k == 0 {
+                    1.0
+                } else {
+                    quadratic_terms(&inputs[i])[k - 1]
+                }
+            });
+            let c = a
+                .clone()
+                .svd(true, true)
+                .solve(&DVector::from_column_slice(&y), 1e-12)
+                .map_err(|_| SurrogateError::Singular)?;
+            mean[j] = c[0];
+            trends[j] = c.iter().skip(1).copied().collect();
+            let fitted = &a * &c;
+            r = y.iter().zip(fitted.iter()).map(|(v, f)| v - f).collect();
+        }
+        gps.push(Gp::fit(&inputs, &r).ok_or(SurrogateError::Singular)?);
+        let mut e = vec![0.0; m];
+        e[j] = 1.0;
+        basis.push(e);
+    }
+    Ok((mean, basis, gps, trends))
 }
 
 /// Same drive kind and samples (and times) to 1e-12 relative: a record
