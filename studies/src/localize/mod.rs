@@ -23,16 +23,17 @@
 //!   the block's ends the excess leans towards the nearer end, so shallow
 //!   nodules 25-45 mm from an end are placed ~0.16 mm towards it
 //!   (docs/validation/r2-localisation.md);
-//! * along the block ([`LocSetup::r2_along`], `--scan along`): (depth,
-//!   ln x_n) -> the excess E itself ([`LocSetup::excess_curve`]) at signed
-//!   offsets -half-width..half-width, for nodules left of the centre; a
-//!   nodule right of it is the mirror image, E(o; d, x) = E(-o; d, L - x).
-//!   Offsets off the rolled path are undefined, so the surrogate is one
-//!   trend + GP per offset. It removes most of that lean, but with 16 + 4
-//!   FE scans its held-out error is ~5 % of the peak excess against ~1 %
-//!   for the centre scan, and on the FE records its depth intervals cover
-//!   less often: not the default (session 10 measurements in the
-//!   validation doc).
+//! * along the block ([`LocSetup::r2_along`], `--scan along`): the centre
+//!   model plus FE scans over (depth, ln x_n) at signed offsets
+//!   -half-width..half-width for nodules left of the centre (a nodule
+//!   right of it is the mirror image, E(o; d, x) = E(-o; d, L - x)), and a
+//!   surrogate of what they add to the centre's excess
+//!   ([`LocSetup::excess_curve`] minus the centre's E; offsets off the
+//!   rolled path are undefined, so one trend + GP per offset). It removes
+//!   most of the shallow nodules' lean, but on the FE records its depths
+//!   are worse than the centre model's (the correction also fits the mesh
+//!   differences between the scans): not the default (session 10
+//!   measurements in the validation doc).
 //!
 //! Both are cached on disk per RD ([`crate::surrogate`]). The surrogate's
 //! held-out error variance, per offset, is added to the likelihood's noise
