@@ -144,7 +144,7 @@ fn a_study_killed_at_several_points_resumes_to_the_same_results() {
     let m = study(
         dir.path(),
         "s.toml",
-        &["nh", "yeoh"],
+        &["nh", "yeoh", "mr"],
         &["absolute", "relative"],
     );
     let reference = dir.path().join("reference");
@@ -152,7 +152,7 @@ fn a_study_killed_at_several_points_resumes_to_the_same_results() {
     let want = std::fs::read(reference.join("results.json")).unwrap();
 
     let mut interrupted = 0;
-    // Kill points: at once, and after 1, 3 and 6 of the 8 fits started,
+    // Kill points: at once, and after 1, 3 and 6 of the 12 fits started (three laws: with two, 8 fits, a kill after the 6th often landed after the run had ended),
     // each with SIGINT (Ctrl-C) and SIGKILL, each into a fresh folder.
     for (k, (lines, sig)) in [0, 1, 3, 6]
         .iter()
@@ -243,15 +243,18 @@ fn a_study_killed_at_random_instants_resumes_to_the_same_results() {
     let m = study(
         dir.path(),
         "s.toml",
-        &["nh", "yeoh"],
+        &["nh", "yeoh", "mr"],
         &["absolute", "relative"],
     );
     let reference = dir.path().join("reference");
     let t0 = std::time::Instant::now();
     ok(&run(&m, &reference));
-    // The instants are drawn over 1.2 x the time of an uncached run (the
-    // load of the machine changes it; the seed fixes the fractions).
-    let span = t0.elapsed().as_secs_f64() * 1.2;
+    // The instants are drawn over 0.7 x the time of an uncached run (the
+    // load of the machine changes it; the seed fixes the fractions): the
+    // second and third runs into a folder resume from its cache and end
+    // sooner, so over 1.2 x the span fewer than half the kills landed
+    // inside a run on a busy machine (4 of 12, session 10).
+    let span = t0.elapsed().as_secs_f64() * 0.7;
     let want = std::fs::read(reference.join("results.json")).unwrap();
     let mut interrupted = 0;
     let mut kills = 0;
