@@ -337,6 +337,20 @@ pub struct LocModel {
     pub baseline_status: Option<CacheStatus>,
 }
 
+/// The Catmull-Rom cubic through the grid values `at(k)` at u (between
+/// `at(floor u)` and `at(floor u + 1)`).
+fn cubic(at: impl Fn(isize) -> f64, u: f64) -> f64 {
+    let k = u.floor() as isize;
+    let t = u - k as f64;
+    let (p0, p1, p2, p3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
+    let t2 = t * t;
+    let t3 = t2 * t;
+    0.5 * (2.0 * p1
+        + (-p0 + p2) * t
+        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
+        + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
+}
+
 /// Catmull-Rom interpolation of the uniform grid `g` (g[k] at u = k) at
 /// any u, zero outside the grid.
 fn catmull_zero_outside(g: &[f64], u: f64) -> f64 {
@@ -348,15 +362,7 @@ fn catmull_zero_outside(g: &[f64], u: f64) -> f64 {
             0.0
         }
     };
-    let k = u.floor() as isize;
-    let t = u - k as f64;
-    let (p0, p1, p2, p3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
-    let t2 = t * t;
-    let t3 = t2 * t;
-    0.5 * (2.0 * p1
-        + (-p0 + p2) * t
-        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
-        + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
+    cubic(at, u)
 }
 
 /// Catmull-Rom interpolation of the uniform grid `g` (g[k] at u = k) at
@@ -371,15 +377,7 @@ fn catmull(g: &[f64], u: f64, past: impl Fn(isize) -> f64) -> f64 {
             past(k)
         }
     };
-    let k = u.floor() as isize;
-    let t = u - k as f64;
-    let (p0, p1, p2, p3) = (at(k - 1), at(k), at(k + 1), at(k + 2));
-    let t2 = t * t;
-    let t3 = t2 * t;
-    0.5 * (2.0 * p1
-        + (-p0 + p2) * t
-        + (2.0 * p0 - 5.0 * p1 + 4.0 * p2 - p3) * t2
-        + (-p0 + 3.0 * p1 - 3.0 * p2 + p3) * t3)
+    cubic(at, u)
 }
 
 impl LocModel {
