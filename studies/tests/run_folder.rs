@@ -164,6 +164,18 @@ fn a_study_killed_at_several_points_resumes_to_the_same_results() {
         let out = dir.path().join(format!("killed-{k}"));
         let (mut child, _) = start_until(&m, &out, lines);
         signal(&mut child, sig);
+        // What the kill met (printed on a failure): the run before it made
+        // its folder, inside it, or after its end.
+        eprintln!(
+            "SIG{sig} after {lines} lines: {}",
+            if out.join("results.json").exists() {
+                "the run had ended"
+            } else if out.exists() {
+                "interrupted"
+            } else {
+                "before the folder existed"
+            }
+        );
         if out.join("results.json").exists() {
             // It finished before the signal: then it is complete.
             assert!(!out.join("INCOMPLETE").exists());
