@@ -34,9 +34,10 @@
 //! Piola-Kirchhoff stress) differs from it at second order. The terms
 //! `g_i, tau_i` are the material's, copied ([`RealTimeSurrogate::build`]);
 //! the held-out FE histories measure what that costs: within 1 % of the
-//! peak for Q1 to 0.8 mm, 4-14 % for the N1 needle to 10 mm (docs/guide.md),
-//! where fitting the terms to FE ramp-and-hold runs (per depth band) is
-//! the next step.
+//! peak for Q1 to 0.8 mm, 4-14 % for the N1 needle to 10 mm (docs/guide.md;
+//! fitted depth-dependent terms, split loading / unloading terms and a
+//! memory refreshed by the needle's travel were tried in session 11 and do
+//! not reach 2 % either: the error left is in the needle's unloading).
 //!
 //! Loss of contact: a punch withdrawn faster than the tissue recovers
 //! leaves it; the force cannot pull (`F >= 0`). When the trial force of a
