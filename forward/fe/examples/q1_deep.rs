@@ -9,7 +9,8 @@
 //! smoothing as a fraction of the element size; `NODES=1` contact at the
 //! nodes; `LINE=slope` the slope line search; `STAG=` the relative
 //! residual at which a stagnating increment is accepted; `HOLD=` seconds: viscoelastic ramp in 0.5 s and hold; `SELF=0` without the
-//! surface's self-contact).
+//! surface's self-contact; `BULK=` a bulk modulus of BULK x mu instead of
+//! the exact constraint).
 use palpate_core::{Drive, ForwardError, Loading};
 use palpate_fe::mesh::jacobian::corner_jacobians;
 use palpate_fe::Q1Punch;
@@ -46,6 +47,10 @@ fn main() {
         m.options.line_search = palpate_fe::LineSearch::Slope;
     }
     m.self_contact = std::env::var("SELF").map(|v| v != "0").unwrap_or(true);
+    if let Ok(v) = std::env::var("BULK") {
+        // a mean-dilatation penalty K = BULK mu instead of the exact constraint
+        m.bulk = palpate_fe::Bulk::Ratio(v.parse().unwrap());
+    }
     let n = (depth / step).round().max(1.0) as usize;
     let drive: Vec<f64> = (1..=n).map(|k| depth * k as f64 / n as f64).collect();
     let t0 = std::time::Instant::now();
