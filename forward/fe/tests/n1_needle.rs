@@ -214,7 +214,15 @@ fn viscoelastic_needle_relaxes_to_g_inf_times_the_elastic_force() {
     // neither run keeps a history of its increments in the contact
     m.options.max_augmentations = 30;
     m.penetration_tol = 1e-6;
-    let drive: Vec<f64> = (1..=8).map(|k| 0.25 * k as f64).collect();
+    // a stiff penalty: the augmentations to 1e-6 mm then take few rounds
+    // (100 mu / h, the default, made this test ~200 s of the CI's test time
+    // in the dev profile; 1e4: ~55 s and the relaxed force within 5e-7 of
+    // g_inf F_el instead of 4e-5; 1e5 does not converge)
+    m.penalty = 1e4;
+    // 4 samples of 0.5 mm (the ramp at 0.4 mm/s), a 20 s hold sampled
+    // twice: the recursive update is exact at constant strain, so long
+    // hold steps cost no accuracy
+    let drive: Vec<f64> = (1..=4).map(|k| 0.5 * k as f64).collect();
     let elastic = m
         .predict(
             &NH,
@@ -223,26 +231,26 @@ fn viscoelastic_needle_relaxes_to_g_inf_times_the_elastic_force() {
         .unwrap();
     let mut time: Vec<f64> = drive.iter().map(|d| d / 0.4).collect();
     let mut d = drive.clone();
-    for k in 1..=4 {
-        time.push(5.0 + 5.0 * k as f64);
+    for t in [15.0, 25.0] {
+        time.push(t);
         d.push(2.0);
     }
     let loading = Loading::timed(Drive::DisplacementMm, time, d);
     m.prony = Some(Prony::new(vec![(0.3, 0.25), (0.2, 0.5)]).unwrap());
-    m.options.max_time_step = Some(2.5);
+    m.options.max_time_step = Some(10.0);
     let f = m.predict(&NH, &loading).unwrap();
-    let relaxed = 0.5 * elastic[7];
+    let relaxed = 0.5 * elastic[3];
     println!(
         "elastic {:.6e} N, ramp end {:.6e} N, end of hold {:.6e} N (g_inf F_el {relaxed:.6e})",
-        elastic[7], f[7], f[11]
+        elastic[3], f[3], f[5]
     );
-    assert!(f[7] < elastic[7] && f[7] > f[11]);
-    assert!((f[11] / relaxed - 1.0).abs() < 2e-4, "{} {relaxed}", f[11]);
+    assert!(f[3] < elastic[3] && f[3] > f[5]);
+    assert!((f[5] / relaxed - 1.0).abs() < 2e-4, "{} {relaxed}", f[5]);
 
     m.prony = Some(Prony::new(vec![(0.3, 1e4), (0.2, 2e4)]).unwrap());
-    m.options.max_time_step = Some(1.0);
+    m.options.max_time_step = Some(1.25);
     let f = m.predict(&NH, &loading).unwrap();
-    for k in 0..8 {
+    for k in 0..4 {
         assert!(
             (f[k] / elastic[k] - 1.0).abs() < 2e-4,
             "{k}: {} {}",
