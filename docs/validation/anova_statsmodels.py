@@ -2,7 +2,7 @@
 """Independent reference values for palpate's ANOVA and residual checks.
 
 Computes, with statsmodels (ols + anova_lm, normal_ad) and scipy.stats
-(bartlett, levene, t quantiles), the numbers that uq/tests/anova_reference.rs
+(bartlett, levene, t quantiles), the numbers that uq/tests/integration/anova_reference.rs
 compares with palpate-uq to 6 significant digits, and writes them to
 docs/validation/anova_reference.json (next to this script).
 

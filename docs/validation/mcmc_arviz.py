@@ -3,7 +3,7 @@
 Generates a deterministic set of chains (numpy seed 20240611), runs
 arviz.summary / arviz.rhat / arviz.ess / arviz.mcse on them and writes
 chains and results to mcmc_arviz.json beside this script. The Rust test
-uq/tests/mcmc_arviz.rs recomputes every number from the same chains and
+uq/tests/integration/mcmc_arviz.rs recomputes every number from the same chains and
 requires agreement to 1e-6 relative.
 
     pip install arviz numpy

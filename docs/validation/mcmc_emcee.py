@@ -1,6 +1,6 @@
 """Independent reference posterior for the C1 reduced-polynomial (N=2) problem.
 
-Same data (mcmc_c1_rp2_data.csv, written by uq/tests/mcmc_c1.rs), same model
+Same data (mcmc_c1_rp2_data.csv, written by uq/tests/integration/mcmc_c1.rs), same model
 written in numpy, same likelihood (Gaussian, known sigma from the file's
 header comment) and flat priors (C10 > 0), sampled by emcee's stretch move.
 Writes mcmc_emcee.json: mean, sd, mcse_mean, ess_bulk, ess_tail, rhat per

@@ -3,7 +3,7 @@
 
 Every case below is fitted here with scipy.optimize.least_squares on the
 same model and residual as palpate, and the result is written to
-real_data_scipy.json; tests/tests/real_data_fits.rs runs palpate on the same
+real_data_scipy.json; tests/tests/integration/real_data_fits.rs runs palpate on the same
 cases from the same starting points and compares.
 
 The equations are written from the textbook formulas, not from the Rust

@@ -1,6 +1,6 @@
 //! Writes the synthetic R2 withheld-effect records of `tests/data/gap-r2/`
 //! (issue 14, item 5; used by `examples/gap_fe_effects.rs -- r2` and
-//! `tests/gap_fe_effects.rs`): the R2 development pass (`palpate_tests::
+//! `tests/integration/gap_fe_effects.rs`): the R2 development pass (`palpate_tests::
 //! r2_dev`: an 80 x 20 mm neo-Hookean block, wheel of diameter 8 mm rolled at
 //! RD 3 mm from x = 28 to 52 mm, vertical force every 1 mm, 25 samples)
 //! simulated on a mesh twice as fine as the diagnosis's base model (1 mm

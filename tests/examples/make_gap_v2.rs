@@ -1,7 +1,7 @@
 //! Writes the development records of gap diagnosis v2 (issue 14) to
 //! `tests/data/gap-v2/`, one group per weakness of the first version, each
 //! record seeded and with its truth in `truth.json` (used by
-//! `tests/gap_v2.rs`):
+//! `tests/integration/gap_v2.rs`):
 //!
 //! * `w1-*` (weakness 1, a true effect rejected by its own cross-validation):
 //!   C1 compression, a fast ramp and a long hold with two-term relaxation.

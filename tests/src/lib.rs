@@ -21,7 +21,7 @@ pub fn shared(rel: &str) -> PathBuf {
 /// 1 mm (R2's 0.5 mm steps double the cost for the same forces within the
 /// solver tolerance); the records
 /// (`examples/make_gap_r2.rs`) and the diagnoses (`examples/gap_fe_effects.rs
-/// -- r2`, `tests/gap_fe_effects.rs`) share it.
+/// -- r2`, `tests/integration/gap_fe_effects.rs`) share it.
 pub mod r2_dev {
     use palpate_core::{Drive, Loading};
     use palpate_fe::R2Rolling;

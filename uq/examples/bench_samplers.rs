@@ -1,5 +1,5 @@
 //! Sampler benchmark on the C1 reduced-polynomial (N = 2) posterior (the
-//! problem of `uq/tests/mcmc_c1.rs` and `docs/validation/mcmc_emcee.py`):
+//! problem of `uq/tests/integration/mcmc_c1.rs` and `docs/validation/mcmc_emcee.py`):
 //! ESS per second and per 1000 model evaluations for each sampler, beside
 //! emcee and PyMC when their result files are present
 //! (`docs/validation/mcmc_emcee.json`, `mcmc_pymc.json`, written by the
@@ -18,7 +18,7 @@ use palpate_uq::mcmc::{summarize, DemcSettings, EnsembleSettings, NutsSettings, 
 use std::path::Path;
 use std::sync::Arc;
 
-#[path = "../tests/common/mod.rs"]
+#[path = "../tests/integration/common/mod.rs"]
 mod common;
 
 fn main() {

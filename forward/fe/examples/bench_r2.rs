@@ -7,7 +7,7 @@
 //! wall time, the CPU time (user + sys of the process, all threads), and the
 //! force error of the pass against presses on the finer mesh (h = 1 mm) at
 //! a few positions over and between the nodules (a press at x equals the
-//! rolled state at x for this contact, tests/r2_rolling.rs).
+//! rolled state at x for this contact, tests/integration/r2_rolling.rs).
 //!
 //! `cargo run --release -p palpate-fe --example bench_r2 -- [--segments 2]
 //!  [--step 0.5] [--rd 6] [--x 37.5,56.25,75,112.5|none]

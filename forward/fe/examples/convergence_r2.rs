@@ -1,7 +1,7 @@
 //! R2 mesh convergence and the presses compared with CalculiX
 //! (docs/validation/fe.md, "R2"). With a frictionless wheel and pure-penalty
 //! contact the state depends on the wheel position only, so the rolled force
-//! at x is the force of a press to RD at x (tests/r2_rolling.rs checks it);
+//! at x is the force of a press to RD at x (tests/integration/r2_rolling.rs checks it);
 //! each row presses the wheel to RD at x on element sizes h = 4, 2, 1 mm
 //! (the default mesh, level 1, is h = 2) and prints the forces, the observed
 //! order `p = log2((F4 - F2) / (F2 - F1))`, the Richardson estimate of the

@@ -5,10 +5,10 @@
 //! 10, 15 and 20 mm, from their peak force, with its error).
 //!
 //! Peak force = the press to RD at the nodule's x: with a frictionless wheel
-//! the state depends on the wheel position alone (tests/r2_rolling.rs), and
+//! the state depends on the wheel position alone (tests/integration/r2_rolling.rs), and
 //! the R2-1 block and mesh are symmetric about the nodule at x = 75 mm, so
 //! the rolled force peaks there. For R2 (three nodules) the press at each
-//! nodule's x (the peak within the 1 mm of tests/r2_rolling.rs (c)).
+//! nodule's x (the peak within the 1 mm of tests/integration/r2_rolling.rs (c)).
 //! The flat level F0 is the press at x = 75 mm without nodules.
 //!
 //! A nodule is "NI" (not identifiable) here when its peak excess over F0 is

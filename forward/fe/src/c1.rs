@@ -99,7 +99,7 @@ impl C1Fe {
     /// (38 x 18, 76 x 36, 152 x 72), reduced polynomial N = 2, at 2 mm:
     /// 29.81 / 29.09 / 28.61 N (docs/validation/fe.md, "C1 bonded mesh
     /// convergence"). Frictionless: the deformation is homogeneous and Q1/P0
-    /// is exact on any mesh (tests/c1_frictionless.rs); the two meshes agree
+    /// is exact on any mesh (tests/integration/c1_frictionless.rs); the two meshes agree
     /// to round-off and the estimate is zero whatever the order (2 stated,
     /// the element's nominal order).
     pub fn convergence_order(&self) -> ConvergenceOrder {

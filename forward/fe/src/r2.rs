@@ -327,7 +327,7 @@ impl R2Rolling {
     /// position and rolled from there. Exact for a frictionless wheel with
     /// [`R2Rolling::pure_penalty`] contact, whose state is a function of the
     /// wheel position alone (the press at x equals the rolled state at x,
-    /// tests/r2_rolling.rs); with friction (path-dependent) or augmented
+    /// tests/integration/r2_rolling.rs); with friction (path-dependent) or augmented
     /// contact one segment is used whatever `segments` says.
     ///
     /// Returns `[force_N, force_x_N]` per position and the system at the

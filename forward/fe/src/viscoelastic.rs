@@ -47,7 +47,7 @@
 //! nominal stress at finite strain, because the pressure multiplies the
 //! current `C^-1`; the difference, relative to the viscous part, is of
 //! second order in the strain (1.4e-2 at 20 % compression; see
-//! `tests/c1_viscoelastic.rs`).
+//! `tests/integration/c1_viscoelastic.rs`).
 
 use nalgebra::Matrix3;
 

@@ -8,7 +8,7 @@
 //! model is assembled once all are there ([`ModelUnits::assemble`], the
 //! surrogate by [`Surrogate::from_runs`]): the model
 //! [`LocModel::load_or_build`] makes in one process, but for the build
-//! times (tested in `studies/tests/localize_units.rs`).
+//! times (tested in `studies/tests/integration/localize_units.rs`).
 //!
 //! The scan model is a type parameter so that the enumeration and the
 //! assembly can be tested on a cheap stand-in for the FE scan; a study

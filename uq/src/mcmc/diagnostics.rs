@@ -16,7 +16,7 @@
 //! Each function takes the draws of one parameter as `chains[c][t]` (the
 //! `(chain, draw)` array of ArviZ) and follows `arviz.stats.diagnostics`
 //! (0.x) line by line, so results agree to rounding
-//! (`uq/tests/mcmc_arviz.rs` checks against committed ArviZ output). The
+//! (`uq/tests/integration/mcmc_arviz.rs` checks against committed ArviZ output). The
 //! autocovariance is summed directly lag by lag instead of by FFT: the
 //! Geyer truncation stops after a few autocorrelation times, so the direct
 //! sum costs O(N tau), less than an FFT for well-mixed chains, and needs no

@@ -15,7 +15,7 @@ fn data_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/mesa2011")
 }
 
-/// The Mesa-Munera chain of tests/mesa2011.rs, axisymmetric only, records
+/// The Mesa-Munera chain of tests/integration/mesa2011.rs, axisymmetric only, records
 /// cut at 1 mm (5 load steps per FE run).
 fn manifest(dir: &Path) -> PathBuf {
     let recs: Vec<PathBuf> = (1..=3)
@@ -540,9 +540,9 @@ noise = 0.01
 /// whole test 499 s of CPU (user+sys), 819 s wall (a second run: 703 s
 /// wall); per process in
 /// docs/cluster.md ("A localize step"). The units' enumeration and
-/// assembly are tested cheaply by studies/tests/localize_units.rs.
+/// assembly are tested cheaply by studies/tests/integration/localize_units.rs.
 #[test]
-#[ignore = "about 8 minutes of CPU: cargo test -p palpate-studies --release --test shards -- --ignored localize"]
+#[ignore = "about 8 minutes of CPU: cargo test -p palpate-studies --release --test integration -- --ignored shards::localize"]
 fn localize_fe_runs_and_posterior_are_shard_units_and_merge_to_the_single_run() {
     let dir = tempfile::tempdir().unwrap();
     let m = localize_manifest(dir.path());

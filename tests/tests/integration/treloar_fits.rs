@@ -6,7 +6,7 @@
 //! identifiable. Both sides run the same deterministic starting points and
 //! keep the best SSE.
 //!
-//! `TRELOAR_TABLE=1 cargo test -p palpate-tests --test treloar_fits -- --nocapture`
+//! `TRELOAR_TABLE=1 cargo test -p palpate-tests --test integration treloar_fits:: -- --nocapture`
 //! prints the markdown table of `docs/validation/treloar.md`.
 
 use palpate_analytic::{Homogeneous, Mode};

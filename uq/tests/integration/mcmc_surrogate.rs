@@ -10,7 +10,7 @@ use palpate_uq::mcmc::{summarize, DemcSettings, Sampler};
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use std::sync::Arc;
 
-mod common;
+use crate::common;
 use common::c1_rp2_record as data;
 
 fn posterior(model: Arc<dyn ForwardModel>) -> Posterior {

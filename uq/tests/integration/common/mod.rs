@@ -1,5 +1,5 @@
 //! The synthetic C1 record of the MCMC validation
-//! (`docs/validation/mcmc_c1_rp2_data.csv`, written by `tests/mcmc_c1.rs`),
+//! (`docs/validation/mcmc_c1_rp2_data.csv`, written by `tests/integration/mcmc_c1.rs`),
 //! shared by the MCMC tests and `examples/bench_samplers.rs`.
 
 use palpate_core::{Drive, Loading, Table};

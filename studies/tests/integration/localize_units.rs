@@ -7,7 +7,7 @@
 //! its build times, the same predictions bit for bit. Wrong or missing
 //! units are refused with the reason. On a cheap analytic stand-in for the
 //! FE scan (an R2 scan is a minute of CPU; the FE units themselves are
-//! tested by studies/tests/shards.rs, ignored for its cost).
+//! tested by studies/tests/integration/shards.rs, ignored for its cost).
 
 use palpate_core::{
     Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,

@@ -11,7 +11,7 @@
 //! response is even in alpha there). The product path
 //! (`calibrate`, its own starts) is held to 1 % of the scipy SSE.
 //!
-//! `REAL_TABLE=1 cargo test -p palpate-studies --test real_data_fits -- --nocapture`
+//! `REAL_TABLE=1 cargo test -p palpate-studies --test integration real_data_fits:: -- --nocapture`
 //! prints the table of `docs/validation/real-data.md`.
 
 use palpate_inverse::{fit, DataSet, FitOptions, FitReport, Objective, ResidualKind};

@@ -17,7 +17,7 @@ fn quasi_static(depths: &[f64]) -> Loading {
 }
 
 /// Sneddon's exact-sphere force on an incompressible half-space
-/// (E* = 4 mu; tests/hertz.rs has the derivation).
+/// (E* = 4 mu; tests/integration/hertz.rs has the derivation).
 fn sneddon(r: f64, d: f64) -> f64 {
     let depth_of = |a: f64| 0.5 * a * ((r + a) / (r - a)).ln();
     let (mut lo, mut hi) = (0.0, r * (1.0 - 1e-12));
@@ -91,8 +91,8 @@ fn quadratic_hexahedra_against_sneddon() {
 
 /// The same on 0.4 mm hexahedra (growth 1.5) at 0.25 and 0.5 mm: within
 /// 2 % of Sneddon (measured -0.8 / -1.5 %, the finite-deformation and
-/// finite-block deviations of tests/hertz.rs). ~40 s of CPU:
-/// `cargo test -p palpate-fe --test n3_needle -- --ignored`.
+/// finite-block deviations of tests/integration/hertz.rs). ~40 s of CPU:
+/// `cargo test -p palpate-fe --test integration n3_needle:: -- --ignored`.
 #[test]
 #[ignore]
 fn sphere_on_level_1_like_mesh_within_2_percent() {
@@ -105,7 +105,7 @@ fn sphere_on_level_1_like_mesh_within_2_percent() {
 /// against N1 on level 2 (0.2 mm, near converged at 2 mm): N3 is
 /// 2.7 / 2.9 % stiffer. The square 70 x 80 mm block has 1.46 x the
 /// cylinder's cross-section (stiffer far field, ~+1 % for a body this much
-/// larger, tests/hertz.rs) and the 0.8 mm hexahedra are stiffer than a
+/// larger, tests/integration/hertz.rs) and the 0.8 mm hexahedra are stiffer than a
 /// converged mesh (N1 on the same 0.8 mm grading is -1.2 / +3.9 % from
 /// level 2, so roughly that much again). ~60 s of CPU: `-- --ignored`.
 #[test]

@@ -5,7 +5,7 @@
 //! A few cases check that input that only looks odd (a byte-order mark,
 //! CR-only line endings) is read as what it is.
 
-mod common;
+use crate::common;
 use common::*;
 use std::process::Output;
 
@@ -979,7 +979,7 @@ fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
         &q1(&ramp, "elastic,relaxation"),
         &["ramp.csv", "a hold after it"],
     );
-    let rec = crate::two_stage_record();
+    let rec = two_stage_record();
     refused(
         &q1(&rec, "elastic,viscous"),
         &["--stages", "unknown stage `viscous`"],

@@ -7,7 +7,7 @@ use palpate_analytic::C1Compression;
 use palpate_core::ForwardModel;
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 
-mod common;
+use crate::common;
 use common::c1_rp2_record as data;
 
 #[test]

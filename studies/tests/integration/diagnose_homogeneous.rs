@@ -3,7 +3,7 @@
 //! kind offers. Seeded synthetic uniaxial records with known truth, and one
 //! real file end to end.
 
-mod common;
+use crate::common;
 use common::Scratch;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};

@@ -15,7 +15,7 @@ use palpate_uq::likelihood::{
 use palpate_uq::mcmc::{DemcSettings, Sampler};
 use std::sync::Arc;
 
-mod common;
+use crate::common;
 
 #[test]
 fn laplace_and_thermodynamic_integration_match_the_exact_evidence() {

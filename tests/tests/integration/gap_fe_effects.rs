@@ -2,7 +2,7 @@
 //! in CI; the full diagnoses of the development records are `#[ignore]`d
 //! (minutes of CPU each) and run with
 //!
-//!     cargo test -p palpate-tests --test gap_fe_effects -- --ignored
+//!     cargo test -p palpate-tests --test integration gap_fe_effects:: -- --ignored
 //!
 //! (or the release example `examples/gap_fe_effects.rs`, which prints the
 //! table of docs/gap-diagnosis.md).
@@ -280,7 +280,7 @@ fn check_verdicts(
 /// the 2 mm base with its three effects. Heavy: some 50-80 passes of 8 s of
 /// CPU per record.
 #[test]
-#[ignore = "R2 diagnoses, tens of minutes of CPU: cargo test -p palpate-tests --release --test gap_fe_effects -- --ignored r2_"]
+#[ignore = "R2 diagnoses, tens of minutes of CPU: cargo test -p palpate-tests --release --test integration -- --ignored gap_fe_effects::r2_"]
 fn r2_records_get_the_expected_verdicts() {
     let base = R2Gap::new(r2_dev::rolling(2.0), 1.0);
     check_verdicts("gap-r2", Drive::PositionMm, &base, None);
@@ -290,7 +290,7 @@ fn r2_records_get_the_expected_verdicts() {
 /// generator, steps of tau_min / 10) against the elastic punch on mesh
 /// level 2 with `viscoelasticity`.
 #[test]
-#[ignore = "Q1 diagnoses, minutes of CPU: cargo test -p palpate-tests --release --test gap_fe_effects -- --ignored q1_"]
+#[ignore = "Q1 diagnoses, minutes of CPU: cargo test -p palpate-tests --release --test integration -- --ignored gap_fe_effects::q1_"]
 fn q1_records_get_the_expected_verdicts() {
     let mut base = Q1Punch::new(Law::NeoHookean);
     base.level = 2;
@@ -306,7 +306,7 @@ fn q1_records_get_the_expected_verdicts() {
 /// against the coarse axisymmetric N1 base with `modelling_space` and
 /// `friction`.
 #[test]
-#[ignore = "N3 runs, minutes of CPU: cargo test -p palpate-tests --release --test gap_fe_effects -- --ignored n3_"]
+#[ignore = "N3 runs, minutes of CPU: cargo test -p palpate-tests --release --test integration -- --ignored gap_fe_effects::n3_"]
 fn n3_records_get_the_expected_verdicts() {
     let mut base = N1Needle::new(Law::NeoHookean);
     base.friction = 0.0;

@@ -5,7 +5,7 @@
 //! before anything is computed or written. Each case asserts a non-zero
 //! exit, no panic and the locator.
 
-mod common;
+use crate::common;
 use common::*;
 use std::process::Output;
 

@@ -220,7 +220,7 @@ fn near_half_space_is_within_3_percent_of_hertz_up_to_0_1_r() {
 
 /// The small-strain limit: the deviation goes to zero with the depth, and
 /// CalculiX on a 0.025 mm CAX8R mesh agrees.
-/// (20 s: `cargo test -p palpate-fe --test hertz -- --ignored`.)
+/// (20 s: `cargo test -p palpate-fe --test integration hertz:: -- --ignored`.)
 #[test]
 #[ignore]
 fn sphere_force_tends_to_hertz_at_small_depth() {
@@ -247,7 +247,7 @@ fn sphere_force_tends_to_hertz_at_small_depth() {
 }
 
 /// Prints the FE curve of the docs table (CSV on stderr):
-/// `cargo test -p palpate-fe --test hertz print_fe_curve -- --ignored --nocapture`.
+/// `cargo test -p palpate-fe --test integration hertz::print_fe_curve -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn print_fe_curve() {
