@@ -805,6 +805,7 @@ fn sphere_forces(friction: f64) -> Vec<(f64, f64)> {
 /// force on the dent tilted by the drag; it shrinks as the contact
 /// flattens: +2.4 % here, and with penalties of 50 MPa/mm +8.7 % at
 /// R = 2 mm, d = 0.25 mm, +2.3 % here, +1.1 % at R = 8 mm, d = 0.1 mm.)
+/// Frictionless: the next test.
 #[test]
 fn sliding_sphere_drags_the_surface_at_the_coulomb_limit() {
     let mu = 0.3;
@@ -824,6 +825,14 @@ fn sliding_sphere_drags_the_surface_at_the_coulomb_limit() {
         out[1].0,
         out[2].0
     );
+}
+
+/// The same sphere frictionless: no horizontal force. (A test of its own
+/// so that the two 3D runs, ~30 s each in the dev profile, run side by
+/// side.)
+#[test]
+fn frictionless_sliding_sphere_has_no_horizontal_force() {
+    let mu = 0.3;
     let out = sphere_forces(0.0);
     for (fx, fz) in &out {
         assert!(

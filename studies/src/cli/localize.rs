@@ -75,17 +75,20 @@ pub struct Args {
     /// centre, translation invariance assumed: shallow nodules within ~45
     /// mm of an end read ~0.16 mm towards it) or along (depth and position
     /// of the nodule, 20 FE scans instead of 8: removes most of that bias,
-    /// but its surrogate error is larger; docs/validation/r2-localisation.md).
-    #[arg(long, default_value = "centre", value_parser = ["centre", "along"])]
+    /// but its surrogate error is larger; docs/validation/r2-localisation.md)
+    /// or lean (the centre model with the excess shifted by the end lean
+    /// measured on 16 short FE scans near the end: one shift per nodule
+    /// position and depth).
+    #[arg(long, default_value = "centre", value_parser = ["centre", "along", "lean"])]
     pub scan: String,
 }
 
 /// Runs `palpate localize`.
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let mut setup = if a.scan == "along" {
-        LocSetup::r2_along(a.rd)
-    } else {
-        LocSetup::r2(a.rd)
+    let mut setup = match a.scan.as_str() {
+        "along" => LocSetup::r2_along(a.rd),
+        "lean" => LocSetup::r2_lean(a.rd),
+        _ => LocSetup::r2(a.rd),
     };
     if let Some(n) = a.design {
         setup.training = n;
@@ -193,6 +196,16 @@ pub fn report_model(model: &LocModel, elapsed: f64) {
         v.rms_relative_error,
         model.scan.basis_size()
     );
+    if let Some(l) = &model.lean {
+        eprintln!(
+            "end lean (mm, + towards the nearer end) from FE scans, by distance from the end (rows) and depth {:?} mm:",
+            l.depth
+        );
+        for (e, row) in l.distance.iter().zip(&l.shift) {
+            let cells: Vec<String> = row.iter().map(|v| format!("{v:+.3}")).collect();
+            eprintln!("  {e:>5.1} mm: {}", cells.join("  "));
+        }
+    }
 }
 
 fn fmt_iv(i: &crate::localize::posterior::Interval) -> String {

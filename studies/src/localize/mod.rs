@@ -43,6 +43,7 @@
 //! (C1, so the log-posterior is smooth in x_n); E is tapered to zero over
 //! one step past the half-width.
 
+pub mod lean;
 pub mod posterior;
 pub mod record;
 pub mod units;
@@ -71,6 +72,9 @@ pub struct LocSetup {
     /// Whether the scan has the nodule's position as a parameter (module
     /// docs); otherwise translation invariance is assumed.
     pub along_block: bool,
+    /// Whether the centre model's excess is shifted by the end lean
+    /// measured on FE scans near the end ([`lean`], `--scan lean`).
+    pub lean: bool,
 }
 
 impl LocSetup {
@@ -88,8 +92,27 @@ impl LocSetup {
             training: 6,
             holdout: 2,
             along_block: false,
+            lean: false,
         }
     }
+
+    /// The centre model with the end lean ([`lean`]): [`Self::r2`] plus
+    /// [`Self::LEAN_DISTANCES`] x [`Self::LEAN_DEPTHS`] FE scans of
+    /// [`Self::LEAN_HALF_WINDOW`] on each side of one nodule.
+    pub fn r2_lean(rd: f64) -> Self {
+        LocSetup {
+            lean: true,
+            ..Self::r2(rd)
+        }
+    }
+
+    /// Distances (mm) from the nearer block end of the lean's FE scans.
+    pub const LEAN_DISTANCES: [f64; 4] = [15.0, 25.0, 35.0, 50.0];
+    /// Nodule depths (mm) of the lean's FE scans (the studied 8-24 mm).
+    pub const LEAN_DEPTHS: [f64; 4] = [8.0, 12.0, 16.0, 24.0];
+    /// The offsets of a lean scan: -w..w mm every `step` (the peak and its
+    /// flanks, where a shift shows).
+    pub const LEAN_HALF_WINDOW: f64 = 12.0;
 
     /// The scan along the block (depth and ln x_n; module docs): offsets
     /// -30..30 mm every 2 mm, 16 training + 4 held-out scans of up to 60
@@ -110,6 +133,7 @@ impl LocSetup {
             training: 6,
             holdout: 2,
             along_block: false,
+            lean: false,
             ..self.clone()
         }
     }
@@ -290,6 +314,23 @@ impl LocSetup {
             }
         )
     }
+
+    /// The offsets of one lean scan.
+    pub fn lean_offsets(&self) -> Vec<f64> {
+        let n = (Self::LEAN_HALF_WINDOW / self.step).round() as i64;
+        (-n..=n).map(|k| self.step * k as f64).collect()
+    }
+
+    /// What defines the cached lean scans.
+    fn lean_description(&self) -> String {
+        format!(
+            "{}; lean scans at distances {:?}, depths {:?}, offsets {:?}",
+            self.at_centre().description(),
+            Self::LEAN_DISTANCES,
+            Self::LEAN_DEPTHS,
+            self.lean_offsets()
+        )
+    }
 }
 
 /// The nodule-free force every `step` mm from the block's centre.
@@ -331,6 +372,8 @@ pub struct LocModel {
     /// surrogate corrects (E = E_centre + the surrogate's), or `None` when
     /// the surrogate is of E itself.
     pub centre_model: Option<Box<LocModel>>,
+    /// The end lean of the excess (`--scan lean`), or `None`.
+    pub lean: Option<lean::Lean>,
     pub baseline: Baseline,
     /// Where each came from (None for a model built in memory).
     pub scan_status: Option<CacheStatus>,
@@ -412,7 +455,77 @@ impl LocModel {
             cache,
             &format!("R2 scan surrogate, RD {}", setup.template.rd),
         )?;
-        Self::from_parts(setup, s, baseline, Some(status), Some(baseline_status))
+        let mut m = Self::from_parts(setup, s, baseline, Some(status), Some(baseline_status))?;
+        if setup.lean {
+            m.lean = Some(m.load_or_measure_lean(setup, cache)?);
+        }
+        Ok(m)
+    }
+
+    /// The end lean ([`lean`]) of this centre model: FE scans past one
+    /// nodule at each of the setup's distances from the end and depths
+    /// (cached, in parallel, with a progress bar), each fitted to this
+    /// model's excess by a shift and an amplitude.
+    fn load_or_measure_lean(&self, setup: &LocSetup, cache: &Path) -> anyhow::Result<lean::Lean> {
+        let offsets = setup.lean_offsets();
+        let cases: Vec<(f64, f64)> = LocSetup::LEAN_DISTANCES
+            .iter()
+            .flat_map(|&e| LocSetup::LEAN_DEPTHS.iter().map(move |&d| (e, d)))
+            .collect();
+        let scan = R2NoduleScan::along_block(setup.template.clone(), false);
+        let (runs, _) = load_or_compute("r2-lean", &setup.lean_description(), cache, || {
+            use rayon::prelude::*;
+            let bar = crate::limits::Progress::new(
+                cases.len() as u64,
+                &format!("R2 end-lean FE scans, RD {}", setup.template.rd),
+                "{msg} [{bar:40}] {pos}/{len} FE scans ({elapsed}, eta {eta})",
+            );
+            let runs: Vec<Vec<f64>> = cases
+                .par_iter()
+                .map(|&(e, d)| {
+                    let r = scan.scan(&[d, e.ln()], &offsets);
+                    bar.inc(1);
+                    r.map_err(|err| {
+                        anyhow::anyhow!("the R2 lean scan at x = {e} mm, depth {d} mm: {err}")
+                    })
+                })
+                .collect::<anyhow::Result<_>>()?;
+            bar.finish();
+            Ok(runs)
+        })?;
+        let (lo, hi) = self.path;
+        let mut grid = vec![0.0; self.scan.loading().len()];
+        let nd = LocSetup::LEAN_DEPTHS.len();
+        let mut shift = vec![vec![0.0; nd]; LocSetup::LEAN_DISTANCES.len()];
+        let mut amplitude = shift.clone();
+        for (k, (&(e, d), forces)) in cases.iter().zip(&runs).enumerate() {
+            // the excess at the offsets on the rolled path
+            let (mut os, mut es) = (Vec::new(), Vec::new());
+            for (&o, &f) in offsets.iter().zip(forces) {
+                if e + o >= lo - 1e-9 && e + o <= hi + 1e-9 {
+                    os.push(o);
+                    es.push(f - self.baseline_at(e + o));
+                }
+            }
+            self.excess_grid(d, self.centre, &mut grid)?;
+            let (delta, a) =
+                lean::fit_shift(&os, &es, |o| self.excess_at(&grid, o, false), self.step);
+            shift[k / nd][k % nd] = delta;
+            amplitude[k / nd][k % nd] = a;
+        }
+        Ok(lean::Lean {
+            distance: LocSetup::LEAN_DISTANCES.to_vec(),
+            depth: LocSetup::LEAN_DEPTHS.to_vec(),
+            shift,
+            amplitude,
+            centre: self.centre,
+        })
+    }
+
+    /// What to add to a wheel offset `p - x` from a nodule at `x` and depth
+    /// `d` before reading its excess: the end lean's shift, or zero.
+    pub fn offset_shift(&self, x: f64, d: f64) -> f64 {
+        self.lean.as_ref().map_or(0.0, |l| l.offset_shift(x, d))
     }
 
     /// The model along the block: the centre model of the same RD (its
@@ -507,6 +620,7 @@ impl LocModel {
             centre: setup.centre(),
             scan,
             centre_model: None,
+            lean: None,
             baseline,
             scan_status,
             baseline_status,
@@ -660,9 +774,10 @@ impl LocModel {
         let mut v = vec![0.0; positions.len()];
         for &(x, d) in nodules {
             let m = self.excess_grid(d, x, &mut grid)?;
+            let shift = self.offset_shift(x, d);
             for (i, &p) in positions.iter().enumerate() {
-                f[i] += self.excess_at(&grid, p - x, m);
-                v[i] += self.error_variance_at(p - x, m);
+                f[i] += self.excess_at(&grid, p - x + shift, m);
+                v[i] += self.error_variance_at(p - x + shift, m);
             }
         }
         for (fi, vi) in f.iter_mut().zip(v.iter_mut()) {
@@ -673,9 +788,13 @@ impl LocModel {
     }
 
     /// FE runs behind the model: the surrogate's design and held-out scans,
-    /// and the nodule-free pass.
+    /// the end lean's scans and the nodule-free pass.
     pub fn fe_runs(&self) -> usize {
-        self.scan.fe_runs + self.centre_model.as_ref().map_or(1, |c| c.fe_runs())
+        let lean = self
+            .lean
+            .as_ref()
+            .map_or(0, |l| l.distance.len() * l.depth.len());
+        self.scan.fe_runs + lean + self.centre_model.as_ref().map_or(1, |c| c.fe_runs())
     }
 
     /// The surrogate's held-out error relative to the peak force of its

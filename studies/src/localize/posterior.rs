@@ -208,8 +208,9 @@ fn log_likelihood(
             return f64::NEG_INFINITY;
         };
         let reach = model.half_width + 2.0 * model.step;
+        let shift = model.offset_shift(xn, d);
         for (i, &p) in x.iter().enumerate() {
-            let o = p - xn;
+            let o = p - xn + shift;
             if o.abs() <= reach {
                 pred[i] += model.excess_at(grid, o, m);
                 var[i] += model.error_variance_at(o, m);
@@ -232,8 +233,9 @@ fn sse(model: &LocModel, x: &[f64], y: &[f64], f0: &[f64], nod: &[(f64, f64)], s
         let Ok(m) = model.excess_grid(d, xn, &mut grid) else {
             return f64::INFINITY;
         };
+        let shift = model.offset_shift(xn, d);
         for (i, &p) in x.iter().enumerate() {
-            pred[i] += model.excess_at(&grid, p - xn, m);
+            pred[i] += model.excess_at(&grid, p - xn + shift, m);
         }
     }
     x.iter()
