@@ -178,6 +178,10 @@ pub fn check_outputs_and_dirs(
     Ok(())
 }
 
+/// The name prefix of [`check_writable`]'s probe file (created and removed
+/// at once; another process may see it for an instant).
+pub const WRITE_PROBE: &str = ".palpate-write-check.";
+
 /// Checks that `path` can be written as a file (`dir = false`) or written
 /// in as a directory, without writing it: the path is not a directory (for
 /// a file) or not a file (for a directory), and the nearest existing folder
@@ -220,7 +224,7 @@ pub fn check_writable(option: &str, path: &Path, dir: bool) -> anyhow::Result<()
         }
     }
     tempfile::Builder::new()
-        .prefix(".palpate-write-check.")
+        .prefix(WRITE_PROBE)
         .tempfile_in(at)
         .map(drop)
         .map_err(|e| anyhow::anyhow!("{option} {shown}: cannot write in {}: {e}", at.display()))

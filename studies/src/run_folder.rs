@@ -69,7 +69,7 @@ impl RunFolder {
         if out.exists() && !out.is_dir() {
             anyhow::bail!("run folder {shown}: is a file; give a folder with --out");
         }
-        if out.is_dir() && !is_run_folder(out) && !is_empty(out)? {
+        if out.is_dir() && !is_empty(out)? && !is_run_folder(out) {
             anyhow::bail!(
                 "run folder {shown}: exists, is not empty and is not a palpate run folder (no {STATE}/ or provenance.json in it); \
                  give a new or empty folder with --out so that nothing of yours is replaced"
@@ -128,7 +128,7 @@ impl RunFolder {
         if out.exists() && !out.is_dir() {
             anyhow::bail!("run folder {shown}: is a file; give a folder with --out");
         }
-        if out.is_dir() && !is_run_folder(out) && !is_empty(out)? {
+        if out.is_dir() && !is_empty(out)? && !is_run_folder(out) {
             anyhow::bail!(
                 "run folder {shown}: exists, is not empty and is not a palpate run folder (no {STATE}/ or provenance.json in it); \
                  give a new or empty folder with --out so that nothing of yours is replaced"
@@ -378,11 +378,24 @@ fn is_run_folder(dir: &Path) -> bool {
     dir.join(STATE).is_dir() || dir.join("provenance.json").is_file()
 }
 
+/// Whether `dir` holds nothing but another palpate process's write probe
+/// ([`check_writable`]'s). Asked BEFORE [`is_run_folder`]: shards started
+/// at once into a new folder race, and a folder seen non-empty because
+/// another shard has just created its state folder must then be seen as a
+/// run folder (asked the other way round, a shard saw neither state folder
+/// nor emptiness and refused the folder; the Python guide's Dask block hit
+/// it).
 fn is_empty(dir: &Path) -> anyhow::Result<bool> {
-    Ok(std::fs::read_dir(dir)
-        .with_context(|| format!("cannot read {}", dir.display()))?
-        .next()
-        .is_none())
+    let mut entries =
+        std::fs::read_dir(dir).with_context(|| format!("cannot read {}", dir.display()))?;
+    Ok(entries.all(|e| {
+        e.map(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(crate::output::WRITE_PROBE)
+        })
+        .unwrap_or(false)
+    }))
 }
 
 /// A relative path without `..` or a root (a record from disk is not trusted
@@ -433,6 +446,38 @@ fn list_files(dir: &Path) -> anyhow::Result<Vec<String>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Shards started at the same instant into a folder that does not exist
+    /// yet, or exists empty, all open it (none sees it half-made and
+    /// refuses it as a user's folder).
+    #[test]
+    fn shards_started_at_once_all_open_a_new_folder() {
+        for trial in 0..40 {
+            let dir = tempfile::tempdir().unwrap();
+            let out = dir.path().join("run");
+            if trial % 2 == 1 {
+                std::fs::create_dir(&out).unwrap();
+            }
+            let n = 4;
+            let barrier = std::sync::Barrier::new(n);
+            std::thread::scope(|s| {
+                let handles: Vec<_> = (0..n)
+                    .map(|i| {
+                        let (out, barrier) = (&out, &barrier);
+                        s.spawn(move || {
+                            barrier.wait();
+                            let shard = format!("{i}/{n}").parse().unwrap();
+                            RunFolder::open_shared(out, shard).map(drop)
+                        })
+                    })
+                    .collect();
+                for h in handles {
+                    let r = h.join().unwrap();
+                    assert!(r.is_ok(), "trial {trial}: {}", r.err().unwrap());
+                }
+            });
+        }
+    }
 
     #[test]
     fn a_second_open_is_refused_naming_the_holder_and_a_drop_releases() {
