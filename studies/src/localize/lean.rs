@@ -23,7 +23,11 @@
 //! the way a correction of the whole curve did (session 11: that fitted
 //! ~0.1 N of noise and cost depth accuracy).
 
+use super::{LocModel, LocSetup};
+use crate::surrogate::load_or_compute;
+use palpate_fe::r2_scan::R2NoduleScan;
 use serde::{Deserialize, Serialize};
+use std::path::Path;
 
 /// Measured shifts on a grid of (distance to the nearer end, depth).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -159,6 +163,65 @@ pub fn fit_shift(
     }
     let delta = 0.5 * (lo + hi);
     (delta, misfit(delta).1)
+}
+
+/// The end lean of the centre model `model`: FE scans past one
+/// nodule at each of the setup's distances from the end and depths
+/// (cached, in parallel, with a progress bar), each fitted to this
+/// model's excess by a shift and an amplitude.
+pub fn load_or_measure(model: &LocModel, setup: &LocSetup, cache: &Path) -> anyhow::Result<Lean> {
+    let offsets = setup.lean_offsets();
+    let cases: Vec<(f64, f64)> = LocSetup::LEAN_DISTANCES
+        .iter()
+        .flat_map(|&e| LocSetup::LEAN_DEPTHS.iter().map(move |&d| (e, d)))
+        .collect();
+    let scan = R2NoduleScan::along_block(setup.template.clone(), false);
+    let (runs, _) = load_or_compute("r2-lean", &setup.lean_description(), cache, || {
+        use rayon::prelude::*;
+        let bar = crate::limits::Progress::new(
+            cases.len() as u64,
+            &format!("R2 end-lean FE scans, RD {}", setup.template.rd),
+            "{msg} [{bar:40}] {pos}/{len} FE scans ({elapsed}, eta {eta})",
+        );
+        let runs: Vec<Vec<f64>> = cases
+            .par_iter()
+            .map(|&(e, d)| {
+                let r = scan.scan(&[d, e.ln()], &offsets);
+                bar.inc(1);
+                r.map_err(|err| {
+                    anyhow::anyhow!("the R2 lean scan at x = {e} mm, depth {d} mm: {err}")
+                })
+            })
+            .collect::<anyhow::Result<_>>()?;
+        bar.finish();
+        Ok(runs)
+    })?;
+    let (lo, hi) = model.path;
+    let mut grid = vec![0.0; model.scan.loading().len()];
+    let nd = LocSetup::LEAN_DEPTHS.len();
+    let mut shift = vec![vec![0.0; nd]; LocSetup::LEAN_DISTANCES.len()];
+    let mut amplitude = shift.clone();
+    for (k, (&(e, d), forces)) in cases.iter().zip(&runs).enumerate() {
+        // the excess at the offsets on the rolled path
+        let (mut os, mut es) = (Vec::new(), Vec::new());
+        for (&o, &f) in offsets.iter().zip(forces) {
+            if e + o >= lo - 1e-9 && e + o <= hi + 1e-9 {
+                os.push(o);
+                es.push(f - model.baseline_at(e + o));
+            }
+        }
+        model.excess_grid(d, model.centre, &mut grid)?;
+        let (delta, a) = fit_shift(&os, &es, |o| model.excess_at(&grid, o, false), model.step);
+        shift[k / nd][k % nd] = delta;
+        amplitude[k / nd][k % nd] = a;
+    }
+    Ok(Lean {
+        distance: LocSetup::LEAN_DISTANCES.to_vec(),
+        depth: LocSetup::LEAN_DEPTHS.to_vec(),
+        shift,
+        amplitude,
+        centre: model.centre,
+    })
 }
 
 #[cfg(test)]

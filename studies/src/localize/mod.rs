@@ -457,69 +457,9 @@ impl LocModel {
         )?;
         let mut m = Self::from_parts(setup, s, baseline, Some(status), Some(baseline_status))?;
         if setup.lean {
-            m.lean = Some(m.load_or_measure_lean(setup, cache)?);
+            m.lean = Some(lean::load_or_measure(&m, setup, cache)?);
         }
         Ok(m)
-    }
-
-    /// The end lean ([`lean`]) of this centre model: FE scans past one
-    /// nodule at each of the setup's distances from the end and depths
-    /// (cached, in parallel, with a progress bar), each fitted to this
-    /// model's excess by a shift and an amplitude.
-    fn load_or_measure_lean(&self, setup: &LocSetup, cache: &Path) -> anyhow::Result<lean::Lean> {
-        let offsets = setup.lean_offsets();
-        let cases: Vec<(f64, f64)> = LocSetup::LEAN_DISTANCES
-            .iter()
-            .flat_map(|&e| LocSetup::LEAN_DEPTHS.iter().map(move |&d| (e, d)))
-            .collect();
-        let scan = R2NoduleScan::along_block(setup.template.clone(), false);
-        let (runs, _) = load_or_compute("r2-lean", &setup.lean_description(), cache, || {
-            use rayon::prelude::*;
-            let bar = crate::limits::Progress::new(
-                cases.len() as u64,
-                &format!("R2 end-lean FE scans, RD {}", setup.template.rd),
-                "{msg} [{bar:40}] {pos}/{len} FE scans ({elapsed}, eta {eta})",
-            );
-            let runs: Vec<Vec<f64>> = cases
-                .par_iter()
-                .map(|&(e, d)| {
-                    let r = scan.scan(&[d, e.ln()], &offsets);
-                    bar.inc(1);
-                    r.map_err(|err| {
-                        anyhow::anyhow!("the R2 lean scan at x = {e} mm, depth {d} mm: {err}")
-                    })
-                })
-                .collect::<anyhow::Result<_>>()?;
-            bar.finish();
-            Ok(runs)
-        })?;
-        let (lo, hi) = self.path;
-        let mut grid = vec![0.0; self.scan.loading().len()];
-        let nd = LocSetup::LEAN_DEPTHS.len();
-        let mut shift = vec![vec![0.0; nd]; LocSetup::LEAN_DISTANCES.len()];
-        let mut amplitude = shift.clone();
-        for (k, (&(e, d), forces)) in cases.iter().zip(&runs).enumerate() {
-            // the excess at the offsets on the rolled path
-            let (mut os, mut es) = (Vec::new(), Vec::new());
-            for (&o, &f) in offsets.iter().zip(forces) {
-                if e + o >= lo - 1e-9 && e + o <= hi + 1e-9 {
-                    os.push(o);
-                    es.push(f - self.baseline_at(e + o));
-                }
-            }
-            self.excess_grid(d, self.centre, &mut grid)?;
-            let (delta, a) =
-                lean::fit_shift(&os, &es, |o| self.excess_at(&grid, o, false), self.step);
-            shift[k / nd][k % nd] = delta;
-            amplitude[k / nd][k % nd] = a;
-        }
-        Ok(lean::Lean {
-            distance: LocSetup::LEAN_DISTANCES.to_vec(),
-            depth: LocSetup::LEAN_DEPTHS.to_vec(),
-            shift,
-            amplitude,
-            centre: self.centre,
-        })
     }
 
     /// What to add to a wheel offset `p - x` from a nodule at `x` and depth
