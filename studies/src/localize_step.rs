@@ -75,6 +75,27 @@ fn default_noise() -> f64 {
 /// R2-1's depths (BENCHMARKS.md).
 pub const R2_1_DEPTHS: [f64; 8] = [8.0, 10.0, 12.0, 15.0, 18.0, 20.0, 22.0, 24.0];
 
+/// Which localisation model a localize step builds per RD.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LocScan {
+    /// [`LocSetup::r2_lean`].
+    #[default]
+    Lean,
+    /// [`LocSetup::r2`].
+    Centre,
+}
+
+impl LocScan {
+    /// The setup of this model at `rd`.
+    pub fn setup(self, rd: f64) -> LocSetup {
+        match self {
+            LocScan::Lean => LocSetup::r2_lean(rd),
+            LocScan::Centre => LocSetup::r2(rd),
+        }
+    }
+}
+
 /// `[steps.localize]`.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -93,6 +114,12 @@ pub struct LocalizeStep {
     /// The posterior's sampler (`nuts`, default, or `ensemble`).
     #[serde(default)]
     pub sampler: LocSampler,
+    /// The localisation model: `lean` (default, the centre scans plus the
+    /// end lean's 16 FE scans, `LocSetup::r2_lean`) or `centre`
+    /// (`LocSetup::r2`: translation invariance assumed, shallow nodules
+    /// near the ends read towards them).
+    #[serde(default)]
+    pub scan: LocScan,
     /// Refused with the reason (the FE runs are units of the run folder);
     /// kept so that a manifest of an earlier palpate that set it is told
     /// why rather than "unknown field".
@@ -148,7 +175,8 @@ impl LocalizeStep {
             self.noise
         );
         for &rd in &self.rds {
-            LocSetup::r2(rd)
+            self.scan
+                .setup(rd)
                 .check()
                 .map_err(|(_, r)| anyhow::anyhow!("{at}.rds: {rd}: {r}"))?;
             let m = self
@@ -204,7 +232,7 @@ pub(crate) fn run_localize(
         .iter()
         .map(|&rd| -> anyhow::Result<RdPlan> {
             let model =
-                ModelUnits::r2(&LocSetup::r2(rd)).map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+                ModelUnits::r2(&step.scan.setup(rd)).map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
             let record = step
                 .record_model(rd)
                 .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
@@ -324,11 +352,15 @@ pub(crate) fn run_localize(
     let _ = writeln!(report, "## Localisation `{}`\n", step.name);
     let _ = writeln!(
         report,
-        "FE records of the nodules `{}` at h = {} mm every {} mm, Gaussian noise SD {} % of the peak force (seed {seed}); posterior on the localisation model (studies/src/localize).\n",
+        "FE records of the nodules `{}` at h = {} mm every {} mm, Gaussian noise SD {} % of the peak force (seed {seed}); posterior on the localisation model (studies/src/localize), {}.\n",
         step.nodules,
         step.record_h_mm,
         step.record_step_mm,
         100.0 * step.noise,
+        match step.scan {
+            LocScan::Lean => "its excess shifted by the end lean measured on FE scans near the end (`scan = \"lean\"`)",
+            LocScan::Centre => "translation invariance assumed (`scan = \"centre\"`)",
+        }
     );
     let _ = writeln!(
         report,

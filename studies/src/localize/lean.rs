@@ -165,17 +165,31 @@ pub fn fit_shift(
     (delta, misfit(delta).1)
 }
 
-/// The end lean of the centre model `model`: FE scans past one
-/// nodule at each of the setup's distances from the end and depths
-/// (cached, in parallel, with a progress bar), each fitted to this
-/// model's excess by a shift and an amplitude.
-pub fn load_or_measure(model: &LocModel, setup: &LocSetup, cache: &Path) -> anyhow::Result<Lean> {
-    let offsets = setup.lean_offsets();
-    let cases: Vec<(f64, f64)> = LocSetup::LEAN_DISTANCES
+/// The (distance from the nearer end, depth) of each lean FE scan, in
+/// the order of [`Lean::shift`]'s rows then columns.
+pub fn cases() -> Vec<(f64, f64)> {
+    LocSetup::LEAN_DISTANCES
         .iter()
         .flat_map(|&e| LocSetup::LEAN_DEPTHS.iter().map(move |&d| (e, d)))
-        .collect();
-    let scan = R2NoduleScan::along_block(setup.template.clone(), false);
+        .collect()
+}
+
+/// The lean FE scan of `case` (distance `e` from the left end, depth `d`):
+/// the force at the wheel offsets [`LocSetup::lean_offsets`] from the
+/// nodule (offsets off the rolled path clamped to it), or why it failed.
+pub fn scan(setup: &LocSetup, case: (f64, f64)) -> Result<Vec<f64>, String> {
+    let (e, d) = case;
+    R2NoduleScan::along_block(setup.template.clone(), false)
+        .scan(&[d, e.ln()], &setup.lean_offsets())
+        .map_err(|err| format!("the R2 lean scan at x = {e} mm, depth {d} mm: {err}"))
+}
+
+/// The end lean of the centre model `model`: FE scans past one nodule at
+/// each of the setup's distances from the end and depths (cached, in
+/// parallel, with a progress bar), each fitted to this model's excess by a
+/// shift and an amplitude ([`from_runs`]).
+pub fn load_or_measure(model: &LocModel, setup: &LocSetup, cache: &Path) -> anyhow::Result<Lean> {
+    let cases = cases();
     let (runs, _) = load_or_compute("r2-lean", &setup.lean_description(), cache, || {
         use rayon::prelude::*;
         let bar = crate::limits::Progress::new(
@@ -185,23 +199,44 @@ pub fn load_or_measure(model: &LocModel, setup: &LocSetup, cache: &Path) -> anyh
         );
         let runs: Vec<Vec<f64>> = cases
             .par_iter()
-            .map(|&(e, d)| {
-                let r = scan.scan(&[d, e.ln()], &offsets);
+            .map(|&c| {
+                let r = scan(setup, c);
                 bar.inc(1);
-                r.map_err(|err| {
-                    anyhow::anyhow!("the R2 lean scan at x = {e} mm, depth {d} mm: {err}")
-                })
+                r.map_err(|err| anyhow::anyhow!(err))
             })
             .collect::<anyhow::Result<_>>()?;
         bar.finish();
         Ok(runs)
     })?;
+    from_runs(model, setup, &runs)
+}
+
+/// The lean from the FE scans `runs` of [`cases`] (in that order, each at
+/// [`LocSetup::lean_offsets`]): each scan's excess over `model`'s
+/// nodule-free pass, on the rolled path, fitted by [`fit_shift`] to the
+/// centre model's excess at the same depth.
+pub fn from_runs(model: &LocModel, setup: &LocSetup, runs: &[Vec<f64>]) -> anyhow::Result<Lean> {
+    let cases = cases();
+    let offsets = setup.lean_offsets();
+    anyhow::ensure!(
+        runs.len() == cases.len(),
+        "{} lean scans for the {} of the model at RD {}",
+        runs.len(),
+        cases.len(),
+        setup.template.rd
+    );
     let (lo, hi) = model.path;
     let mut grid = vec![0.0; model.scan.loading().len()];
     let nd = LocSetup::LEAN_DEPTHS.len();
     let mut shift = vec![vec![0.0; nd]; LocSetup::LEAN_DISTANCES.len()];
     let mut amplitude = shift.clone();
-    for (k, (&(e, d), forces)) in cases.iter().zip(&runs).enumerate() {
+    for (k, (&(e, d), forces)) in cases.iter().zip(runs).enumerate() {
+        anyhow::ensure!(
+            forces.len() == offsets.len(),
+            "the lean scan at x = {e} mm, depth {d} mm has {} forces for {} offsets",
+            forces.len(),
+            offsets.len()
+        );
         // the excess at the offsets on the rolled path
         let (mut os, mut es) = (Vec::new(), Vec::new());
         for (&o, &f) in offsets.iter().zip(forces) {

@@ -322,7 +322,7 @@ impl LocSetup {
     }
 
     /// What defines the cached lean scans.
-    fn lean_description(&self) -> String {
+    pub(crate) fn lean_description(&self) -> String {
         format!(
             "{}; lean scans at distances {:?}, depths {:?}, offsets {:?}",
             self.at_centre().description(),

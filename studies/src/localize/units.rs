@@ -8,13 +8,15 @@
 //! model is assembled once all are there ([`ModelUnits::assemble`], the
 //! surrogate by [`Surrogate::from_runs`]): the model
 //! [`LocModel::load_or_build`] makes in one process, but for the build
-//! times (tested in `studies/tests/integration/localize_units.rs`).
+//! times (tested in `studies/tests/integration/localize_units.rs`). With
+//! the end lean ([`LocSetup::lean`], the study's default) its FE scans
+//! ([`lean::cases`]) are units too, after the design's scans.
 //!
 //! The scan model is a type parameter so that the enumeration and the
 //! assembly can be tested on a cheap stand-in for the FE scan; a study
 //! uses [`ModelUnits::r2`].
 
-use super::{Baseline, LocModel, LocSetup};
+use super::{lean, Baseline, LocModel, LocSetup};
 use crate::surrogate::code_version;
 use palpate_core::{ForwardModel, Loading};
 use palpate_fe::r2_scan::R2NoduleScan;
@@ -29,7 +31,13 @@ pub enum ModelRun {
     /// A scan of the design: the force at the offsets, or why the FE run
     /// failed (the surrogate leaves a failed run out, as `Surrogate::build`).
     Scan(Result<Vec<f64>, String>),
+    /// A lean scan ([`lean::scan`]): the force at the lean's offsets.
+    Lean(Vec<f64>),
 }
+
+/// The FE scan of one lean case (distance from the end, depth), or a
+/// stand-in for it in tests.
+pub type LeanScan = Box<dyn Fn((f64, f64)) -> Result<Vec<f64>, String> + Send + Sync>;
 
 /// The units of one RD's localisation model.
 pub struct ModelUnits<M> {
@@ -39,6 +47,8 @@ pub struct ModelUnits<M> {
     bounds: ParamBox,
     /// The scan depths, training then held-out.
     points: Vec<Vec<f64>>,
+    /// With the end lean: its scan of each of [`lean::cases`].
+    lean: Option<LeanScan>,
 }
 
 impl ModelUnits<R2NoduleScan> {
@@ -62,10 +72,33 @@ impl<M: ForwardModel> ModelUnits<M> {
             loading: setup.scan_loading(),
             bounds,
             points: Vec::new(),
+            lean: None,
         };
+        if setup.lean {
+            let s = setup.clone();
+            u.lean = Some(Box::new(move |c| lean::scan(&s, c)));
+        }
         u.points = Surrogate::design(&u.request())
             .map_err(|e| anyhow::anyhow!("the design of the R2 scan surrogate: {e}"))?;
         Ok(u)
+    }
+
+    /// The same units with `scan` for the lean's FE scans (a cheap
+    /// stand-in in tests); `setup.lean` must be set.
+    pub fn with_lean_scan(mut self, scan: LeanScan) -> Self {
+        if self.setup.lean {
+            self.lean = Some(scan);
+        }
+        self
+    }
+
+    /// The number of lean units (0 without the lean).
+    fn lean_units(&self) -> usize {
+        if self.lean.is_some() {
+            lean::cases().len()
+        } else {
+            0
+        }
     }
 
     /// The surrogate's request; its description is `palpate localize`'s
@@ -81,9 +114,9 @@ impl<M: ForwardModel> ModelUnits<M> {
         }
     }
 
-    /// Number of units: the baseline and the design's scans.
+    /// Number of units: the baseline, the design's scans and the lean's.
     pub fn len(&self) -> usize {
-        1 + self.points.len()
+        1 + self.points.len() + self.lean_units()
     }
 
     /// Never empty (the baseline is always a unit).
@@ -96,8 +129,16 @@ impl<M: ForwardModel> ModelUnits<M> {
     /// path, scan), and for a scan the model, the offsets and the depth.
     pub fn inputs(&self, k: usize) -> String {
         let setup = self.setup.description();
+        let scans = 1 + self.points.len();
         match k {
             0 => format!("R2 localisation baseline; {setup}"),
+            k if k >= scans => {
+                let (e, d) = lean::cases()[k - scans];
+                format!(
+                    "R2 localisation lean scan; {setup}; distance {e} mm; depth {d} mm; offsets {:?}",
+                    self.setup.lean_offsets()
+                )
+            }
             _ => format!(
                 "R2 localisation scan; {setup}; {}; offsets {:?}; depth {:?}",
                 self.scan.name(),
@@ -116,8 +157,12 @@ impl<M: ForwardModel> ModelUnits<M> {
             "unit {k} of a localisation model of {} units",
             self.len()
         );
-        Ok(match k {
-            0 => ModelRun::Baseline(self.setup.baseline_pass(None)?),
+        let scans = 1 + self.points.len();
+        Ok(match (k, &self.lean) {
+            (0, _) => ModelRun::Baseline(self.setup.baseline_pass(None)?),
+            (k, Some(scan)) if k >= scans => {
+                ModelRun::Lean(scan(lean::cases()[k - scans]).map_err(anyhow::Error::msg)?)
+            }
             _ => ModelRun::Scan(self.scan_run(k)),
         })
     }
@@ -178,17 +223,24 @@ impl<M: ForwardModel> ModelUnits<M> {
         let Some(ModelRun::Baseline(baseline)) = runs.next() else {
             anyhow::bail!("unit 0 of the localisation model at RD {rd} is not the baseline");
         };
-        let scans = runs
-            .enumerate()
-            .map(|(k, r)| match r {
-                ModelRun::Scan(s) => Ok(s),
-                ModelRun::Baseline(_) => Err(anyhow::anyhow!(
-                    "unit {} of the localisation model at RD {rd} is not a scan",
-                    k + 1
-                )),
-            })
-            .collect::<anyhow::Result<Vec<_>>>()?;
+        let (mut scans, mut leans) = (Vec::new(), Vec::new());
+        for (k, r) in runs.enumerate() {
+            let want_scan = k < self.points.len();
+            match r {
+                ModelRun::Scan(s) if want_scan => scans.push(s),
+                ModelRun::Lean(f) if !want_scan => leans.push(f),
+                _ => anyhow::bail!(
+                    "unit {} of the localisation model at RD {rd} is not a {}",
+                    k + 1,
+                    if want_scan { "scan" } else { "lean scan" }
+                ),
+            }
+        }
         let s = self.surrogate(&baseline, scans, None)?;
-        LocModel::from_parts(&self.setup, s, baseline, None, None)
+        let mut m = LocModel::from_parts(&self.setup, s, baseline, None, None)?;
+        if self.lean.is_some() {
+            m.lean = Some(lean::from_runs(&m, &self.setup, &leans)?);
+        }
+        Ok(m)
     }
 }

@@ -127,3 +127,93 @@ fn units_computed_apart_assemble_to_the_model_built_in_one_go() {
         "{e}"
     );
 }
+
+/// With the end lean (the study's default model), its 16 FE scans are
+/// units after the design's scans, each with its own inputs; computed
+/// apart and read back from JSON they assemble to the centre model plus
+/// the lean, whose shifts are the ones planted in the stand-in scans
+/// (each a shifted, scaled copy of the centre model's excess).
+#[test]
+fn lean_scans_are_units_and_assemble_to_the_planted_lean() {
+    use palpate_studies::localize::lean;
+    use std::sync::Arc;
+    let centre = LocSetup::r2(6.0);
+    let setup = LocSetup::r2_lean(6.0);
+    // the centre model, as the lean-less units assemble it
+    let plain = ModelUnits::new(&centre, scan()).unwrap();
+    let mut runs: Vec<ModelRun> = vec![ModelRun::Baseline(baseline(&centre))];
+    runs.extend((1..plain.len()).map(|k| plain.compute(k).unwrap()));
+    let model = Arc::new(plain.assemble(runs.clone()).unwrap());
+    // planted lean: shift 0.6 mm at 15 mm from the end falling to 0 at 50,
+    // larger for shallow nodules; amplitude 0.95
+    let planted = |e: f64, d: f64| 0.6 * (50.0 - e) / 35.0 * (30.0 - d) / 22.0;
+    let m = Arc::clone(&model);
+    let offsets = setup.lean_offsets();
+    let stand_in: palpate_studies::localize::units::LeanScan = Box::new(move |(e, d)| {
+        let mut grid = vec![0.0; m.scan.loading().len()];
+        m.excess_grid(d, m.centre, &mut grid)
+            .map_err(|e| e.to_string())?;
+        Ok(offsets
+            .iter()
+            .map(|&o| m.baseline_at(e + o) + 0.95 * m.excess_at(&grid, o + planted(e, d), false))
+            .collect())
+    });
+    let units = ModelUnits::new(&setup, scan())
+        .unwrap()
+        .with_lean_scan(stand_in);
+    let cases = lean::cases();
+    assert_eq!(units.len(), plain.len() + cases.len());
+    let inputs: Vec<String> = (0..units.len()).map(|k| units.inputs(k)).collect();
+    let mut distinct = inputs.clone();
+    distinct.sort();
+    distinct.dedup();
+    assert_eq!(distinct.len(), units.len(), "{inputs:#?}");
+    // the centre units keep their inputs (their cached runs are shared)
+    assert!((0..plain.len()).all(|k| plain.inputs(k) == inputs[k]));
+    assert!(
+        inputs[plain.len()].contains("lean scan") && inputs[plain.len()].contains("distance 15")
+    );
+
+    for k in (plain.len()..units.len()).rev() {
+        let r = through_json(units.compute(k).unwrap());
+        assert!(matches!(r, ModelRun::Lean(_)), "unit {k}: {r:?}");
+    }
+    let mut all = runs.clone();
+    all.extend((plain.len()..units.len()).map(|k| through_json(units.compute(k).unwrap())));
+    let parts = units.assemble(all.clone()).unwrap();
+    let l = parts.lean.as_ref().expect("the lean");
+    for (i, &e) in l.distance.iter().enumerate() {
+        for (j, &d) in l.depth.iter().enumerate() {
+            // the fit is exact but for the cubic interpolation of the grid
+            assert!(
+                (l.shift[i][j] - planted(e, d)).abs() < 0.03,
+                "e {e} d {d}: {} vs {}",
+                l.shift[i][j],
+                planted(e, d)
+            );
+            assert!(
+                (l.amplitude[i][j] - 0.95).abs() < 0.02,
+                "{}",
+                l.amplitude[i][j]
+            );
+        }
+    }
+    // the same centre model otherwise
+    let positions: Vec<f64> = (0..=60).map(|k| 20.0 + 2.0 * k as f64).collect();
+    let mid = [(75.0, 15.0)];
+    let (a, _) = parts.predict(&positions, &mid, 1.0).unwrap();
+    let (b, _) = model.predict(&positions, &mid, 1.0).unwrap();
+    assert!(a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-12));
+    // a centre scan where a lean scan belongs, or one lean scan short: refused
+    let mut wrong = all.clone();
+    let last = wrong.len() - 1;
+    wrong[last] = ModelRun::Scan(Ok(vec![0.0]));
+    let refusal = |runs: Vec<ModelRun>| match units.assemble(runs) {
+        Ok(_) => panic!("accepted"),
+        Err(e) => format!("{e:#}"),
+    };
+    let e = refusal(wrong);
+    assert!(e.contains("not a lean scan"), "{e}");
+    let e = refusal(all[..all.len() - 1].to_vec());
+    assert!(e.contains("units of the localisation model at RD 6"), "{e}");
+}

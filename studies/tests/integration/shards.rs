@@ -504,8 +504,10 @@ fn chains_and_surrogate_runs_are_shard_units_and_merge_to_the_single_run() {
 
 /// The cheapest localize step the manifest allows: one RD (3 mm), one
 /// nodule (75:15), the record on a 3 mm mesh every 10 mm (14 positions).
-/// The localisation model is fixed by R2 (`LocSetup::r2`: 6 + 2 FE scans
-/// of 16 offsets at h = 2 mm, and the nodule-free pass of 34 positions).
+/// The localisation model is fixed by R2; `scan = "centre"` (`LocSetup::r2`:
+/// 6 + 2 FE scans of 16 offsets at h = 2 mm, and the nodule-free pass of 34
+/// positions) leaves out the default lean's 16 FE scans, whose units are
+/// tested on a stand-in by localize_units.rs.
 /// Units: 10 FE runs (the pass, 8 scans, the record), then 1 posterior.
 fn localize_manifest(dir: &Path) -> PathBuf {
     let text = r#"
@@ -521,6 +523,7 @@ nodules = "75:15"
 record_h_mm = 3.0
 record_step_mm = 10.0
 noise = 0.01
+scan = "centre"
 "#;
     let path = dir.join("localized.toml");
     std::fs::write(&path, text).unwrap();
