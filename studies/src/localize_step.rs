@@ -366,6 +366,7 @@ pub(crate) fn run_localize(
         report,
         "| RD mm | nodule (true x:depth) | x mm mean [94 % HDI] | depth mm mean [94 % HDI] | identifiable | R-hat max | posterior evaluations |\n|---|---|---|---|---|---|---|"
     );
+    let mut leans = String::new();
     let mut table3 = String::from(
         "\nPeak force of one nodule against depth (R2-1, the scan surrogate at offset 0), and depth = a F^2 + b F + c:\n\n| RD mm |",
     );
@@ -429,9 +430,30 @@ pub(crate) fn run_localize(
             "localisation": post.result,
             "peak_force_vs_depth": { "depth_mm": R2_1_DEPTHS, "force_N": f, "quadratic_abc": q },
             "surrogate_max_rel_error": model.max_rel_error(),
+            "end_lean": model.lean,
         }));
+        if let Some(l) = &model.lean {
+            let _ = write!(
+                leans,
+                "\nEnd lean at RD {rd} (mm, + towards the nearer end; rows: the nodule's distance from the end, columns: depth), from FE scans near the end:\n\n| distance mm |"
+            );
+            for d in &l.depth {
+                let _ = write!(leans, " {d} mm |");
+            }
+            leans.push_str("\n|---|");
+            leans.push_str(&"---|".repeat(l.depth.len()));
+            leans.push('\n');
+            for (e, row) in l.distance.iter().zip(&l.shift) {
+                let _ = write!(leans, "| {e} |");
+                for v in row {
+                    let _ = write!(leans, " {v:+.3} |");
+                }
+                leans.push('\n');
+            }
+        }
     }
     report.push_str(&table3);
+    report.push_str(&leans);
     report.push('\n');
     Ok(StepResult::Localize {
         name: step.name.clone(),
