@@ -12,7 +12,25 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 
 fn palpate() -> Command {
-    Command::new(env!("CARGO_BIN_EXE_palpate"))
+    #[allow(unused_mut)]
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_palpate"));
+    // A test run started in the background of a non-interactive shell
+    // (`.ci/run &`, nohup) inherits SIGINT ignored, and so would the run:
+    // its SIGINT kills would then never land (the failures of this test in
+    // sessions 10 and 13, "the run had ended" after every SIGINT). Ctrl-C
+    // is what the test means, so the run gets SIGINT's default action.
+    #[cfg(unix)]
+    {
+        use std::os::unix::process::CommandExt;
+        // SAFETY: signal(2) is async-signal-safe, as pre_exec requires.
+        unsafe {
+            cmd.pre_exec(|| {
+                libc::signal(libc::SIGINT, libc::SIG_DFL);
+                Ok(())
+            });
+        }
+    }
+    cmd
 }
 
 /// A cheap study: `models` x 2 groups x `residuals` fits on Treloar's data
