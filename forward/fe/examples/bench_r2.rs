@@ -11,11 +11,11 @@
 //!
 //! `cargo run --release -p palpate-fe --example bench_r2 -- [--segments 2]
 //!  [--step 0.5] [--rd 6] [--x 37.5,56.25,75,112.5|none]
-//!  [--from X0] [--to X1] [--no-press] [--predictor secant|0|1]`
+//!  [--from X0] [--to X1] [--no-press] [--predictor secant|0|1] [--h MM]`
 //! (`--from`/`--to`: a shorter pass, for profiling; `--no-press`: print the
 //! pass forces at `--x` without the h = 1 presses; `--predictor`: the
 //! stepper's secant instead of the default wheel-following prediction,
-//! `R2Rolling::predictor`)
+//! `R2Rolling::predictor`; `--h`: another element size than level 1's 2 mm)
 
 use std::time::Instant;
 
@@ -86,6 +86,7 @@ fn main() {
                 }
             }
             "--friction" => model.friction = value().parse().expect("a coefficient"),
+            "--h" => model.element_size = Some(value().parse().expect("mm")),
             "--tangent-penalty" => model.tangent_penalty = value().parse().expect("a fraction"),
             "--no-press" => presses = false,
             "--from" => from = Some(value().parse().expect("mm")),
@@ -152,7 +153,8 @@ fn main() {
             .collect::<Vec<_>>()
             .join(" ")
     );
-    println!("\n| x mm | pass h=2 N | press h=1 N | error h=2 | Fx pass N | CPU s (h=1 press) |\n|---|---|---|---|---|---|");
+    let h = model.h();
+    println!("\n| x mm | pass h={h} N | press h=1 N | error h={h} | Fx pass N | CPU s (h=1 press) |\n|---|---|---|---|---|---|");
     let mut fine = model.clone();
     fine.element_size = Some(1.0);
     for &x in &xs {
