@@ -1084,8 +1084,8 @@ fn r2_geometry_is_checked_before_the_fe_run() {
     refused(&r2(&["--rd", "9"]), &["rd", "deeper"]);
 }
 
-/// `[steps.localize]`: a bad RD or nodule list, or the surrogate cache of
-/// an earlier palpate, is refused by `run --check`, naming the manifest
+/// `[steps.localize]`: a bad RD, nodule list or scan, or the surrogate
+/// cache of an earlier palpate, is refused by `run --check`, naming the manifest
 /// field.
 #[test]
 fn localize_step_fields_are_checked() {
@@ -1106,6 +1106,10 @@ fn localize_step_fields_are_checked() {
         ),
         ("rds = [3]\nnodules = \"75:29\"", vec!["nodules", "depth"]),
         ("rds = [3]\nnoise = -1", vec!["noise = -1"]),
+        (
+            "rds = [3]\nscan = \"middle\"",
+            vec!["line 8", "middle", "expected `lean` or `centre`"],
+        ),
         (
             "rds = [3]\ncache = \"c\"",
             vec![
