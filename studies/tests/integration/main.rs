@@ -7,6 +7,8 @@
 //! running process, and tests beside it in the same binary load the machine.
 
 mod bad_input;
+mod bad_input_benchmarks;
+mod bad_input_manifests;
 mod bad_input_messages;
 mod cli;
 mod common;
