@@ -616,3 +616,7 @@ impl System {
 #[cfg(test)]
 #[path = "system_tests.rs"]
 mod tests;
+
+#[cfg(test)]
+#[path = "system_q1_tests.rs"]
+mod q1_tests;
