@@ -73,9 +73,12 @@ pub struct BuildArgs {
     /// The material's Prony series g1=..,tau1=..,...
     #[arg(long)]
     pub prony: String,
-    /// The deepest depth it answers for (mm); Q1 stalls near 2 mm (punch-edge crease).
+    /// The deepest depth it answers for (mm); Q1's FE stalls near 2 mm with the default edge (see --edge-radius).
     #[arg(long, value_name = "MM")]
     pub depth_max: f64,
+    /// Q1: radius of the punch's rounded edge in mm [default: 0.2], as `palpate simulate --edge-radius`: a larger edge reaches deeper (1 mm: about 4.4 mm elastic) but is a rounded punch.
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub edge_radius: Option<f64>,
     /// Mesh level of the FE runs (default 1).
     #[arg(long, default_value_t = 1)]
     pub mesh: usize,
@@ -145,30 +148,45 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     if a.friction.is_some() && !a.benchmark.eq_ignore_ascii_case("N1") {
         bail!("--friction applies to --benchmark N1 only (Q1's punch is frictionless)");
     }
-    let (elastic, visco): (Box<dyn ForwardModel>, Box<dyn ForwardModel>) =
-        match a.benchmark.to_ascii_uppercase().as_str() {
-            "Q1" => {
-                let mut e = Q1Punch::new(law);
-                e.level = a.mesh;
-                let mut v = e.clone();
-                v.prony = Some(prony.clone());
-                (Box::new(e), Box::new(v))
-            }
-            "N1" => {
-                let mut e = N1Needle::new(law);
-                e.mesh.level = a.mesh;
-                if let Some(mu) = a.friction {
-                    if !(mu >= 0.0 && mu.is_finite()) {
-                        bail!("--friction {mu}: give a coefficient >= 0");
-                    }
-                    e.friction = mu;
+    if a.edge_radius.is_some() && !a.benchmark.eq_ignore_ascii_case("Q1") {
+        bail!("--edge-radius applies to --benchmark Q1 only (the flat punch's edge)");
+    }
+    let (elastic, visco): (Box<dyn ForwardModel>, Box<dyn ForwardModel>) = match a
+        .benchmark
+        .to_ascii_uppercase()
+        .as_str()
+    {
+        "Q1" => {
+            let mut e = Q1Punch::new(law);
+            e.level = a.mesh;
+            if let Some(rho) = a.edge_radius {
+                if !(rho > 0.0 && rho < e.punch_radius) {
+                    bail!(
+                            "--edge-radius {rho}: expected an edge radius in mm, > 0 and below the punch radius {}",
+                            e.punch_radius
+                        );
                 }
-                let mut v = e.clone();
-                v.prony = Some(prony.clone());
-                (Box::new(e), Box::new(v))
+                e.edge_radius = rho;
             }
-            b => bail!("--benchmark {b}: the real-time surrogate is built for Q1 or N1"),
-        };
+            let mut v = e.clone();
+            v.prony = Some(prony.clone());
+            (Box::new(e), Box::new(v))
+        }
+        "N1" => {
+            let mut e = N1Needle::new(law);
+            e.mesh.level = a.mesh;
+            if let Some(mu) = a.friction {
+                if !(mu >= 0.0 && mu.is_finite()) {
+                    bail!("--friction {mu}: give a coefficient >= 0");
+                }
+                e.friction = mu;
+            }
+            let mut v = e.clone();
+            v.prony = Some(prony.clone());
+            (Box::new(e), Box::new(v))
+        }
+        b => bail!("--benchmark {b}: the real-time surrogate is built for Q1 or N1"),
+    };
     let extra = |m: &dyn ForwardModel| -> Vec<f64> {
         let mut t = theta.clone();
         t.extend(m.space().params[theta.len()..].iter().map(|p| p.initial));

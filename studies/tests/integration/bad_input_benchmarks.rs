@@ -11,6 +11,66 @@ use common::*;
 // ---------- Q1 two-stage identification and the real-time surrogate (issue 13) ----------
 
 #[test]
+fn q1_edge_radius_is_checked() {
+    let s = Scratch::new();
+    let run = |benchmark: &str, edge: &str| {
+        s.run(&[
+            "simulate",
+            "--benchmark",
+            benchmark,
+            "--law",
+            "neo-hookean",
+            "--param",
+            "C10=0.001",
+            "--edge-radius",
+            edge,
+            "--csv",
+            &s.path("q1.csv").display().to_string(),
+        ])
+    };
+    for bad in ["0", "-0.2", "2", "7.5", "NaN"] {
+        refused(
+            &run("Q1", bad),
+            &["--edge-radius", "below the punch radius 2"],
+        );
+    }
+    refused(&run("N1", "0.5"), &["--edge-radius", "benchmark Q1"]);
+    refused(&run("Q1", "wide"), &["--edge-radius"]);
+    assert!(!s.path("q1.csv").exists());
+    // the real-time surrogate's build takes the same option
+    let build = |benchmark: &str, edge: &str| {
+        s.run(&[
+            "surrogate",
+            "build",
+            "--benchmark",
+            benchmark,
+            "--law",
+            "neo-hookean",
+            "--param",
+            "C10=0.0016",
+            "--prony",
+            "g1=0.3,tau1=1",
+            "--depth-max",
+            "1",
+            "--edge-radius",
+            edge,
+            "--out",
+            &s.path("rt.json").display().to_string(),
+        ])
+    };
+    refused(
+        &build("Q1", "0"),
+        &["--edge-radius 0", "below the punch radius 2"],
+    );
+    refused(
+        &build("Q1", "2.5"),
+        &["--edge-radius 2.5", "below the punch radius 2"],
+    );
+    refused(&build("N1", "0.5"), &["--edge-radius", "Q1 only"]);
+    assert!(!s.path("rt.json").exists());
+}
+
+#[test]
 fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
     let s = Scratch::new();
     let build = |prony: &str, depth: &str| {

@@ -341,6 +341,64 @@ fn simulate_c1_viscoelastic_ramp_and_hold() {
     }
 }
 
+/// `simulate --benchmark Q1 --edge-radius`: the punch's edge rounding is
+/// the user's to choose; a 1 mm edge is a rounded punch whose force at
+/// 0.1 mm is well below the flat punch's (docs/validation/fe.md "Q1":
+/// 0.571 of Sneddon's 8 G a d on 0.1 mm elements), and the CSV names it.
+#[test]
+fn simulate_q1_edge_radius_rounds_the_punch() {
+    let dir = tempfile::tempdir().unwrap();
+    let force = |edge: Option<&str>| {
+        let csv = dir
+            .path()
+            .join(format!("q1-{}.csv", edge.unwrap_or("default")));
+        let mut args = vec![
+            "simulate",
+            "--benchmark",
+            "Q1",
+            "--law",
+            "neo-hookean",
+            "--param",
+            "C10=0.001",
+            "--mesh",
+            "coarse",
+            "--depth",
+            "0.1",
+            "--hold",
+            "1",
+            "--error-estimate",
+            "off",
+            "--csv",
+            csv.to_str().unwrap(),
+        ];
+        if let Some(e) = edge {
+            args.extend(["--edge-radius", e]);
+        }
+        let o = palpate(&args);
+        assert!(o.status.success(), "{}", stderr(&o));
+        let text = std::fs::read_to_string(&csv).unwrap();
+        let t = palpate_core::Table::read(&csv).unwrap();
+        let f = t.column("force_N").unwrap();
+        (f[100], text)
+    };
+    // Sneddon's incompressible flat punch: 8 G a d, G = 2 C10
+    let sneddon = 8.0 * 2e-3 * 2.0 * 0.1;
+    let (flat, text) = force(None);
+    assert!(text.contains("edge 0.2 mm"), "{text}");
+    assert!(
+        (0.93..0.96).contains(&(flat / sneddon)),
+        "{}",
+        flat / sneddon
+    );
+    let (rounded, text) = force(Some("1"));
+    assert!(text.contains("edge 1 mm"), "{text}");
+    assert!(
+        (0.55..0.62).contains(&(rounded / sneddon)),
+        "{}",
+        rounded / sneddon
+    );
+}
+
 /// `simulate --benchmark Q1`: always timed (ramp then hold), `time_s`,
 /// 100 ramp samples and 200 hold samples, relaxing with a Prony series;
 /// bad timing and geometry-free options are clear errors.
