@@ -66,6 +66,8 @@ pub struct TwoStageOptions {
     pub h_fine: f64,
     /// Time step of the viscoelastic runs (s), fixed for every parameter.
     pub max_time_step: f64,
+    /// Radius of the punch's rounded edge (mm; `Q1Punch::edge_radius`).
+    pub edge_radius: f64,
     /// Stages in order (`elastic`, `relaxation`); the polish follows.
     pub stages: Vec<String>,
     /// Also fit every parameter at once from the default start.
@@ -93,6 +95,7 @@ impl TwoStageOptions {
             terms: 2,
             h_fine: 0.3,
             max_time_step: 1.0,
+            edge_radius: crate::models::Q1_DEFAULT_EDGE_RADIUS,
             stages: STAGES.iter().map(|s| s.to_string()).collect(),
             one_stage: true,
             profile: true,
@@ -138,9 +141,23 @@ impl TwoStageOptions {
         Ok(stages)
     }
 
+    /// `rho` if it is a valid edge radius of the Q1 punch (> 0 and below
+    /// the punch radius), else why not.
+    pub fn check_edge_radius(rho: f64) -> Result<f64, String> {
+        let a = Q1Punch::new(Law::NeoHookean).punch_radius;
+        if rho > 0.0 && rho < a {
+            Ok(rho)
+        } else {
+            Err(format!(
+                "expected an edge radius in mm, > 0 and below the punch radius {a}"
+            ))
+        }
+    }
+
     /// The elastic FE model of the fits.
     pub fn elastic_model(&self) -> Q1Punch {
         let mut m = Q1Punch::new(self.law);
+        m.edge_radius = self.edge_radius;
         m.grading = Some(Grading {
             h_fine: self.h_fine,
             fine_length: 3.0,
@@ -767,6 +784,9 @@ pub struct TwoStageStep {
     /// Time step of the viscoelastic runs (s, default 1).
     #[serde(default)]
     pub time_step: Option<f64>,
+    /// Radius of the punch's rounded edge (mm, default 0.2).
+    #[serde(default)]
+    pub edge_radius: Option<f64>,
     /// The one-stage comparison (default true).
     #[serde(default)]
     pub compare: Option<bool>,
@@ -807,6 +827,10 @@ impl TwoStageStep {
                 "time_step = {dt}: must be > 0 s"
             );
             o.max_time_step = dt;
+        }
+        if let Some(rho) = self.edge_radius {
+            o.edge_radius = TwoStageOptions::check_edge_radius(rho)
+                .map_err(|e| anyhow::anyhow!("edge_radius = {rho}: {e}"))?;
         }
         o.one_stage = self.compare.unwrap_or(true);
         o.profile = self.profile.unwrap_or(true);
@@ -885,4 +909,24 @@ pub(crate) fn run_two_stage(
         name: step.name.clone(),
         result: unit.result,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_edge_radius_reaches_both_fit_models() {
+        let mut o = TwoStageOptions::new(Law::NeoHookean);
+        assert_eq!(
+            o.elastic_model().edge_radius,
+            crate::models::Q1_DEFAULT_EDGE_RADIUS
+        );
+        o.edge_radius = TwoStageOptions::check_edge_radius(1.0).unwrap();
+        assert_eq!(o.elastic_model().edge_radius, 1.0);
+        assert_eq!(o.viscoelastic_model().edge_radius, 1.0);
+        for bad in [0.0, -1.0, 2.0, f64::NAN] {
+            assert!(TwoStageOptions::check_edge_radius(bad).is_err(), "{bad}");
+        }
+    }
 }

@@ -92,6 +92,9 @@ pub struct Args {
     /// --benchmark Q1: time step of the viscoelastic FE runs, s (default 1).
     #[arg(long, value_name = "S")]
     pub time_step: Option<f64>,
+    /// --benchmark Q1: radius of the punch's rounded edge, mm (default 0.2; as palpate simulate --edge-radius).
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub edge_radius: Option<f64>,
     /// --benchmark Q1: also fit every parameter at once from the default start (comparison).
     #[arg(long)]
     pub compare: bool,
@@ -242,6 +245,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         (args.prony_terms.is_some(), "--prony-terms"),
         (args.fit_mesh.is_some(), "--fit-mesh"),
         (args.time_step.is_some(), "--time-step"),
+        (args.edge_radius.is_some(), "--edge-radius"),
         (args.compare, "--compare"),
         (args.profile, "--profile"),
     ] {
@@ -334,6 +338,10 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
             "--time-step {dt}: must be a positive number of seconds"
         );
         o.max_time_step = dt;
+    }
+    if let Some(rho) = args.edge_radius {
+        o.edge_radius = TwoStageOptions::check_edge_radius(rho)
+            .map_err(|e| anyhow::anyhow!("--edge-radius {rho}: {e}"))?;
     }
     o.one_stage = args.compare;
     o.profile = args.profile;

@@ -76,6 +76,9 @@ pub struct Args {
     /// Q1: the Prony series g1=..,tau1=.. held fixed (the law's parameters are sampled).
     #[arg(long, value_name = "g1=..,tau1=..")]
     pub prony: Option<String>,
+    /// Q1: radius of the punch's rounded edge, mm [default: 0.2; as palpate simulate --edge-radius].
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub edge_radius: Option<f64>,
     /// N1, N3, Q1: FE runs of the surrogate's training design [default: max(30, 15 x parameters)].
     #[arg(long, value_name = "N")]
     pub design: Option<usize>,
@@ -744,6 +747,7 @@ mod tests {
             bulk: None,
             friction: None,
             prony: None,
+            edge_radius: None,
             design: None,
             holdout: None,
             cache: None,
@@ -798,6 +802,7 @@ mod tests {
             bulk: None,
             friction: None,
             prony: None,
+            edge_radius: None,
             design: None,
             holdout: None,
             cache: None,

@@ -33,7 +33,7 @@ pub fn fe_benchmark(benchmark: Option<&str>) -> Option<&'static str> {
 /// benchmark, naming it.
 pub fn check_options(args: &Args) -> anyhow::Result<()> {
     let kind = fe_benchmark(args.benchmark.as_deref());
-    let given: [(bool, &str, &[&str]); 8] = [
+    let given: [(bool, &str, &[&str]); 9] = [
         (!args.boxes.is_empty(), "--box", &FE_BENCHMARKS),
         (args.mesh.is_some(), "--mesh", &FE_BENCHMARKS),
         (args.design.is_some(), "--design", &FE_BENCHMARKS),
@@ -42,6 +42,7 @@ pub fn check_options(args: &Args) -> anyhow::Result<()> {
         (args.bulk.is_some(), "--bulk", &FE_BENCHMARKS),
         (args.friction.is_some(), "--friction", &["N1", "N3"]),
         (args.prony.is_some(), "--prony", &["Q1"]),
+        (args.edge_radius.is_some(), "--edge-radius", &["Q1"]),
     ];
     for (on, name, users) in given {
         if on && !kind.is_some_and(|k| users.contains(&k)) {
@@ -82,6 +83,7 @@ pub fn model_spec(kind: &str, args: &Args) -> ModelSpec {
             mesh,
             bulk: args.bulk.clone(),
             prony: args.prony.clone(),
+            edge_radius: args.edge_radius,
             ..Default::default()
         }),
     }

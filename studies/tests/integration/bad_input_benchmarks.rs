@@ -68,6 +68,53 @@ fn q1_edge_radius_is_checked() {
     );
     refused(&build("N1", "0.5"), &["--edge-radius", "Q1 only"]);
     assert!(!s.path("rt.json").exists());
+    // the staged identification and the posterior take it too
+    let rec = two_stage_record();
+    let calibrate = |benchmark: &str, edge: &str| {
+        s.run(&[
+            "calibrate",
+            "--benchmark",
+            benchmark,
+            "--law",
+            "neo-hookean",
+            "--data",
+            &rec,
+            "--edge-radius",
+            edge,
+        ])
+    };
+    refused(
+        &calibrate("Q1", "0"),
+        &["--edge-radius 0", "below the punch radius 2"],
+    );
+    refused(
+        &calibrate("C1", "0.5"),
+        &["--edge-radius", "--benchmark Q1"],
+    );
+    let o = s.run(&[
+        "sample",
+        "--benchmark",
+        "N1",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &rec,
+        "--edge-radius",
+        "0.5",
+    ]);
+    refused(&o, &["--edge-radius", "--benchmark Q1"]);
+    // the study step of the staged identification
+    let m = s.file(
+        "q1.toml",
+        &format!(
+            "[study]\nname = \"q1\"\n\n[[steps]]\n[steps.two_stage]\nname = \"fit\"\nrecord = \"{}\"\nlaw = \"neo-hookean\"\nedge_radius = 2.5\n",
+            rec.replace('\\', "/")
+        ),
+    );
+    refused(
+        &s.run(&["run", "--check", &m]),
+        &["edge_radius = 2.5", "below the punch radius 2"],
+    );
 }
 
 #[test]
