@@ -110,12 +110,13 @@ fn main() {
         mesh.nodes.len()
     );
     println!(
-        "R2 full pass: x {}..{} mm every {step} mm ({} positions), RD {rd}, nodules 37.5:10,75:15,112.5:20, level {} (h = {} mm), {segments} segments, {cores} cores",
+        "R2 full pass: x {}..{} mm every {step} mm ({} positions), RD {rd}, nodules 37.5:10,75:15,112.5:20, level {} (h = {} mm), {segments} segments, {cores} cores ({})",
         model.press_x,
         model.roll_to,
         positions.len(),
         model.level,
-        model.h()
+        model.h(),
+        cpu_model()
     );
     let (c0, t0) = (cpu_seconds(false), Instant::now());
     let (pass, last) = model
@@ -194,4 +195,19 @@ fn main() {
             cpu_seconds(false) - c
         );
     }
+}
+
+/// The processor's name (Linux: `model name` of /proc/cpuinfo), for the
+/// record: the same pass takes 2.4 x longer on some 2-core VMs than on
+/// others (docs/validation/fe.md R2, "Speed, session 14").
+fn cpu_model() -> String {
+    std::fs::read_to_string("/proc/cpuinfo")
+        .ok()
+        .and_then(|t| {
+            t.lines()
+                .find(|l| l.starts_with("model name"))
+                .and_then(|l| l.split_once(':'))
+                .map(|(_, v)| v.trim().to_string())
+        })
+        .unwrap_or_else(|| "processor unknown".into())
 }
