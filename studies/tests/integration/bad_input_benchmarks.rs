@@ -10,6 +10,37 @@ use common::*;
 
 // ---------- Q1 two-stage identification and the real-time surrogate (issue 13) ----------
 
+/// `palpate surrogate build --benchmark BENCHMARK` of a neo-Hookean
+/// material into `rt.json` of `s`, with `--prony PRONY --depth-max DEPTH`
+/// and the `extra` options.
+fn surrogate_build(
+    s: &Scratch,
+    benchmark: &str,
+    prony: &str,
+    depth: &str,
+    extra: &[&str],
+) -> std::process::Output {
+    let out = s.path("rt.json").display().to_string();
+    let mut args = vec![
+        "surrogate",
+        "build",
+        "--benchmark",
+        benchmark,
+        "--law",
+        "neo-hookean",
+        "--param",
+        "C10=0.0016",
+        "--prony",
+        prony,
+        "--depth-max",
+        depth,
+        "--out",
+        &out,
+    ];
+    args.extend_from_slice(extra);
+    s.run(&args)
+}
+
 #[test]
 fn q1_edge_radius_is_checked() {
     let s = Scratch::new();
@@ -39,24 +70,13 @@ fn q1_edge_radius_is_checked() {
     assert!(!s.path("q1.csv").exists());
     // the real-time surrogate's build takes the same option
     let build = |benchmark: &str, edge: &str| {
-        s.run(&[
-            "surrogate",
-            "build",
-            "--benchmark",
+        surrogate_build(
+            &s,
             benchmark,
-            "--law",
-            "neo-hookean",
-            "--param",
-            "C10=0.0016",
-            "--prony",
             "g1=0.3,tau1=1",
-            "--depth-max",
             "1",
-            "--edge-radius",
-            edge,
-            "--out",
-            &s.path("rt.json").display().to_string(),
-        ])
+            &["--edge-radius", edge],
+        )
     };
     refused(
         &build("Q1", "0"),
@@ -120,24 +140,7 @@ fn q1_edge_radius_is_checked() {
 #[test]
 fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
     let s = Scratch::new();
-    let build = |prony: &str, depth: &str| {
-        s.run(&[
-            "surrogate",
-            "build",
-            "--benchmark",
-            "Q1",
-            "--law",
-            "neo-hookean",
-            "--param",
-            "C10=0.0016",
-            "--prony",
-            prony,
-            "--depth-max",
-            depth,
-            "--out",
-            &s.path("rt.json").display().to_string(),
-        ])
-    };
+    let build = |prony: &str, depth: &str| surrogate_build(&s, "Q1", prony, depth, &[]);
     // Prony weights summing to 1 or more, a zero or negative time constant
     refused(
         &build("g1=0.6,tau1=1,g2=0.4,tau2=10", "1"),
@@ -149,24 +152,7 @@ fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
     // friction is the needle's: refused for the frictionless punch, and a
     // negative coefficient for N1
     let with_friction = |benchmark: &str, mu: &str| {
-        s.run(&[
-            "surrogate",
-            "build",
-            "--benchmark",
-            benchmark,
-            "--friction",
-            mu,
-            "--law",
-            "neo-hookean",
-            "--param",
-            "C10=0.0016",
-            "--prony",
-            "g1=0.3,tau1=1",
-            "--depth-max",
-            "1",
-            "--out",
-            &s.path("rt.json").display().to_string(),
-        ])
+        surrogate_build(&s, benchmark, "g1=0.3,tau1=1", "1", &["--friction", mu])
     };
     refused(&with_friction("Q1", "0"), &["--friction", "N1 only"]);
     refused(&with_friction("N1", "-0.2"), &["--friction -0.2", ">= 0"]);

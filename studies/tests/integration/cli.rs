@@ -341,6 +341,17 @@ fn simulate_c1_viscoelastic_ramp_and_hold() {
     }
 }
 
+/// `palpate simulate` of Q1 with a neo-Hookean material (C10 = 0.001 MPa).
+const Q1_NH: [&str; 7] = [
+    "simulate",
+    "--benchmark",
+    "Q1",
+    "--law",
+    "neo-hookean",
+    "--param",
+    "C10=0.001",
+];
+
 /// `simulate --benchmark Q1 --edge-radius`: the punch's edge rounding is
 /// the user's to choose; a 1 mm edge is a rounded punch whose force at
 /// 0.1 mm is well below the flat punch's (docs/validation/fe.md "Q1":
@@ -352,14 +363,8 @@ fn simulate_q1_edge_radius_rounds_the_punch() {
         let csv = dir
             .path()
             .join(format!("q1-{}.csv", edge.unwrap_or("default")));
-        let mut args = vec![
-            "simulate",
-            "--benchmark",
-            "Q1",
-            "--law",
-            "neo-hookean",
-            "--param",
-            "C10=0.001",
+        let mut args = Q1_NH.to_vec();
+        args.extend([
             "--mesh",
             "coarse",
             "--depth",
@@ -370,7 +375,7 @@ fn simulate_q1_edge_radius_rounds_the_punch() {
             "off",
             "--csv",
             csv.to_str().unwrap(),
-        ];
+        ]);
         if let Some(e) = edge {
             args.extend(["--edge-radius", e]);
         }
@@ -406,14 +411,8 @@ fn simulate_q1_edge_radius_rounds_the_punch() {
 fn simulate_q1_ramp_and_hold() {
     let dir = tempfile::tempdir().unwrap();
     let csv = dir.path().join("q1.csv");
-    let o = palpate(&[
-        "simulate",
-        "--benchmark",
-        "Q1",
-        "--law",
-        "neo-hookean",
-        "--param",
-        "C10=0.001",
+    let mut args = Q1_NH.to_vec();
+    args.extend([
         "--mesh",
         "coarse",
         "--depth",
@@ -429,6 +428,7 @@ fn simulate_q1_ramp_and_hold() {
         "--csv",
         csv.to_str().unwrap(),
     ]);
+    let o = palpate(&args);
     assert!(o.status.success(), "{}", stderr(&o));
     let text = std::fs::read_to_string(&csv).unwrap();
     assert!(
@@ -448,15 +448,6 @@ fn simulate_q1_ramp_and_hold() {
         f[300]
     );
 
-    let base = [
-        "simulate",
-        "--benchmark",
-        "Q1",
-        "--law",
-        "neo-hookean",
-        "--param",
-        "C10=0.001",
-    ];
     for (extra, says) in [
         (&["--hold=-1"][..], &["--hold", "zero or more"][..]),
         (&["--hold", "0.001"], &["--hold", "shorter than one step"]),
@@ -464,7 +455,7 @@ fn simulate_q1_ramp_and_hold() {
         (&["--prony", "g1=0.3,tau1=-1"], &["tau1", "positive"]),
         (&["--element", "quad8"], &["--element", "quad4 or quad9"]),
     ] {
-        let mut args = base.to_vec();
+        let mut args = Q1_NH.to_vec();
         args.extend(extra);
         assert_clean_failure(&palpate(&args), says);
     }
