@@ -276,15 +276,10 @@ pub struct Q1Spec {
     #[serde(default)]
     pub prony: Option<String>,
     /// Radius of the punch's rounded edge (mm), 0 < edge_radius < 2 (the
-    /// punch radius); default 0.2 ([`Q1_DEFAULT_EDGE_RADIUS`]).
+    /// punch radius); default 0.2 (`palpate_fe::q1::DEFAULT_EDGE_RADIUS`).
     #[serde(default)]
     pub edge_radius: Option<f64>,
 }
-
-/// The Q1 punch's default edge radius (mm): the flat punch BENCHMARKS.md
-/// names, rounded just enough for contact to follow it
-/// (docs/validation/fe.md "Q1": F / 8Gad 0.943 at 0.1 mm).
-pub const Q1_DEFAULT_EDGE_RADIUS: f64 = 0.2;
 
 /// Why a Q1 ramp stops near one punch radius, and what reaches deeper; for
 /// the message of a run that stopped (docs/validation/fe.md "Q1").
@@ -534,18 +529,8 @@ impl ModelSpec {
                 m.element = parse_element(K, s.element.as_deref())?;
                 m.prony = parse_prony(K, s.prony.as_deref())?;
                 if let Some(rho) = s.edge_radius {
-                    if !(rho > 0.0 && rho < m.punch_radius) {
-                        return Err(ModelError::new(
-                            K,
-                            "edge_radius",
-                            rho,
-                            format!(
-                                "expected an edge radius in mm, > 0 and below the punch radius {}",
-                                m.punch_radius
-                            ),
-                        ));
-                    }
-                    m.edge_radius = rho;
+                    m.set_edge_radius(rho)
+                        .map_err(|e| ModelError::new(K, "edge_radius", rho, e))?;
                 }
                 Model::Q1(m)
             }
@@ -1113,7 +1098,7 @@ mod tests {
             toml::from_str(&format!("[q1]\nlaw = \"neo-hookean\"\n{extra}")).unwrap()
         };
         assert!(matches!(q1("").validate(),
-            Ok(Model::Q1(m)) if m.edge_radius == Q1_DEFAULT_EDGE_RADIUS));
+            Ok(Model::Q1(m)) if m.edge_radius == palpate_fe::q1::DEFAULT_EDGE_RADIUS));
         assert!(matches!(q1("edge_radius = 1.0\n").validate(),
             Ok(Model::Q1(m)) if m.edge_radius == 1.0));
         for bad in ["0", "-0.2", "2.0", "5.0", "nan"] {

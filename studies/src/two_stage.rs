@@ -95,7 +95,7 @@ impl TwoStageOptions {
             terms: 2,
             h_fine: 0.3,
             max_time_step: 1.0,
-            edge_radius: crate::models::Q1_DEFAULT_EDGE_RADIUS,
+            edge_radius: palpate_fe::q1::DEFAULT_EDGE_RADIUS,
             stages: STAGES.iter().map(|s| s.to_string()).collect(),
             one_stage: true,
             profile: true,
@@ -141,17 +141,12 @@ impl TwoStageOptions {
         Ok(stages)
     }
 
-    /// `rho` if it is a valid edge radius of the Q1 punch (> 0 and below
-    /// the punch radius), else why not.
-    pub fn check_edge_radius(rho: f64) -> Result<f64, String> {
-        let a = Q1Punch::new(Law::NeoHookean).punch_radius;
-        if rho > 0.0 && rho < a {
-            Ok(rho)
-        } else {
-            Err(format!(
-                "expected an edge radius in mm, > 0 and below the punch radius {a}"
-            ))
-        }
+    /// Sets the punch's edge radius (mm), or says why `rho` is not one
+    /// ([`Q1Punch::set_edge_radius`]).
+    pub fn set_edge_radius(&mut self, rho: f64) -> Result<(), String> {
+        Q1Punch::new(self.law).set_edge_radius(rho)?;
+        self.edge_radius = rho;
+        Ok(())
     }
 
     /// The elastic FE model of the fits.
@@ -829,7 +824,7 @@ impl TwoStageStep {
             o.max_time_step = dt;
         }
         if let Some(rho) = self.edge_radius {
-            o.edge_radius = TwoStageOptions::check_edge_radius(rho)
+            o.set_edge_radius(rho)
                 .map_err(|e| anyhow::anyhow!("edge_radius = {rho}: {e}"))?;
         }
         o.one_stage = self.compare.unwrap_or(true);
@@ -920,13 +915,14 @@ mod tests {
         let mut o = TwoStageOptions::new(Law::NeoHookean);
         assert_eq!(
             o.elastic_model().edge_radius,
-            crate::models::Q1_DEFAULT_EDGE_RADIUS
+            palpate_fe::q1::DEFAULT_EDGE_RADIUS
         );
-        o.edge_radius = TwoStageOptions::check_edge_radius(1.0).unwrap();
+        o.set_edge_radius(1.0).unwrap();
         assert_eq!(o.elastic_model().edge_radius, 1.0);
         assert_eq!(o.viscoelastic_model().edge_radius, 1.0);
         for bad in [0.0, -1.0, 2.0, f64::NAN] {
-            assert!(TwoStageOptions::check_edge_radius(bad).is_err(), "{bad}");
+            assert!(o.set_edge_radius(bad).is_err(), "{bad}");
+            assert_eq!(o.edge_radius, 1.0);
         }
     }
 }

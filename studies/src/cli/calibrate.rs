@@ -340,7 +340,7 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
         o.max_time_step = dt;
     }
     if let Some(rho) = args.edge_radius {
-        o.edge_radius = TwoStageOptions::check_edge_radius(rho)
+        o.set_edge_radius(rho)
             .map_err(|e| anyhow::anyhow!("--edge-radius {rho}: {e}"))?;
     }
     o.one_stage = args.compare;

@@ -151,42 +151,34 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     if a.edge_radius.is_some() && !a.benchmark.eq_ignore_ascii_case("Q1") {
         bail!("--edge-radius applies to --benchmark Q1 only (the flat punch's edge)");
     }
-    let (elastic, visco): (Box<dyn ForwardModel>, Box<dyn ForwardModel>) = match a
-        .benchmark
-        .to_ascii_uppercase()
-        .as_str()
-    {
-        "Q1" => {
-            let mut e = Q1Punch::new(law);
-            e.level = a.mesh;
-            if let Some(rho) = a.edge_radius {
-                if !(rho > 0.0 && rho < e.punch_radius) {
-                    bail!(
-                            "--edge-radius {rho}: expected an edge radius in mm, > 0 and below the punch radius {}",
-                            e.punch_radius
-                        );
+    let (elastic, visco): (Box<dyn ForwardModel>, Box<dyn ForwardModel>) =
+        match a.benchmark.to_ascii_uppercase().as_str() {
+            "Q1" => {
+                let mut e = Q1Punch::new(law);
+                e.level = a.mesh;
+                if let Some(rho) = a.edge_radius {
+                    e.set_edge_radius(rho)
+                        .map_err(|why| anyhow::anyhow!("--edge-radius {rho}: {why}"))?;
                 }
-                e.edge_radius = rho;
+                let mut v = e.clone();
+                v.prony = Some(prony.clone());
+                (Box::new(e), Box::new(v))
             }
-            let mut v = e.clone();
-            v.prony = Some(prony.clone());
-            (Box::new(e), Box::new(v))
-        }
-        "N1" => {
-            let mut e = N1Needle::new(law);
-            e.mesh.level = a.mesh;
-            if let Some(mu) = a.friction {
-                if !(mu >= 0.0 && mu.is_finite()) {
-                    bail!("--friction {mu}: give a coefficient >= 0");
+            "N1" => {
+                let mut e = N1Needle::new(law);
+                e.mesh.level = a.mesh;
+                if let Some(mu) = a.friction {
+                    if !(mu >= 0.0 && mu.is_finite()) {
+                        bail!("--friction {mu}: give a coefficient >= 0");
+                    }
+                    e.friction = mu;
                 }
-                e.friction = mu;
+                let mut v = e.clone();
+                v.prony = Some(prony.clone());
+                (Box::new(e), Box::new(v))
             }
-            let mut v = e.clone();
-            v.prony = Some(prony.clone());
-            (Box::new(e), Box::new(v))
-        }
-        b => bail!("--benchmark {b}: the real-time surrogate is built for Q1 or N1"),
-    };
+            b => bail!("--benchmark {b}: the real-time surrogate is built for Q1 or N1"),
+        };
     let extra = |m: &dyn ForwardModel| -> Vec<f64> {
         let mut t = theta.clone();
         t.extend(m.space().params[theta.len()..].iter().map(|p| p.initial));

@@ -122,6 +122,17 @@ fn bad_input_is_named() {
     m.edge_radius = 0.0;
     let e = m.predict(&[C10], &loading).unwrap_err().to_string();
     assert!(e.contains("edge_radius"), "{e}");
+    // the checked setter refuses the same and keeps the radius it had
+    let mut m = model(0.2, 0.4, 1.4);
+    for bad in [0.0, -0.1, 2.0, f64::NAN] {
+        assert!(m
+            .set_edge_radius(bad)
+            .unwrap_err()
+            .contains("punch radius 2"));
+        assert_eq!(m.edge_radius, 0.2);
+    }
+    m.set_edge_radius(1.0).unwrap();
+    assert_eq!(m.edge_radius, 1.0);
     let mut m = model(0.2, 0.4, 1.4);
     m.punch_radius = -1.0;
     let e = m.predict(&[C10], &loading).unwrap_err().to_string();
