@@ -18,7 +18,9 @@ const C1_ARGS: [&str; 6] = [
     "--param",
 ];
 
-fn simulate(s: &Scratch, benchmark: &str, extra: &[&str]) -> Output {
+/// `palpate simulate --benchmark BENCHMARK` of a neo-Hookean material with
+/// the `extra` options, without the error estimate's second solve.
+pub(crate) fn simulate(s: &Scratch, benchmark: &str, extra: &[&str]) -> Output {
     let mut a = vec![
         "simulate",
         "--benchmark",

@@ -5,6 +5,7 @@
 //! with a non-zero exit, without a panic, naming the option, the manifest
 //! field or file:line.
 
+use crate::bad_input::simulate;
 use crate::common;
 use common::*;
 
@@ -44,20 +45,9 @@ fn surrogate_build(
 #[test]
 fn q1_edge_radius_is_checked() {
     let s = Scratch::new();
+    let csv = s.path("q1.csv").display().to_string();
     let run = |benchmark: &str, edge: &str| {
-        s.run(&[
-            "simulate",
-            "--benchmark",
-            benchmark,
-            "--law",
-            "neo-hookean",
-            "--param",
-            "C10=0.001",
-            "--edge-radius",
-            edge,
-            "--csv",
-            &s.path("q1.csv").display().to_string(),
-        ])
+        simulate(&s, benchmark, &["--edge-radius", edge, "--csv", &csv])
     };
     for bad in ["0", "-0.2", "2", "7.5", "NaN"] {
         refused(
