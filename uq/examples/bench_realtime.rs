@@ -22,15 +22,31 @@ fn main() {
     }
     let per = t0.elapsed().as_secs_f64() / n as f64;
     println!("{}", s.model);
+    match &s.kernel {
+        Some(k) => println!(
+            "memory kernel: {} knots, {} time constants, loss of contact {}",
+            k.knots,
+            k.taus.len(),
+            if k.lift_off {
+                "frees the surface"
+            } else {
+                "clamps"
+            }
+        ),
+        None => println!("plain QLV on the force curve"),
+    }
     println!(
         "| samples | time per sample | rate (one core) | target |\n|---|---|---|---|\n| {n} | {:.1} ns | {:.1} MHz | 10 us (1 kHz needs 1 ms) |",
         per * 1e9,
         1e-6 / per
     );
-    println!("\n| held-out FE history | stations | peak force (N) | max error / peak |\n|---|---|---|---|");
-    for v in &s.validation {
+    println!("\n| held-out FE history | stations | peak force (N) | max error / peak | plain QLV |\n|---|---|---|---|---|");
+    for (j, v) in s.validation.iter().enumerate() {
+        let qlv = s.qlv_validation.get(j).map_or("".to_string(), |q| {
+            format!("{:.2} %", 100.0 * q.max_relative_error)
+        });
         println!(
-            "| {} | {} | {:.4e} | {:.2} % |",
+            "| {} | {} | {:.4e} | {:.2} % | {qlv} |",
             v.history,
             v.samples,
             v.peak_force_n,

@@ -1,8 +1,8 @@
 //! `palpate surrogate build|query`: the real-time surrogate of the Q1 (or
 //! N1) force response (`palpate_uq::surrogate::realtime`): built once from
-//! FE runs (an elastic ramp for the force curve, random held-out histories
-//! for its error table) with a progress bar, stored as a JSON file, queried
-//! on a CSV of depths.
+//! FE runs (an elastic ramp for the force curve, training histories for its
+//! memory kernel, random held-out histories for its error table) with a
+//! progress bar, stored as a JSON file, queried on a CSV of depths.
 
 use crate::limits::Progress;
 use crate::output::{check_outputs, given, write_atomic};
@@ -17,10 +17,11 @@ use std::path::{Path, PathBuf};
 /// Build (from FE runs) or query the real-time force surrogate of Q1 or N1
 ///
 /// `build` runs the FE model of the benchmark (an elastic ramp to
-/// --depth-max for the force curve, plus random held-out histories of ramps,
-/// holds and unloadings for its error table) for one material (--law,
-/// --param, --prony) and stores the surrogate as JSON; `query` answers any
-/// depth history, sample by sample, in well under a microsecond per sample.
+/// --depth-max for the force curve, --train histories its memory is fitted
+/// to, and random held-out histories of ramps, holds and unloadings for its
+/// error table) for one material (--law, --param, --prony) and stores the
+/// surrogate as JSON; `query` answers any depth history, sample by sample,
+/// in about a microsecond per sample.
 /// The surrogate is valid only for that material, benchmark and depth range.
 ///
 /// Examples:
@@ -45,10 +46,13 @@ pub enum Sub {
 /// Build the surrogate from FE runs and store it
 ///
 /// Runs the benchmark's FE model for the material given (--law, --param,
-/// --prony): one elastic ramp to --depth-max, then --holdout random
-/// histories of --segments ramps, holds and unloadings, whose FE forces are
-/// compared with the surrogate's in a printed error table (max and RMS as a
-/// percentage of the peak force).
+/// --prony): one elastic ramp to --depth-max; --train histories (a ramp and
+/// hold, then random ones) to which the surrogate's memory is fitted (a
+/// relaxation read through the present depth; 0: plain QLV on the force
+/// curve with the material's terms); then --holdout other random histories
+/// of --segments ramps, holds and unloadings, whose FE forces are compared
+/// with the surrogate's (and plain QLV's) in a printed error table (max
+/// error as a percentage of the history's peak force).
 ///
 /// Example: palpate surrogate build --benchmark Q1 --law neo-hookean --param C10=0.0016
 ///   --prony g1=0.3,tau1=0.5,g2=0.2,tau2=10 --depth-max 1 --out q1-rt.json
@@ -82,6 +86,10 @@ pub struct BuildArgs {
     /// Mesh level of the FE runs (default 1).
     #[arg(long, default_value_t = 1)]
     pub mesh: usize,
+    /// FE training histories for the fitted memory (default 12; 0: plain
+    /// QLV, no training runs; otherwise at least 5).
+    #[arg(long, default_value_t = 12)]
+    pub train: usize,
     /// Held-out random histories run by FE for the error table (default 4).
     #[arg(long, default_value_t = 4)]
     pub holdout: usize,
@@ -136,6 +144,12 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     }
     if !(1..=6).contains(&a.mesh) {
         bail!("--mesh {}: give a level 1..6", a.mesh);
+    }
+    if a.train != 0 && !(5..=64).contains(&a.train) {
+        bail!(
+            "--train {}: give 0 (plain QLV) or 5..64 FE training histories",
+            a.train
+        );
     }
     if !(1..=64).contains(&a.holdout) || !(1..=50).contains(&a.segments) {
         bail!(
@@ -195,8 +209,10 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         knots: 20,
         validation_histories: a.holdout,
         segments: a.segments,
+        training_histories: a.train,
+        kernel_knots: 10,
     };
-    let total = (1 + a.holdout) as u64;
+    let total = (1 + a.train + a.holdout) as u64;
     let bar = Progress::new(
         total,
         "real-time surrogate",
@@ -217,13 +233,47 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The held-out error table (Markdown).
+/// The held-out error table (Markdown), with plain QLV's error beside the
+/// fitted memory's when the surrogate has one.
 pub fn error_table(s: &RealTimeSurrogate) -> String {
-    let mut r = String::from(
-        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak |\n|---|---|---|---|---|\n",
+    let with_qlv = s.qlv_validation.len() == s.validation.len() && s.kernel.is_some();
+    let mut r = String::new();
+    if let Some(k) = &s.kernel {
+        let _ = write!(
+            r,
+            "memory fitted to {} FE training histories ({} stations, RMS {:.3e} N); on loss of contact it {}",
+            k.training.histories,
+            k.training.stations,
+            k.training.rms_n,
+            if k.lift_off {
+                "follows the free surface"
+            } else {
+                "follows the punch"
+            },
+        );
+        if let Some([without, with]) = k.training.cv_max_relative_error {
+            let _ = write!(
+                r,
+                " (cross-validated mean max error {:.2} % following the punch, {:.2} % the surface)",
+                100.0 * without,
+                100.0 * with
+            );
+        }
+        r.push_str("\n\n");
+    }
+    for f in &s.training_failures {
+        let _ = writeln!(r, "left out of the fit: {f}\n");
+    }
+    r.push_str(
+        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak |",
     );
-    for h in &s.validation {
-        let _ = writeln!(
+    r.push_str(if with_qlv {
+        " plain QLV: max error / peak |\n|---|---|---|---|---|---|\n"
+    } else {
+        "\n|---|---|---|---|---|\n"
+    });
+    for (j, h) in s.validation.iter().enumerate() {
+        let _ = write!(
             r,
             "| {} | {} | {:.4e} | {:.3e} | {:.2} % |",
             h.history,
@@ -232,6 +282,14 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
             h.max_abs_error_n,
             100.0 * h.max_relative_error
         );
+        if with_qlv {
+            let _ = write!(
+                r,
+                " {:.2} % |",
+                100.0 * s.qlv_validation[j].max_relative_error
+            );
+        }
+        r.push('\n');
     }
     r
 }

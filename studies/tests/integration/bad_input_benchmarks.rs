@@ -139,6 +139,11 @@ fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
     refused(&build("g1=0.3,tau1=0", "1"), &["--prony", "tau1"]);
     refused(&build("g1=0.3,tau1=-2", "1"), &["--prony", "tau1"]);
     refused(&build("g1=0.3,tau1=1", "0"), &["--depth-max 0"]);
+    // too few training histories for the fitted memory's cross-validation
+    refused(
+        &surrogate_build(&s, "Q1", "g1=0.3,tau1=1", "1", &["--train", "3"]),
+        &["--train 3", "5..64"],
+    );
     // friction is the needle's: refused for the frictionless punch, and a
     // negative coefficient for N1
     let with_friction = |benchmark: &str, mu: &str| {

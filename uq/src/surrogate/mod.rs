@@ -52,6 +52,7 @@
 
 pub mod design;
 pub mod gp;
+pub mod memory_kernel;
 pub mod model;
 pub mod realtime;
 

@@ -31,13 +31,15 @@
 //! sample. For the flat punch under displacement control it is exact in the
 //! linear range (correspondence principle: `F = 8 a int G(t - s) dG d`);
 //! at finite depth the FE material (Prony series on the isochoric second
-//! Piola-Kirchhoff stress) differs from it at second order. The terms
-//! `g_i, tau_i` are the material's, copied ([`RealTimeSurrogate::build`]);
-//! the held-out FE histories measure what that costs: within 1 % of the
-//! peak for Q1 to 0.8 mm, 4-14 % for the N1 needle to 10 mm (docs/guide.md;
-//! fitted depth-dependent terms, split loading / unloading terms and a
-//! memory refreshed by the needle's travel were tried in session 11 and do
-//! not reach 2 % either: the error left is in the needle's unloading).
+//! Piola-Kirchhoff stress) differs from it: within 2 % of the peak for Q1
+//! to 0.8 mm, 5-12 % for the rounded Q1 punch to 4 mm and 4-14 % for the
+//! N1 needle to 10 mm (docs/guide.md).
+//!
+//! So a build with training histories (`RealTimeRequest::training_histories`)
+//! replaces QLV's memory by a fitted one ([`super::memory_kernel`]): the
+//! memory read through the present depth, its coefficients from FE runs by
+//! least squares, the same recursion. Held-out errors (docs/guide.md): Q1
+//! within 1.5 % to 4 mm (the 1 mm edge), N1 0.5-3.5 %.
 //!
 //! Loss of contact: a punch withdrawn faster than the tissue recovers
 //! leaves it; the force cannot pull (`F >= 0`). When the trial force of a
@@ -52,6 +54,8 @@
 //! anything else is refused ([`RangeError`]), never extrapolated.
 
 use serde::{Deserialize, Serialize};
+
+use super::memory_kernel::{MemoryKernel, TrainingRun};
 
 /// A monotone piecewise-cubic Hermite interpolant (Fritsch & Carlson 1980,
 /// SIAM J. Numer. Anal. 17, 238; the slopes of Fritsch & Butland 1984, as
@@ -154,6 +158,17 @@ pub struct RealTimeSurrogate {
     pub prony: Vec<(f64, f64)>,
     /// Held-out FE histories and the error on each.
     pub validation: Vec<HistoryError>,
+    /// The fitted memory that replaces QLV's when present
+    /// ([`super::memory_kernel`]); built from FE training histories.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kernel: Option<MemoryKernel>,
+    /// With a kernel: plain QLV's errors on the same held-out histories.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub qlv_validation: Vec<HistoryError>,
+    /// Training histories the FE model could not finish (left out of the
+    /// fit), with the reason.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub training_failures: Vec<String>,
     /// FE runs and wall time of the build.
     pub fe_runs: usize,
     pub build_time_s: f64,
@@ -204,6 +219,9 @@ impl RealTimeSurrogate {
             elastic,
             prony,
             validation: Vec::new(),
+            kernel: None,
+            qlv_validation: Vec::new(),
+            training_failures: Vec::new(),
             fe_runs: 0,
             build_time_s: 0.0,
             state: State::default(),
@@ -222,6 +240,9 @@ impl RealTimeSurrogate {
             e: vec![0.0; n],
             phi: vec![0.0; n],
         };
+        if let Some(k) = self.kernel.as_mut() {
+            k.reset();
+        }
     }
 
     /// `g_inf = 1 - sum g_i`.
@@ -242,6 +263,9 @@ impl RealTimeSurrogate {
         }
         if !(dt >= 0.0 && dt.is_finite()) {
             return Err(RangeError::TimeStep { dt });
+        }
+        if let Some(k) = self.kernel.as_mut() {
+            return Ok(k.step(depth.min(k.depth_max), dt).0);
         }
         if self.state.h.len() != self.prony.len() {
             self.reset();
@@ -302,6 +326,19 @@ impl RealTimeSurrogate {
         let elastic = MonotoneCubic::new(s.elastic.x.clone(), s.elastic.y.clone())?;
         let mut out = RealTimeSurrogate::new(s.model, elastic, s.prony)?;
         out.validation = s.validation;
+        if let Some(k) = &s.kernel {
+            k.check()?;
+            if k.depth_max != out.depth_max {
+                return Err(format!(
+                    "memory kernel on [0, {}] mm for a surrogate on [0, {}] mm",
+                    k.depth_max, out.depth_max
+                ));
+            }
+        }
+        out.kernel = s.kernel;
+        out.qlv_validation = s.qlv_validation;
+        out.training_failures = s.training_failures;
+        out.reset();
         out.fe_runs = s.fe_runs;
         out.build_time_s = s.build_time_s;
         Ok(out)
@@ -365,19 +402,11 @@ pub fn random_history(seed: u64, depth_max: f64, segments: usize, dt: f64) -> Hi
         d = target;
         knots.push((t, d));
     }
-    let n = (t / dt).round() as usize;
-    let time: Vec<f64> = (1..=n).map(|k| k as f64 * dt).collect();
-    let depth = time
-        .iter()
-        .map(|&s| {
-            let j = knots
-                .partition_point(|k| k.0 <= s)
-                .clamp(1, knots.len() - 1);
-            let (a, b) = (knots[j - 1], knots[j]);
-            (a.1 + (b.1 - a.1) * ((s - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)).clamp(0.0, depth_max)
-        })
-        .collect();
-    History { knots, time, depth }
+    let mut h = History::from_knots(knots, dt);
+    h.depth
+        .iter_mut()
+        .for_each(|d| *d = d.clamp(0.0, depth_max));
+    h
 }
 
 /// A depth history: its segment ends `(time, depth)` and its samples.
@@ -386,6 +415,49 @@ pub struct History {
     pub knots: Vec<(f64, f64)>,
     pub time: Vec<f64>,
     pub depth: Vec<f64>,
+}
+
+impl History {
+    /// The piecewise-linear history through `knots` `(time_s, depth_mm)`
+    /// (from `(0, 0)`, times increasing), sampled every `dt` from `dt`.
+    pub fn from_knots(knots: Vec<(f64, f64)>, dt: f64) -> History {
+        let t = knots.last().map_or(0.0, |k| k.0);
+        let n = (t / dt).round() as usize;
+        let time: Vec<f64> = (1..=n).map(|k| k as f64 * dt).collect();
+        let depth = time
+            .iter()
+            .map(|&s| {
+                let j = knots
+                    .partition_point(|k| k.0 <= s)
+                    .clamp(1, knots.len() - 1);
+                let (a, b) = (knots[j - 1], knots[j]);
+                a.1 + (b.1 - a.1) * ((s - a.0) / (b.0 - a.0)).clamp(0.0, 1.0)
+            })
+            .collect();
+        History { knots, time, depth }
+    }
+
+    /// The FE stations of the history `(times, depths)`: each segment's end
+    /// and `ramp` (`hold`) equally spaced points inside each ramp (hold).
+    pub fn stations(&self, ramp: usize, hold: usize) -> (Vec<f64>, Vec<f64>) {
+        let mut st = Vec::new();
+        for w in self.knots.windows(2) {
+            let ((ta, da), (tb, db)) = (w[0], w[1]);
+            let inner = if da == db { hold } else { ramp };
+            for j in 1..=inner + 1 {
+                let s = j as f64 / (inner + 1) as f64;
+                st.push((ta + s * (tb - ta), da + s * (db - da)));
+            }
+        }
+        st.into_iter().unzip()
+    }
+
+    /// The index of the 1 kHz-style sample at time `t` (the nearest sample
+    /// time `k dt`, at least the first).
+    pub fn sample_at(&self, t: f64) -> usize {
+        let dt = self.time.first().copied().unwrap_or(1.0);
+        ((t / dt).round() as usize).clamp(1, self.time.len().max(1)) - 1
+    }
 }
 
 /// What a build runs: the elastic and viscoelastic forms of one model (the
@@ -406,6 +478,13 @@ pub struct RealTimeRequest<'a> {
     pub validation_histories: usize,
     /// Segments per held-out history.
     pub segments: usize,
+    /// FE training histories for the memory kernel
+    /// ([`super::memory_kernel`]): a ramp to `depth_max` in 1 s held 20 s,
+    /// then random histories of seeds 1001.. (never a held-out seed); 0
+    /// (or fewer than 5): QLV with the material's terms, nothing fitted.
+    pub training_histories: usize,
+    /// Hat functions of the kernel on `[0, depth_max]`.
+    pub kernel_knots: usize,
 }
 
 impl RealTimeSurrogate {
@@ -421,7 +500,13 @@ impl RealTimeSurrogate {
         use palpate_core::{Drive, Loading};
         use rayon::prelude::*;
         let t0 = std::time::Instant::now();
-        let total = 1 + req.validation_histories;
+        let total = 1
+            + req.validation_histories
+            + if req.training_histories >= 5 {
+                req.training_histories
+            } else {
+                0
+            };
         if !(req.depth_max > 0.0 && req.depth_max.is_finite()) || req.knots < 2 {
             return Err(format!(
                 "depth range {} mm with {} samples: need a depth > 0 and at least 2 samples",
@@ -453,14 +538,36 @@ impl RealTimeSurrogate {
             elastic,
             req.prony.clone(),
         )?;
+        // the FE histories, training and held-out, in one parallel batch
+        let train = if req.training_histories >= 5 {
+            req.training_histories
+        } else {
+            0
+        };
+        let mut jobs: Vec<(String, History, (usize, usize))> = (0..train)
+            .map(|k| {
+                let h = if k == 0 {
+                    let d = req.depth_max;
+                    History::from_knots(vec![(0.0, 0.0), (1.0, d), (21.0, d)], 1e-3)
+                } else {
+                    random_history(1000 + k as u64, req.depth_max, req.segments, 1e-3)
+                };
+                (format!("training {k}"), h, (8, 6))
+            })
+            .collect();
+        jobs.extend((1..=req.validation_histories as u64).map(|seed| {
+            (
+                format!("random {seed}"),
+                random_history(seed, req.depth_max, req.segments, 1e-3),
+                (4, 3),
+            )
+        }));
         let done = std::sync::atomic::AtomicUsize::new(1);
-        let results: Vec<Result<HistoryError, String>> = (1..=req.validation_histories as u64)
-            .into_par_iter()
-            .map(|seed| {
-                let h = random_history(seed, req.depth_max, req.segments, 1e-3);
-                let r = s
-                    .clone()
-                    .compare(req.viscoelastic, req.viscoelastic_theta, &h, seed);
+        let fe: Vec<Result<Vec<(f64, f64)>, String>> = jobs
+            .par_iter()
+            .map(|(name, h, (ramp, hold))| {
+                let r = fe_stations(req.viscoelastic, req.viscoelastic_theta, h, (*ramp, *hold))
+                    .map_err(|e| format!("FE run of {name}: {e}"));
                 let n = done.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
                 if let Some(t) = tick {
                     t(n, total);
@@ -468,7 +575,63 @@ impl RealTimeSurrogate {
                 r
             })
             .collect();
-        s.validation = results.into_iter().collect::<Result<_, _>>()?;
+        // a training history the FE model cannot finish is left out (named
+        // in the error if too few are left); a held-out one is an error
+        let mut failed: Vec<String> = Vec::new();
+        let mut fe_ok: Vec<Option<Vec<(f64, f64)>>> = Vec::with_capacity(fe.len());
+        for (j, r) in fe.into_iter().enumerate() {
+            match r {
+                Ok(st) => fe_ok.push(Some(st)),
+                Err(e) if j < train => {
+                    failed.push(e);
+                    fe_ok.push(None);
+                }
+                Err(e) => return Err(e),
+            }
+        }
+        let held = (train..jobs.len()).map(|j| {
+            (
+                &jobs[j].0,
+                &jobs[j].1,
+                fe_ok[j].as_ref().expect("held-out runs succeeded"),
+            )
+        });
+        if train > 0 {
+            let runs: Vec<TrainingRun<'_>> = (0..train)
+                .filter_map(|j| {
+                    fe_ok[j].as_ref().map(|st| TrainingRun {
+                        history: &jobs[j].1,
+                        stations: st,
+                    })
+                })
+                .collect();
+            if fe_ok[0].is_none() || runs.len() < 5 {
+                return Err(format!(
+                    "{} of {train} FE training histories failed (the ramp and hold to {} mm {}); first: {}",
+                    failed.len(),
+                    req.depth_max,
+                    if fe_ok[0].is_none() { "among them" } else { "ran" },
+                    failed.first().map_or("", |s| s.as_str())
+                ));
+            }
+            s.training_failures = failed;
+            let taus: Vec<f64> = req.prony.iter().map(|p| p.1).collect();
+            let mut qlv = s.clone();
+            s.qlv_validation = held
+                .clone()
+                .map(|(name, h, st)| qlv.error_on(name, h, st))
+                .collect::<Result<_, _>>()?;
+            s.kernel = Some(MemoryKernel::fit(
+                req.depth_max,
+                req.kernel_knots,
+                &taus,
+                &runs,
+            )?);
+        }
+        s.validation = held
+            .map(|(name, h, st)| s.error_on(name, h, st))
+            .collect::<Result<_, _>>()?;
+        s.reset();
         s.fe_runs = total;
         s.build_time_s = t0.elapsed().as_secs_f64();
         Ok(s)
@@ -484,41 +647,54 @@ impl RealTimeSurrogate {
         history: &History,
         seed: u64,
     ) -> Result<HistoryError, String> {
-        use palpate_core::{Drive, Loading};
-        let mut st = Vec::new();
-        for w in history.knots.windows(2) {
-            let ((ta, da), (tb, db)) = (w[0], w[1]);
-            let inner = if da == db { 3 } else { 4 };
-            for j in 1..=inner + 1 {
-                let s = j as f64 / (inner + 1) as f64;
-                st.push((ta + s * (tb - ta), da + s * (db - da)));
-            }
-        }
-        let time: Vec<f64> = st.iter().map(|p| p.0).collect();
-        let depth: Vec<f64> = st.iter().map(|p| p.1).collect();
-        let fe = model
-            .predict(
-                theta,
-                &Loading::timed(Drive::DisplacementMm, time.clone(), depth.clone()),
-            )
+        let st = fe_stations(model, theta, history, (4, 3))
             .map_err(|e| format!("FE run of random history {seed}: {e}"))?;
+        self.error_on(&format!("random {seed}"), history, &st)
+    }
+
+    /// The surrogate's largest error at the FE `stations` `(time_s,
+    /// force_n)` of `history`, run from rest at the history's samples.
+    pub fn error_on(
+        &mut self,
+        name: &str,
+        history: &History,
+        stations: &[(f64, f64)],
+    ) -> Result<HistoryError, String> {
         let forces = self
             .run(&history.time, &history.depth)
-            .map_err(|(k, e)| format!("history {seed}, sample {k}: {e}"))?;
-        let peak = fe.iter().cloned().fold(0.0, f64::max);
-        let mut worst: f64 = 0.0;
-        for (k, &t) in time.iter().enumerate() {
-            let j = ((t / 1e-3).round() as usize).clamp(1, forces.len()) - 1;
-            worst = worst.max((forces[j] - fe[k]).abs());
-        }
+            .map_err(|(k, e)| format!("{name}, sample {k}: {e}"))?;
+        let peak = stations.iter().map(|s| s.1).fold(0.0, f64::max);
+        let worst = stations
+            .iter()
+            .map(|&(t, f)| (forces[history.sample_at(t)] - f).abs())
+            .fold(0.0, f64::max);
         Ok(HistoryError {
-            history: format!("random {seed}"),
-            samples: time.len(),
+            history: name.to_string(),
+            samples: stations.len(),
             peak_force_n: peak,
             max_abs_error_n: worst,
             max_relative_error: worst / peak,
         })
     }
+}
+
+/// The FE force of `history` at its stations ([`History::stations`] with
+/// `(ramp, hold)` inner points): `(time_s, force_n)`.
+fn fe_stations(
+    model: &dyn palpate_core::ForwardModel,
+    theta: &[f64],
+    history: &History,
+    (ramp, hold): (usize, usize),
+) -> Result<Vec<(f64, f64)>, String> {
+    use palpate_core::{Drive, Loading};
+    let (time, depth) = history.stations(ramp, hold);
+    let f = model
+        .predict(
+            theta,
+            &Loading::timed(Drive::DisplacementMm, time.clone(), depth),
+        )
+        .map_err(|e| e.to_string())?;
+    Ok(time.into_iter().zip(f).collect())
 }
 
 #[cfg(test)]
@@ -630,5 +806,168 @@ mod tests {
         assert!(bad.contains("sum to 1"), "{bad}");
         let json = t.to_json();
         assert!(RealTimeSurrogate::from_json(&json).is_ok());
+    }
+
+    /// With a memory kernel (here QLV's own coefficients): the same answers
+    /// as plain QLV, the same range checks, and the kernel survives the
+    /// file; a kernel on another depth range is refused on reading.
+    #[test]
+    fn a_memory_kernel_answers_and_is_stored() {
+        let prony = vec![(0.3, 0.5), (0.2, 10.0)];
+        let mut plain = linear_surrogate(prony.clone());
+        let mut with = plain.clone();
+        let at_knots: Vec<f64> = (1..=10).map(|k| 0.2 * k as f64).collect();
+        with.kernel = Some(MemoryKernel::qlv(1.0, &at_knots, &prony, true));
+        let h = random_history(7, 1.0, 6, 1e-3);
+        let a = plain.run(&h.time, &h.depth).unwrap();
+        let b = with.run(&h.time, &h.depth).unwrap();
+        let worst = a
+            .iter()
+            .zip(&b)
+            .map(|(p, q)| (p - q).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-9, "{worst}");
+        assert!(with.force(1.2, 0.1).is_err());
+        assert!(with.force(0.5, -1.0).is_err());
+        let mut back = RealTimeSurrogate::from_json(&with.to_json()).unwrap();
+        assert!(back.kernel.is_some());
+        assert_eq!(back.run(&h.time, &h.depth).unwrap(), b);
+        let mut other = with.clone();
+        other.kernel = Some(MemoryKernel::qlv(2.0, &at_knots, &prony, true));
+        let e = RealTimeSurrogate::from_json(&other.to_json()).unwrap_err();
+        assert!(e.contains("memory kernel on [0, 2] mm"), "{e}");
+    }
+
+    /// A tissue with a memory that QLV cannot represent, behind the forward
+    /// trait: its force is a [`MemoryKernel`] (the stored stress reads 60 %
+    /// stronger at the deepest present depth), run along the loading's
+    /// stations joined linearly in 1 ms steps; without `viscous`, the instantaneous
+    /// response (the elastic form).
+    struct KernelTissue {
+        truth: MemoryKernel,
+        viscous: bool,
+        space: palpate_core::ParamSpace,
+    }
+
+    struct KernelTissueEval<'a>(&'a KernelTissue);
+
+    impl palpate_core::Evaluator for KernelTissueEval<'_> {
+        fn predict_into(
+            &mut self,
+            _theta: &[f64],
+            loading: &palpate_core::Loading,
+            out: &mut [f64],
+        ) -> Result<(), palpate_core::ForwardError> {
+            let mut k = self.0.truth.clone();
+            k.reset();
+            let time = match (&loading.time, self.0.viscous) {
+                (Some(t), true) => t.clone(),
+                _ => vec![0.0; loading.drive.len()],
+            };
+            let mut knots = vec![(0.0, 0.0)];
+            knots.extend(time.iter().copied().zip(loading.drive.iter().copied()));
+            let mut prev = (0.0, 0.0);
+            for (o, &(t, d)) in out.iter_mut().zip(&knots[1..]) {
+                // 1 ms steps (as the surrogate's), the depth linear in time
+                let n = ((t - prev.0) / 1e-3).round().max(1.0) as usize;
+                let mut f = 0.0;
+                for j in 1..=n {
+                    let s = j as f64 / n as f64;
+                    f = k.step(prev.1 + s * (d - prev.1), (t - prev.0) / n as f64).0;
+                }
+                *o = f;
+                prev = (t, d);
+            }
+            Ok(())
+        }
+    }
+
+    impl palpate_core::ForwardModel for KernelTissue {
+        fn name(&self) -> String {
+            "kernel tissue".into()
+        }
+        fn space(&self) -> &palpate_core::ParamSpace {
+            &self.space
+        }
+        fn observable(&self) -> palpate_core::Observable {
+            palpate_core::Observable::ForceN
+        }
+        fn evaluator(&self) -> Box<dyn palpate_core::Evaluator + '_> {
+            Box::new(KernelTissueEval(self))
+        }
+    }
+
+    /// The whole build on that tissue: the training histories, the fit and
+    /// the held-out table (12 training histories, as the CLI's default): the
+    /// fitted memory is within 1 % of the peak on histories it was not
+    /// built from (measured 0.23-0.48 %), where QLV with the same terms is
+    /// off by more than 2 % (3.1-9.9 %).
+    #[test]
+    fn a_build_fits_a_memory_that_qlv_misses() {
+        let prony = vec![(0.3, 0.5), (0.2, 10.0)];
+        let knots = 10;
+        let at_knots: Vec<f64> = (1..=knots)
+            .map(|k| {
+                let x = k as f64 / knots as f64;
+                0.02 * x + 0.03 * x * x
+            })
+            .collect();
+        let mut truth = MemoryKernel::qlv(1.0, &at_knots, &prony, true);
+        truth.memory.chunks_mut(2).for_each(|c| c[1] *= 1.6);
+        let space = palpate_core::ParamSpace::new(vec![palpate_core::ParamSpec::new(
+            "k", "-", 0.0, 2.0, 1.0,
+        )]);
+        let elastic = KernelTissue {
+            truth: truth.clone(),
+            viscous: false,
+            space: space.clone(),
+        };
+        let viscoelastic = KernelTissue {
+            truth,
+            viscous: true,
+            space,
+        };
+        let req = RealTimeRequest {
+            elastic: &elastic,
+            elastic_theta: &[1.0],
+            viscoelastic: &viscoelastic,
+            viscoelastic_theta: &[1.0],
+            prony,
+            depth_max: 1.0,
+            knots: 20,
+            validation_histories: 3,
+            segments: 6,
+            training_histories: 12,
+            kernel_knots: knots,
+        };
+        let ticks = std::sync::atomic::AtomicUsize::new(0);
+        let tick = |_: usize, total: usize| {
+            assert_eq!(total, 4 + req.training_histories);
+            ticks.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        };
+        let s = RealTimeSurrogate::build(&req, Some(&tick)).unwrap();
+        assert_eq!(ticks.into_inner(), 4 + req.training_histories);
+        assert_eq!(s.fe_runs, 4 + req.training_histories);
+        let k = s.kernel.as_ref().expect("a fitted memory");
+        assert_eq!(k.training.histories, req.training_histories);
+        assert!(k.lift_off, "{:?}", k.training.cv_max_relative_error);
+        assert_eq!(s.validation.len(), 3);
+        for (v, q) in s.validation.iter().zip(&s.qlv_validation) {
+            assert!(v.max_relative_error < 1e-2, "{v:?}");
+            assert!(q.max_relative_error > 2e-2, "{q:?}");
+        }
+        // without training histories: plain QLV, as before
+        let plain = RealTimeSurrogate::build(
+            &RealTimeRequest {
+                training_histories: 0,
+                ..req
+            },
+            None,
+        )
+        .unwrap();
+        assert!(plain.kernel.is_none() && plain.qlv_validation.is_empty());
+        for (p, q) in plain.validation.iter().zip(&s.qlv_validation) {
+            assert_eq!(p.max_relative_error, q.max_relative_error);
+        }
     }
 }
