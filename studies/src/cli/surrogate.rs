@@ -62,10 +62,9 @@ pub struct BuildArgs {
     /// Q1 (flat punch) or N1 (needle, friction 0.8 unless --friction).
     #[arg(long)]
     pub benchmark: String,
-    /// N1: the needle's Coulomb friction [default: 0.8]. The surrogate is
-    /// QLV on the force curve, which a frictionless needle follows; with
-    /// friction the FE force is hysteretic on unloading (held-out errors of
-    /// 4-8 % of the peak at 0.8, docs/guide.md).
+    /// N1: the needle's Coulomb friction [default: 0.8]. The fitted memory
+    /// meets 2 % on Q1 but not yet on N1 (held-out 0.8-2.9 % at 0.8, 1.4-3.5 %
+    /// frictionless, to 10 mm; plain QLV 3.7-13.6 %; docs/guide.md).
     #[arg(long)]
     pub friction: Option<f64>,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
