@@ -63,8 +63,8 @@ pub struct BuildArgs {
     #[arg(long)]
     pub benchmark: String,
     /// N1: the needle's Coulomb friction [default: 0.8]. The fitted memory
-    /// meets 2 % on Q1 but not yet on N1 (held-out 0.8-2.9 % at 0.8, 1.4-3.5 %
-    /// frictionless, to 10 mm; plain QLV 3.7-13.6 %; docs/guide.md).
+    /// is within 2 % of FE on N1 to 4 mm, not deeper (to 10 mm: up to 2.9 %
+    /// at 0.8, 3.5 % frictionless; plain QLV 3.7-13.6 %; docs/guide.md).
     #[arg(long)]
     pub friction: Option<f64>,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.

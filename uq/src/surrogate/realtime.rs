@@ -39,7 +39,8 @@
 //! replaces QLV's memory by a fitted one ([`super::memory_kernel`]): the
 //! memory read through the present depth, its coefficients from FE runs by
 //! least squares, the same recursion. Held-out errors (docs/guide.md): Q1
-//! within 1.5 % to 4 mm (the 1 mm edge), N1 0.5-3.5 %.
+//! within 1.1 % to 4 mm (the 1 mm edge), N1 within 1.6 % to 4 mm and up to
+//! 3.5 % (frictionless) or 4.5 % (friction 0.8, to 7 mm) deeper.
 //!
 //! Loss of contact: a punch withdrawn faster than the tissue recovers
 //! leaves it; the force cannot pull (`F >= 0`). When the trial force of a
