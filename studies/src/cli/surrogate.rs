@@ -263,6 +263,9 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
     for f in &s.training_failures {
         let _ = writeln!(r, "left out of the fit: {f}\n");
     }
+    for f in &s.validation_failures {
+        let _ = writeln!(r, "not in the error table: {f}\n");
+    }
     r.push_str(
         "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak |",
     );
