@@ -58,7 +58,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::realtime::History;
+use super::depth_history::History;
 
 /// Present-depth functions `chi_j`.
 const PRESENT: usize = 2;
