@@ -427,7 +427,7 @@ impl MemoryKernel {
         worst / peak.max(f64::MIN_POSITIVE)
     }
 
-    /// Fits the kernel to FE training runs (at least [`FOLDS`]; the first
+    /// Fits the kernel to FE training runs (at least `FOLDS + 1` = 5; the first
     /// should reach `depth_max`): `knots` hat functions on `[0, depth_max]`,
     /// the material's time constants `taus`. Whether the memory follows a
     /// free surface on loss of contact is chosen by a 4-fold
