@@ -40,6 +40,12 @@ fn main() {
             m.contact_points = palpate_fe::ContactPoints::Nodes;
         }
     }
+    if let Ok(v) = std::env::var("PROX") {
+        m.options.stabilisation = v.parse().unwrap();
+    }
+    if std::env::var("SPLIT").as_deref() == Ok("1") {
+        m.contact_points = palpate_fe::ContactPoints::EdgeSplit;
+    }
     if let Ok(v) = std::env::var("STAG") {
         m.options.stagnation_tolerance = v.parse().unwrap();
     }

@@ -87,6 +87,12 @@ pub enum ContactPoints {
     /// At the Gauss points of every facet, the force shared by the facet's
     /// nodes through the shape functions (a surface-to-rigid integration).
     EdgeGauss,
+    /// Along every straight edge (2D `Line2` facets), Gauss points on each
+    /// stretch between the points where the tool's piece changes or the
+    /// force starts ([`crate::contact_split`]), so that the assembled force
+    /// has no kinks. A pure penalty (no multipliers: the points move along
+    /// the edge), frictionless only.
+    EdgeSplit,
 }
 
 /// Largest number of facet nodes a contact point interpolates.
@@ -171,6 +177,9 @@ pub struct RigidContact {
     /// augmented since the last commit).
     lambda: Vec<f64>,
     forces: Vec<PointForce>,
+    /// [`ContactPoints::EdgeSplit`]: per facet, its reference length and
+    /// volume factors at its two nodes.
+    split: Vec<(f64, f64, f64)>,
 }
 
 impl RigidContact {
@@ -213,6 +222,23 @@ impl RigidContact {
         let set = mesh.facet_set(facets)?;
         let points = contact_points(mesh, set, kinematics, options.points)?;
         let facets: Vec<Vec<usize>> = set.iter().map(|f| f.to_vec()).collect();
+        let mut split = Vec::new();
+        if options.points == ContactPoints::EdgeSplit {
+            if set.cell_type != CellType::Line2 || options.friction > 0.0 {
+                return Err(bad(
+                    "split edge contact needs 2-node edges and no friction".into()
+                ));
+            }
+            for f in &facets {
+                let (pa, pb) = (mesh.nodes[f[0]], mesh.nodes[f[1]]);
+                let len = ((pa[0] - pb[0]).powi(2) + (pa[1] - pb[1]).powi(2)).sqrt();
+                split.push((
+                    len,
+                    kinematics.volume_factor(pa[0]),
+                    kinematics.volume_factor(pb[0]),
+                ));
+            }
+        }
         let mut c = RigidContact {
             name: name.into(),
             surface,
@@ -226,6 +252,7 @@ impl RigidContact {
             forces: vec![PointForce::default(); points.len()],
             points,
             facets,
+            split,
         };
         c.reset(&mesh.nodes);
         let pose = c.motion.pose(&vec![0.0; channels]);
@@ -270,6 +297,76 @@ impl RigidContact {
     }
 }
 
+/// [`Contribution::assemble`] with [`ContactPoints::EdgeSplit`]: the
+/// points of every edge (`facets`, with `split`'s reference lengths and
+/// volume factors) are placed for the current configuration and evaluated
+/// with a pure penalty (no multiplier, no history); their states and
+/// forces replace `state`.
+fn assemble_split(
+    tool: &Tool,
+    facets: &[Vec<usize>],
+    split: &[(f64, f64, f64)],
+    ctx: &AssemblyContext,
+    out: &mut Assembly,
+    state: (&mut Vec<PointHistory>, &mut Vec<PointForce>),
+) -> Result<(), FeError> {
+    {
+        let (trial, forces) = state;
+        let dim = ctx.dofs.dim;
+        let onset = 0.5 * tool.smoothing;
+        forces.clear();
+        trial.clear();
+        let none = PointHistory::default();
+        for (k, f) in facets.iter().enumerate() {
+            let (len0, va, vb) = split[k];
+            let (xa, xb) = (ctx.position(f[0]), ctx.position(f[1]));
+            let pts = crate::contact_split::split_edge_points(
+                tool.surface,
+                tool.pose,
+                xa,
+                xb,
+                len0,
+                va,
+                vb,
+                onset,
+            );
+            for q in pts {
+                let (t, pf) = tool.point(q.area, 0.0, &none, q.x);
+                if pf.force == [0.0; 3] && pf.stiffness == [[0.0; 3]; 3] {
+                    continue;
+                }
+                out.force_scale2 += (0..dim).map(|i| pf.force[i].powi(2)).sum::<f64>();
+                for a in 0..2 {
+                    let na = f[a];
+                    let wa = q.weights[a];
+                    for i in 0..dim {
+                        out.fint[na * dim + i] -= wa * pf.force[i];
+                    }
+                    if out.values.is_none() {
+                        continue;
+                    }
+                    for b in 0..2 {
+                        let wab = wa * q.weights[b];
+                        let nb = f[b];
+                        for i in 0..dim {
+                            for j in 0..dim {
+                                out.add_entry(
+                                    na * dim + i,
+                                    nb * dim + j,
+                                    -wab * pf.stiffness[i][j],
+                                );
+                            }
+                        }
+                    }
+                }
+                trial.push(t);
+                forces.push(pf);
+            }
+        }
+        Ok(())
+    }
+}
+
 /// Contact points of a facet set.
 fn contact_points(
     mesh: &Mesh,
@@ -291,6 +388,8 @@ fn contact_points(
         p
     };
     match (set.cell_type, mode) {
+        // the points are placed at every assembly
+        (_, ContactPoints::EdgeSplit) => {}
         (CellType::Line2, ContactPoints::Nodes) => {
             let mut area = std::collections::BTreeMap::<usize, f64>::new();
             for f in set.iter() {
@@ -334,7 +433,7 @@ fn contact_points(
                     let area = w * da * vf(&x);
                     match mode {
                         ContactPoints::EdgeGauss => out.push(point(f, &n[..f.len()], area)),
-                        ContactPoints::Nodes => {
+                        ContactPoints::Nodes | ContactPoints::EdgeSplit => {
                             for (a, &node) in f.iter().enumerate() {
                                 *tributary.entry(node).or_default() += n[a] * area;
                             }
@@ -613,6 +712,16 @@ impl Contribution for RigidContact {
             smoothing: self.smoothing,
             dim,
         };
+        if !self.split.is_empty() {
+            return assemble_split(
+                &tool,
+                &self.facets,
+                &self.split,
+                ctx,
+                out,
+                (&mut self.trial, &mut self.forces),
+            );
+        }
         for (k, p) in self.points.iter().enumerate() {
             let x = p.position(|n| ctx.position(n));
             let (t, f) = tool.point(p.area, self.lambda[k], &self.committed[k], x);
@@ -654,7 +763,10 @@ impl Contribution for RigidContact {
     }
 
     fn augment(&mut self) -> bool {
-        if self.pure_penalty || self.max_penetration() <= self.options.penetration_tol {
+        if !self.split.is_empty()
+            || self.pure_penalty
+            || self.max_penetration() <= self.options.penetration_tol
+        {
             return false;
         }
         for (l, t) in self.lambda.iter_mut().zip(&self.trial) {

@@ -37,6 +37,7 @@
 pub mod body;
 pub mod c1;
 pub mod contact;
+pub mod contact_split;
 pub mod contribution;
 pub mod discretisation;
 pub mod dofs;

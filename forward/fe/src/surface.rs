@@ -136,6 +136,13 @@ pub trait RigidSurface: Send + Sync + std::fmt::Debug {
     fn name(&self) -> String;
     /// Checks the dimensions.
     fn check(&self) -> Result<(), String>;
+    /// An identifier of the smooth piece of the surface that
+    /// [`RigidSurface::project`] uses at the tool-local point `p`: across a
+    /// change of piece the curvature, hence the contact force's derivative,
+    /// may jump ([`crate::contact_split`]). Default: one smooth piece.
+    fn piece(&self, _p: [f64; 3]) -> u64 {
+        0
+    }
 }
 
 /// The Kronecker delta.
@@ -174,6 +181,12 @@ impl RigidSurface for Profile2d {
     }
     fn check(&self) -> Result<(), String> {
         self.0.check()
+    }
+    fn piece(&self, p: [f64; 3]) -> u64 {
+        match self.0.segment([p[0], p[1]]) {
+            Segment::Arc { xi0, .. } => xi0.to_bits() << 1,
+            Segment::Line { xi0, .. } => (xi0.to_bits() << 1) | 1,
+        }
     }
 }
 

@@ -71,6 +71,16 @@ pub struct SolverOptions {
     /// How far along each full Newton update to step
     /// ([`crate::line_search`]). Default [`LineSearch::Residual`].
     pub line_search: LineSearch,
+    /// Proximal stabilisation of an increment whose Newton fails: `beta >
+    /// 0` solves instead a sequence of problems `R(u) + C (u - u_a) = 0`,
+    /// `C = beta diag(K)` on the free displacements, each anchored at the
+    /// last one's solution (proximal point iterations, Rockafellar 1976;
+    /// the viscous stabilisation of Abaqus's `*STATIC, STABILIZE` with the
+    /// viscous force driven to zero), trying plain Newton after each. The
+    /// accepted state is an equilibrium of `R` alone: the term only carries
+    /// Newton across a local snap (a surface edge draped over a tool's
+    /// rounded corner, Q1). 0 (default): off.
+    pub stabilisation: f64,
 }
 
 impl Default for SolverOptions {
@@ -90,6 +100,7 @@ impl Default for SolverOptions {
             max_time_step: None,
             max_update: None,
             line_search: LineSearch::Residual,
+            stabilisation: 0.0,
         }
     }
 }
@@ -109,6 +120,10 @@ pub struct RunStats {
     pub reused_factors: usize,
     /// Increments accepted at the stagnation tolerance.
     pub loose: usize,
+    /// Increments solved through proximal stabilisation
+    /// ([`SolverOptions::stabilisation`]), and its proximal steps.
+    pub stabilised: usize,
+    pub proximal_steps: usize,
     /// Wall time in assembly and in factorise-and-solve (s).
     pub assembly_seconds: f64,
     pub solve_seconds: f64,
@@ -155,6 +170,9 @@ pub struct System {
     /// it is cleared.
     #[doc(hidden)]
     pub fail_after: Option<usize>,
+    /// The proximal term of a stabilised increment: per state entry the
+    /// weight `c` (0 off the free displacements) and the anchor `u_a`.
+    prox: Option<(Vec<f64>, Vec<f64>)>,
 }
 
 impl System {
@@ -233,6 +251,7 @@ impl System {
             stats: RunStats::default(),
             predictor: None,
             fail_after: None,
+            prox: None,
         })
     }
 
@@ -390,6 +409,22 @@ impl System {
                     break;
                 }
                 force2 += out.force_scale2;
+            }
+        }
+        if let (Some((c, anchor)), Ok(())) = (&self.prox, &result) {
+            let mut out = Assembly {
+                fint: &mut fint,
+                values: if tangent { Some(&mut values) } else { None },
+                pattern: &self.pattern,
+                first_group: 0,
+                dofs: &self.dofs,
+                force_scale2: 0.0,
+            };
+            for (k, &ck) in c.iter().enumerate() {
+                if ck != 0.0 {
+                    out.fint[k] += ck * (self.u[k] - anchor[k]);
+                    out.add_entry(k, k, ck);
+                }
             }
         }
         self.fint = fint;
@@ -576,7 +611,15 @@ impl System {
         target: &Target,
         opts: &SolverOptions,
     ) -> Result<(), FeError> {
-        self.newton(target, opts)?;
+        let start = self.u.clone();
+        match self.newton(target, opts) {
+            Ok(()) => {}
+            Err(e) if opts.stabilisation > 0.0 && e.is_recoverable() => {
+                self.u = start;
+                self.stabilised_newton(target, opts, e)?;
+            }
+            Err(e) => return Err(e),
+        }
         for _ in 0..opts.max_augmentations {
             let mut changed = false;
             for c in self.contributions.iter_mut() {
@@ -589,6 +632,64 @@ impl System {
             self.newton(target, opts)?;
         }
         Ok(())
+    }
+
+    /// [`SolverOptions::stabilisation`]: proximal steps from the current
+    /// state, each followed by a try of plain Newton; `failed` is the error
+    /// returned when none converges.
+    fn stabilised_newton(
+        &mut self,
+        target: &Target,
+        opts: &SolverOptions,
+        failed: FeError,
+    ) -> Result<(), FeError> {
+        const STEPS: usize = 40;
+        self.prescribe(target);
+        self.assemble(target, true)?;
+        let nd = self.dofs.nodes * self.dofs.dim;
+        let mut c = vec![0.0; self.u.len()];
+        for (k, ck) in c.iter_mut().enumerate().take(nd) {
+            let e = self.dofs.equation(k);
+            if e != NONE {
+                if let Some(slot) = self.pattern.slot(e, e) {
+                    *ck = opts.stabilisation * self.values[slot].abs();
+                }
+            }
+        }
+        let plain = SolverOptions {
+            max_iterations: 8,
+            ..*opts
+        };
+        let mut last = failed;
+        let mut weight = 1.0;
+        for _ in 0..STEPS {
+            let anchor = self.u.clone();
+            self.prox = Some((c.iter().map(|v| v * weight).collect(), anchor.clone()));
+            let r = self.newton(target, opts);
+            self.prox = None;
+            self.stats.proximal_steps += 1;
+            if let Err(e) = r {
+                // a firmer term from the same anchor
+                self.u = anchor;
+                weight *= 4.0;
+                last = e;
+                continue;
+            }
+            let save = self.u.clone();
+            match self.newton(target, &plain) {
+                Ok(()) => {
+                    self.stats.stabilised += 1;
+                    return Ok(());
+                }
+                Err(e) => {
+                    last = e;
+                    self.u = save;
+                    // a weaker term: the steps lengthen towards Newton's
+                    weight *= 0.5;
+                }
+            }
+        }
+        Err(last)
     }
 
     /// Accepts the state at `target` as converged.

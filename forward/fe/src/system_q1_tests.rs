@@ -21,6 +21,12 @@ fn q1_tangent_near_the_stop_equals_finite_differences() {
         .unwrap_or(1.95);
     let mut m = crate::Q1Punch::new("neo-hookean".parse().unwrap());
     m.level = 1;
+    if std::env::var("Q1_SPLIT").as_deref() == Ok("1") {
+        m.contact_points = crate::ContactPoints::EdgeSplit;
+    }
+    if let Some(r) = std::env::var("Q1_REFINE").ok().and_then(|v| v.parse().ok()) {
+        m.edge_refinement = r;
+    }
     let n = (depth / 0.05).round().max(1.0) as usize;
     let drive: Vec<f64> = (1..=n).map(|k| depth * k as f64 / n as f64).collect();
     let loading = Loading::quasi_static(Drive::DisplacementMm, drive);
