@@ -1,7 +1,9 @@
 //! Q1 mesh study (docs/validation/fe.md, "Q1"): the elastic flat-punch force
 //! at a small depth against Sneddon's 8 G a d on one grading.
 //! `cargo run --release -p palpate-fe --example convergence_q1 -- H_FINE GROWTH EDGE [DEPTH]`
-//! (env `AUG=20` for an inner augmentation loop, `PEN=` the penalty factor).
+//! (env `AUG=20` for an inner augmentation loop, `PEN=` the penalty factor,
+//! `GAUSS=1` contact at fixed Gauss points of the edges, `REFINE=` edge
+//! refinement).
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
@@ -20,6 +22,12 @@ fn main() {
     m.edge_radius = edge;
     if let Ok(a) = std::env::var("AUG") {
         m.options.max_augmentations = a.parse().unwrap();
+    }
+    if std::env::var("GAUSS").as_deref() == Ok("1") {
+        m.contact_points = palpate_fe::ContactPoints::EdgeGauss;
+    }
+    if let Ok(a) = std::env::var("REFINE") {
+        m.edge_refinement = a.parse().unwrap();
     }
     if let Ok(a) = std::env::var("PEN") {
         m.penalty = a.parse().unwrap();

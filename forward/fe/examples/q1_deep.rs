@@ -89,6 +89,11 @@ fn main() {
     };
     let reached = match m.simulate(&[c10], &loading, None) {
         Ok((sim, _)) => {
+            if std::env::var("CURVE").is_ok() {
+                for (d, f) in drive.iter().zip(&sim.forces) {
+                    println!("curve {d:.3} {f:.6e}");
+                }
+            }
             println!(
                 "level {level} edge {edge}: reached {depth} mm, F {:.6e} N, {} increments, {:.1} s",
                 sim.forces.last().unwrap(),

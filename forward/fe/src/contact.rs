@@ -90,8 +90,10 @@ pub enum ContactPoints {
     /// Along every straight edge (2D `Line2` facets), Gauss points on each
     /// stretch between the points where the tool's piece changes or the
     /// force starts ([`crate::contact_split`]), so that the assembled force
-    /// has no kinks. A pure penalty (no multipliers: the points move along
-    /// the edge), frictionless only.
+    /// has no kinks. A pure penalty (the points move along the edge, so they
+    /// carry no multipliers; nodal multipliers interpolated along the edges
+    /// were tried and load a band beyond the contact's end,
+    /// docs/validation/fe.md "Q1"). Frictionless only.
     EdgeSplit,
 }
 
@@ -177,9 +179,9 @@ pub struct RigidContact {
     /// augmented since the last commit).
     lambda: Vec<f64>,
     forces: Vec<PointForce>,
-    /// [`ContactPoints::EdgeSplit`]: per facet, its reference length and
-    /// volume factors at its two nodes.
-    split: Vec<(f64, f64, f64)>,
+    /// [`ContactPoints::EdgeSplit`]: per facet its reference length and the
+    /// volume factors at its two nodes (`None` for the fixed points).
+    split: Option<Vec<(f64, f64, f64)>>,
 }
 
 impl RigidContact {
@@ -222,8 +224,9 @@ impl RigidContact {
         let set = mesh.facet_set(facets)?;
         let points = contact_points(mesh, set, kinematics, options.points)?;
         let facets: Vec<Vec<usize>> = set.iter().map(|f| f.to_vec()).collect();
-        let mut split = Vec::new();
+        let mut split = None;
         if options.points == ContactPoints::EdgeSplit {
+            let mut edges = Vec::new();
             if set.cell_type != CellType::Line2 || options.friction > 0.0 {
                 return Err(bad(
                     "split edge contact needs 2-node edges and no friction".into()
@@ -232,12 +235,13 @@ impl RigidContact {
             for f in &facets {
                 let (pa, pb) = (mesh.nodes[f[0]], mesh.nodes[f[1]]);
                 let len = ((pa[0] - pb[0]).powi(2) + (pa[1] - pb[1]).powi(2)).sqrt();
-                split.push((
+                edges.push((
                     len,
                     kinematics.volume_factor(pa[0]),
                     kinematics.volume_factor(pb[0]),
                 ));
             }
+            split = Some(edges);
         }
         let mut c = RigidContact {
             name: name.into(),
@@ -297,74 +301,81 @@ impl RigidContact {
     }
 }
 
+/// The evaluated points of every edge of `facets` (with `edges`' reference
+/// lengths and volume factors at the two nodes), placed for the current
+/// configuration ([`crate::contact_split`]) and evaluated with a pure
+/// penalty: the facet, its shape weights, trial state and force.
+fn split_points(
+    tool: &Tool,
+    facets: &[Vec<usize>],
+    edges: &[(f64, f64, f64)],
+    ctx: &AssemblyContext,
+) -> Vec<(usize, [f64; 2], PointHistory, PointForce)> {
+    use crate::contact_split::{split_edge_points, SplitEdge};
+    let onset = 0.5 * tool.smoothing;
+    let none = PointHistory::default();
+    let mut out = Vec::new();
+    for (k, f) in facets.iter().enumerate() {
+        let (len0, va, vb) = edges[k];
+        let edge = SplitEdge {
+            xa: ctx.position(f[0]),
+            xb: ctx.position(f[1]),
+            len0,
+            va,
+            vb,
+        };
+        for q in split_edge_points(tool.surface, tool.pose, &edge, onset) {
+            let (t, pf) = tool.point(q.area, 0.0, &none, q.x);
+            if pf.force != [0.0; 3] || pf.stiffness != [[0.0; 3]; 3] {
+                out.push((k, q.weights, t, pf));
+            }
+        }
+    }
+    out
+}
+
 /// [`Contribution::assemble`] with [`ContactPoints::EdgeSplit`]: the
-/// points of every edge (`facets`, with `split`'s reference lengths and
-/// volume factors) are placed for the current configuration and evaluated
-/// with a pure penalty (no multiplier, no history); their states and
-/// forces replace `state`.
+/// points' states and forces replace `state`.
 fn assemble_split(
     tool: &Tool,
     facets: &[Vec<usize>],
-    split: &[(f64, f64, f64)],
+    edges: &[(f64, f64, f64)],
     ctx: &AssemblyContext,
     out: &mut Assembly,
     state: (&mut Vec<PointHistory>, &mut Vec<PointForce>),
 ) -> Result<(), FeError> {
-    {
-        let (trial, forces) = state;
-        let dim = ctx.dofs.dim;
-        let onset = 0.5 * tool.smoothing;
-        forces.clear();
-        trial.clear();
-        let none = PointHistory::default();
-        for (k, f) in facets.iter().enumerate() {
-            let (len0, va, vb) = split[k];
-            let (xa, xb) = (ctx.position(f[0]), ctx.position(f[1]));
-            let pts = crate::contact_split::split_edge_points(
-                tool.surface,
-                tool.pose,
-                xa,
-                xb,
-                len0,
-                va,
-                vb,
-                onset,
-            );
-            for q in pts {
-                let (t, pf) = tool.point(q.area, 0.0, &none, q.x);
-                if pf.force == [0.0; 3] && pf.stiffness == [[0.0; 3]; 3] {
-                    continue;
-                }
-                out.force_scale2 += (0..dim).map(|i| pf.force[i].powi(2)).sum::<f64>();
-                for a in 0..2 {
-                    let na = f[a];
-                    let wa = q.weights[a];
-                    for i in 0..dim {
-                        out.fint[na * dim + i] -= wa * pf.force[i];
-                    }
-                    if out.values.is_none() {
-                        continue;
-                    }
-                    for b in 0..2 {
-                        let wab = wa * q.weights[b];
-                        let nb = f[b];
-                        for i in 0..dim {
-                            for j in 0..dim {
-                                out.add_entry(
-                                    na * dim + i,
-                                    nb * dim + j,
-                                    -wab * pf.stiffness[i][j],
-                                );
-                            }
-                        }
+    let (trial, forces) = state;
+    let dim = ctx.dofs.dim;
+    forces.clear();
+    trial.clear();
+    for (k, w, t, pf) in split_points(tool, facets, edges, ctx) {
+        let f = &facets[k];
+        out.force_scale2 += (0..dim).map(|i| pf.force[i].powi(2)).sum::<f64>();
+        for a in 0..2 {
+            let na = f[a];
+            for i in 0..dim {
+                out.fint[na * dim + i] -= w[a] * pf.force[i];
+            }
+            if out.values.is_none() {
+                continue;
+            }
+            for b in 0..2 {
+                let nb = f[b];
+                for i in 0..dim {
+                    for j in 0..dim {
+                        out.add_entry(
+                            na * dim + i,
+                            nb * dim + j,
+                            -w[a] * w[b] * pf.stiffness[i][j],
+                        );
                     }
                 }
-                trial.push(t);
-                forces.push(pf);
             }
         }
-        Ok(())
+        trial.push(t);
+        forces.push(pf);
     }
+    Ok(())
 }
 
 /// Contact points of a facet set.
@@ -712,11 +723,11 @@ impl Contribution for RigidContact {
             smoothing: self.smoothing,
             dim,
         };
-        if !self.split.is_empty() {
+        if let Some(split) = &self.split {
             return assemble_split(
                 &tool,
                 &self.facets,
-                &self.split,
+                split,
                 ctx,
                 out,
                 (&mut self.trial, &mut self.forces),
@@ -763,7 +774,7 @@ impl Contribution for RigidContact {
     }
 
     fn augment(&mut self) -> bool {
-        if !self.split.is_empty()
+        if self.split.is_some()
             || self.pure_penalty
             || self.max_penetration() <= self.options.penetration_tol
         {

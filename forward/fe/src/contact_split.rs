@@ -57,23 +57,39 @@ const GAUSS5: [(f64, f64); 5] = [
 /// Samples along the edge at which the piece is read before bisection.
 const SAMPLES: usize = 8;
 
-/// The quadrature points of the edge from `xa` to `xb` (current positions)
-/// whose reference length is `len0` and whose reference volume factors at
-/// its ends are `va`, `vb` (linear along the edge), against the tool
-/// `surface` at `pose`, for a normal force that starts at gap `onset`.
-/// Empty when the edge cannot touch the tool (`g_a + g_b > |xb - xa| +
-/// 2 onset`: the gap is 1-Lipschitz along the edge).
-#[allow(clippy::too_many_arguments)]
+/// A straight edge of the body's surface for [`split_edge_points`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SplitEdge {
+    /// Current positions of its two nodes.
+    pub xa: [f64; 3],
+    pub xb: [f64; 3],
+    /// Reference length, and the volume factors at its two nodes (linear
+    /// along the edge).
+    pub len0: f64,
+    pub va: f64,
+    pub vb: f64,
+}
+
+/// The quadrature points of `edge` against the tool `surface` at `pose`,
+/// for a pure-penalty normal force `t_N = eps (-g)` softened over `|g| <
+/// onset` (half the width of [`crate::contact::RigidContact::smoothing`];
+/// 0: the sharp law). The stretches are cut where the piece changes and
+/// where `g` crosses `onset` (the force starts) and `-onset` (the softened
+/// law turns linear). Empty when the edge cannot touch the tool (`g_a + g_b
+/// > |xb - xa| + 2 onset`: the gap is 1-Lipschitz).
 pub fn split_edge_points(
     surface: &dyn RigidSurface,
     pose: &Pose,
-    xa: [f64; 3],
-    xb: [f64; 3],
-    len0: f64,
-    va: f64,
-    vb: f64,
+    edge: &SplitEdge,
     onset: f64,
 ) -> Vec<SplitPoint> {
+    let SplitEdge {
+        xa,
+        xb,
+        len0,
+        va,
+        vb,
+    } = *edge;
     let at = |s: f64| -> [f64; 3] {
         let (wa, wb) = (0.5 * (1.0 - s), 0.5 * (1.0 + s));
         std::array::from_fn(|i| wa * xa[i] + wb * xb[i])
@@ -197,13 +213,22 @@ mod tests {
         ToolMotion::translating([0.0, 0.0, 0.0], vec![]).pose(&[])
     }
 
+    fn edge(a: [f64; 2], b: [f64; 2]) -> SplitEdge {
+        SplitEdge {
+            xa: [a[0], a[1], 0.0],
+            xb: [b[0], b[1], 0.0],
+            len0: 0.2,
+            va: 1.0,
+            vb: 1.0,
+        }
+    }
+
     #[test]
     fn the_points_integrate_the_edge_and_cut_at_the_pieces() {
         let (s, p) = (punch(), pose());
         // an edge under the punch, 0.01 mm into the face, crossing the
         // face-rounding junction at r = 1.8
-        let (xa, xb) = ([1.7, 0.01, 0.0], [1.9, 0.01, 0.0]);
-        let pts = split_edge_points(&s, &p, xa, xb, 0.2, 1.0, 1.0, 0.0);
+        let pts = split_edge_points(&s, &p, &edge([1.7, 0.01], [1.9, 0.01]), 0.0);
         let total: f64 = pts.iter().map(|q| q.area).sum();
         // the stretch in contact ends where the rounding lifts off the edge
         // (z = 0.01 above the face: r = 1.8 + sqrt(0.2^2 - 0.19^2))
@@ -220,16 +245,7 @@ mod tests {
 
     #[test]
     fn an_edge_clear_of_the_tool_has_no_points() {
-        let pts = split_edge_points(
-            &punch(),
-            &pose(),
-            [2.5, 0.01, 0.0],
-            [2.7, 0.01, 0.0],
-            0.2,
-            1.0,
-            1.0,
-            0.0,
-        );
+        let pts = split_edge_points(&punch(), &pose(), &edge([2.5, 0.01], [2.7, 0.01]), 0.0);
         assert!(pts.is_empty());
     }
 }
@@ -253,7 +269,14 @@ mod fd_tests {
         let eps = 10.0;
         let mut f = [0.0; 4];
         let mut k = [[0.0; 4]; 4];
-        for q in split_edge_points(&s, &p, xa, xb, 0.2, 1.0, 1.0, onset) {
+        let edge = SplitEdge {
+            xa,
+            xb,
+            len0: 0.2,
+            va: 1.0,
+            vb: 1.0,
+        };
+        for q in split_edge_points(&s, &p, &edge, onset) {
             let pr = p.project(&s, q.x);
             let tn = -eps * q.area * (pr.gap - onset).min(0.0);
             if tn <= 0.0 {
