@@ -10,7 +10,9 @@
 //! nodes; `LINE=slope` the slope line search; `STAG=` the relative
 //! residual at which a stagnating increment is accepted; `HOLD=` seconds: viscoelastic ramp in 0.5 s and hold; `SELF=0` without the
 //! surface's self-contact; `BULK=` a bulk modulus of BULK x mu instead of
-//! the exact constraint).
+//! the exact constraint; `GAUSS=1` contact at fixed Gauss points of the
+//! edges instead of the split quadrature; `PROX=` the proximal
+//! stabilisation, 0 off; `CURVE=1` prints the force at every sample).
 use palpate_core::{Drive, ForwardError, Loading};
 use palpate_fe::mesh::jacobian::corner_jacobians;
 use palpate_fe::Q1Punch;
@@ -43,8 +45,8 @@ fn main() {
     if let Ok(v) = std::env::var("PROX") {
         m.options.stabilisation = v.parse().unwrap();
     }
-    if std::env::var("SPLIT").as_deref() == Ok("1") {
-        m.contact_points = palpate_fe::ContactPoints::EdgeSplit;
+    if std::env::var("GAUSS").as_deref() == Ok("1") {
+        m.contact_points = palpate_fe::ContactPoints::EdgeGauss;
     }
     if let Ok(v) = std::env::var("STAG") {
         m.options.stagnation_tolerance = v.parse().unwrap();
