@@ -124,7 +124,7 @@ impl ContactPoint {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct PointHistory {
+pub(crate) struct PointHistory {
     /// 2D stick point (tool-frame arc length), when in contact.
     stick: Option<f64>,
     /// 3D stick point (tool-frame coordinates of the tool's material point
@@ -144,9 +144,9 @@ struct PointHistory {
 /// Force on the body at a contact point and its derivative with respect
 /// to the point's position.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-struct PointForce {
-    force: [f64; 3],
-    stiffness: [[f64; 3]; 3],
+pub(crate) struct PointForce {
+    pub(crate) force: [f64; 3],
+    pub(crate) stiffness: [[f64; 3]; 3],
 }
 
 /// A rigid tool and the body surface that may touch it.
@@ -301,83 +301,6 @@ impl RigidContact {
     }
 }
 
-/// The evaluated points of every edge of `facets` (with `edges`' reference
-/// lengths and volume factors at the two nodes), placed for the current
-/// configuration ([`crate::contact_split`]) and evaluated with a pure
-/// penalty: the facet, its shape weights, trial state and force.
-fn split_points(
-    tool: &Tool,
-    facets: &[Vec<usize>],
-    edges: &[(f64, f64, f64)],
-    ctx: &AssemblyContext,
-) -> Vec<(usize, [f64; 2], PointHistory, PointForce)> {
-    use crate::contact_split::{split_edge_points, SplitEdge};
-    let onset = 0.5 * tool.smoothing;
-    let none = PointHistory::default();
-    let mut out = Vec::new();
-    for (k, f) in facets.iter().enumerate() {
-        let (len0, va, vb) = edges[k];
-        let edge = SplitEdge {
-            xa: ctx.position(f[0]),
-            xb: ctx.position(f[1]),
-            len0,
-            va,
-            vb,
-        };
-        for q in split_edge_points(tool.surface, tool.pose, &edge, onset) {
-            let (t, pf) = tool.point(q.area, 0.0, &none, q.x);
-            if pf.force != [0.0; 3] || pf.stiffness != [[0.0; 3]; 3] {
-                out.push((k, q.weights, t, pf));
-            }
-        }
-    }
-    out
-}
-
-/// [`Contribution::assemble`] with [`ContactPoints::EdgeSplit`]: the
-/// points' states and forces replace `state`.
-fn assemble_split(
-    tool: &Tool,
-    facets: &[Vec<usize>],
-    edges: &[(f64, f64, f64)],
-    ctx: &AssemblyContext,
-    out: &mut Assembly,
-    state: (&mut Vec<PointHistory>, &mut Vec<PointForce>),
-) -> Result<(), FeError> {
-    let (trial, forces) = state;
-    let dim = ctx.dofs.dim;
-    forces.clear();
-    trial.clear();
-    for (k, w, t, pf) in split_points(tool, facets, edges, ctx) {
-        let f = &facets[k];
-        out.force_scale2 += (0..dim).map(|i| pf.force[i].powi(2)).sum::<f64>();
-        for a in 0..2 {
-            let na = f[a];
-            for i in 0..dim {
-                out.fint[na * dim + i] -= w[a] * pf.force[i];
-            }
-            if out.values.is_none() {
-                continue;
-            }
-            for b in 0..2 {
-                let nb = f[b];
-                for i in 0..dim {
-                    for j in 0..dim {
-                        out.add_entry(
-                            na * dim + i,
-                            nb * dim + j,
-                            -w[a] * w[b] * pf.stiffness[i][j],
-                        );
-                    }
-                }
-            }
-        }
-        trial.push(t);
-        forces.push(pf);
-    }
-    Ok(())
-}
-
 /// Contact points of a facet set.
 fn contact_points(
     mesh: &Mesh,
@@ -509,14 +432,14 @@ fn facet_shape(ct: CellType, xi: &[f64; 3], x: &[[f64; 3]]) -> ([f64; MAX_NODES]
 }
 
 /// What the evaluation of a contact point needs of its tool.
-struct Tool<'a> {
-    surface: &'a dyn RigidSurface,
+pub(crate) struct Tool<'a> {
+    pub(crate) surface: &'a dyn RigidSurface,
     /// The pose of the current evaluation and of the last commit.
-    pose: &'a Pose,
+    pub(crate) pose: &'a Pose,
     pose_committed: &'a Pose,
     options: &'a ContactOptions,
     /// [`RigidContact::smoothing`].
-    smoothing: f64,
+    pub(crate) smoothing: f64,
     dim: usize,
 }
 
@@ -524,7 +447,7 @@ impl Tool<'_> {
     /// The trial history and the force (on the body) of a contact point of
     /// reference area `area` at position `x`, with normal multiplier
     /// `lambda` and committed history `c`.
-    fn point(
+    pub(crate) fn point(
         &self,
         area: f64,
         lambda: f64,
@@ -724,7 +647,7 @@ impl Contribution for RigidContact {
             dim,
         };
         if let Some(split) = &self.split {
-            return assemble_split(
+            return crate::contact_split::assemble_split(
                 &tool,
                 &self.facets,
                 split,

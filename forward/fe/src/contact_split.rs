@@ -29,11 +29,17 @@
 //! straight edge, so it has one minimum (golden section) and at most one
 //! such crossing on each side of it.
 //!
+//! `assemble_split` is [`crate::contact::RigidContact`]'s assembly in
+//! this mode ([`crate::ContactPoints::EdgeSplit`]).
+//!
 //! Written here rather than taken from a crate: it is a few bisections on
 //! the tool's own projection, which no quadrature crate knows of.
 
+use crate::contact::{PointForce, PointHistory, Tool};
+use crate::contribution::{Assembly, AssemblyContext};
 use crate::motion::Pose;
 use crate::surface::RigidSurface;
+use crate::FeError;
 
 /// A quadrature point of a split edge: the shape-function weights of the
 /// edge's two nodes, the current position and the reference area (the
@@ -193,6 +199,82 @@ pub fn split_edge_points(
         }
     }
     out
+}
+
+/// The evaluated points of every edge of `facets` (with `edges`' reference
+/// lengths and volume factors at the two nodes), placed for the current
+/// configuration ([`crate::contact_split`]) and evaluated with a pure
+/// penalty: the facet, its shape weights, trial state and force.
+fn split_points(
+    tool: &Tool,
+    facets: &[Vec<usize>],
+    edges: &[(f64, f64, f64)],
+    ctx: &AssemblyContext,
+) -> Vec<(usize, [f64; 2], PointHistory, PointForce)> {
+    let onset = 0.5 * tool.smoothing;
+    let none = PointHistory::default();
+    let mut out = Vec::new();
+    for (k, f) in facets.iter().enumerate() {
+        let (len0, va, vb) = edges[k];
+        let edge = SplitEdge {
+            xa: ctx.position(f[0]),
+            xb: ctx.position(f[1]),
+            len0,
+            va,
+            vb,
+        };
+        for q in split_edge_points(tool.surface, tool.pose, &edge, onset) {
+            let (t, pf) = tool.point(q.area, 0.0, &none, q.x);
+            if pf.force != [0.0; 3] || pf.stiffness != [[0.0; 3]; 3] {
+                out.push((k, q.weights, t, pf));
+            }
+        }
+    }
+    out
+}
+
+/// [`Contribution::assemble`] with [`ContactPoints::EdgeSplit`]: the
+/// points' states and forces replace `state`.
+pub(crate) fn assemble_split(
+    tool: &Tool,
+    facets: &[Vec<usize>],
+    edges: &[(f64, f64, f64)],
+    ctx: &AssemblyContext,
+    out: &mut Assembly,
+    state: (&mut Vec<PointHistory>, &mut Vec<PointForce>),
+) -> Result<(), FeError> {
+    let (trial, forces) = state;
+    let dim = ctx.dofs.dim;
+    forces.clear();
+    trial.clear();
+    for (k, w, t, pf) in split_points(tool, facets, edges, ctx) {
+        let f = &facets[k];
+        out.force_scale2 += (0..dim).map(|i| pf.force[i].powi(2)).sum::<f64>();
+        for a in 0..2 {
+            let na = f[a];
+            for i in 0..dim {
+                out.fint[na * dim + i] -= w[a] * pf.force[i];
+            }
+            if out.values.is_none() {
+                continue;
+            }
+            for b in 0..2 {
+                let nb = f[b];
+                for i in 0..dim {
+                    for j in 0..dim {
+                        out.add_entry(
+                            na * dim + i,
+                            nb * dim + j,
+                            -w[a] * w[b] * pf.stiffness[i][j],
+                        );
+                    }
+                }
+            }
+        }
+        trial.push(t);
+        forces.push(pf);
+    }
+    Ok(())
 }
 
 #[cfg(test)]
