@@ -76,10 +76,13 @@ pub struct SolverOptions {
     /// `C = beta diag(K)` on the free displacements, each anchored at the
     /// last one's solution (proximal point iterations, Rockafellar 1976;
     /// the viscous stabilisation of Abaqus's `*STATIC, STABILIZE` with the
-    /// viscous force driven to zero), trying plain Newton after each. The
-    /// accepted state is an equilibrium of `R` alone: the term only carries
-    /// Newton across a local snap (a surface edge draped over a tool's
-    /// rounded corner, Q1). 0 (default): off.
+    /// viscous force driven to zero), trying plain Newton (8 iterations)
+    /// after each; `C` is halved after a failed try and quadrupled from the
+    /// same anchor when a proximal solve fails, for at most 40 steps. The
+    /// accepted state is one plain Newton accepts (its tolerances, the
+    /// stagnation one included), an equilibrium of `R` alone: the term only
+    /// carries Newton across a local snap (a surface edge draped over a
+    /// tool's rounded corner, Q1). 0 (default): off.
     pub stabilisation: f64,
 }
 
@@ -611,14 +614,15 @@ impl System {
         target: &Target,
         opts: &SolverOptions,
     ) -> Result<(), FeError> {
-        let start = self.u.clone();
-        match self.newton(target, opts) {
-            Ok(()) => {}
-            Err(e) if opts.stabilisation > 0.0 && e.is_recoverable() => {
+        // the start is kept only when a failure may be stabilised
+        let start = (opts.stabilisation > 0.0).then(|| self.u.clone());
+        match (self.newton(target, opts), start) {
+            (Ok(()), _) => {}
+            (Err(e), Some(start)) if e.is_recoverable() => {
                 self.u = start;
                 self.stabilised_newton(target, opts, e)?;
             }
-            Err(e) => return Err(e),
+            (Err(e), _) => return Err(e),
         }
         for _ in 0..opts.max_augmentations {
             let mut changed = false;
