@@ -19,7 +19,10 @@
 //! * `truth.json`: the parameters, the noise and the noise-free forces.
 //!
 //! The record is committed; rerun only to change it:
-//! `cargo run --release -p palpate-tests --example make_two_stage_q1`
+//! `cargo run --release -p palpate-tests --example make_two_stage_q1`.
+//! With env `Q1_RECORD_DEPTH=D` (mm) the ramp goes to D instead, into
+//! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of BENCHMARKS.md runs
+//! since session 16's contact; its fit is a study, not a test).
 //! (`-- --time LEVEL DT` instead times one run of the record's history).
 
 use palpate_core::{Drive, ForwardModel, Loading};
@@ -33,18 +36,26 @@ use std::path::Path;
 /// The truth: C10 (MPa), g1, tau1 (s), g2, tau2 (s).
 const TRUTH: [f64; 5] = [0.0016, 0.3, 0.5, 0.2, 10.0];
 const DEPTH: f64 = 1.0;
+
+/// The record's depth: `DEPTH` unless env `Q1_RECORD_DEPTH` says.
+fn depth() -> f64 {
+    std::env::var("Q1_RECORD_DEPTH").ok().map_or(DEPTH, |v| {
+        v.parse().expect("Q1_RECORD_DEPTH: a depth in mm")
+    })
+}
 const RAMP: f64 = 0.5;
 const HOLD: f64 = 60.0;
 
 /// The record's times and depths.
 fn history() -> (Vec<f64>, Vec<f64>) {
+    let depth = depth();
     let mut t: Vec<f64> = (0..=20).map(|i| RAMP * i as f64 / 20.0).collect();
-    let mut d: Vec<f64> = (0..=20).map(|i| DEPTH * i as f64 / 20.0).collect();
+    let mut d: Vec<f64> = (0..=20).map(|i| depth * i as f64 / 20.0).collect();
     let (first, n) = (0.02f64, 40);
     let ratio = (HOLD / first).powf(1.0 / (n - 1) as f64);
     for k in 0..n {
         t.push(RAMP + first * ratio.powi(k));
-        d.push(DEPTH);
+        d.push(depth);
     }
     (t, d)
 }
@@ -88,8 +99,14 @@ fn main() {
         }
         return;
     }
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/two-stage-q1");
-    std::fs::create_dir_all(&dir).expect("create data/two-stage-q1");
+    let depth = depth();
+    let sub = if depth == DEPTH {
+        "data/two-stage-q1".to_string()
+    } else {
+        format!("data/two-stage-q1-{depth}mm")
+    };
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(&sub);
+    std::fs::create_dir_all(&dir).expect("create the record's folder");
     let f = model(2, 0.25)
         .predict(&TRUTH[..1], &loading)
         .expect("the fine run");
@@ -100,7 +117,7 @@ fn main() {
     let mut csv = format!(
         "# synthetic Q1 ramp-and-hold record (tests/examples/make_two_stage_q1.rs): flat punch r 2 mm \
          (edge 0.2 mm), neo-Hookean C10 = {} MPa, Prony g1 = {}, tau1 = {} s, g2 = {}, tau2 = {} s, \
-         {DEPTH} mm in {RAMP} s, hold {HOLD} s, mesh level 2, time step 0.25 s, noise sd {sd:.4e} N (seed 13)\n\
+         {depth} mm in {RAMP} s, hold {HOLD} s, mesh level 2, time step 0.25 s, noise sd {sd:.4e} N (seed 13)\n\
          time_s,displacement_mm,force_N\n",
         TRUTH[0], TRUTH[1], TRUTH[2], TRUTH[3], TRUTH[4]
     );
@@ -113,7 +130,7 @@ fn main() {
     std::fs::write(dir.join("record.csv"), csv).expect("write the record");
     let truth = format!(
         "{{\"parameters\": {{\"C10\": {}, \"g1\": {}, \"tau1_s\": {}, \"g2\": {}, \"tau2_s\": {}}},\n \
-         \"depth_mm\": {DEPTH}, \"ramp_s\": {RAMP}, \"hold_s\": {HOLD}, \"mesh_level\": 2, \
+         \"depth_mm\": {depth}, \"ramp_s\": {RAMP}, \"hold_s\": {HOLD}, \"mesh_level\": 2, \
          \"max_time_step_s\": 0.25, \"noise_sd_N\": {sd:.6e}, \"seed\": 13,\n \
          \"noise_free_force_N\": [{}]}}\n",
         TRUTH[0],

@@ -148,6 +148,16 @@ pub struct HistoryError {
     pub max_relative_error: f64,
 }
 
+/// One FE history of a build: its name (`training k` or `random k`), its
+/// segment ends `(time_s, depth_mm)` and the FE force at its stations
+/// `(time_s, force_n)`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StoredRun {
+    pub name: String,
+    pub knots: Vec<(f64, f64)>,
+    pub stations: Vec<(f64, f64)>,
+}
+
 /// The stored surrogate and its state (the state is not stored).
 #[derive(Debug, Clone, Serialize, Deserialize)]
 pub struct RealTimeSurrogate {
@@ -176,6 +186,11 @@ pub struct RealTimeSurrogate {
     /// `validation`), with the reason.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub validation_failures: Vec<String>,
+    /// The FE histories of the build (training first, then held out) with
+    /// their FE forces, so the memory can be refitted without FE
+    /// ([`RealTimeSurrogate::refit`]); empty in files of older builds.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub runs: Vec<StoredRun>,
     /// FE runs and wall time of the build.
     pub fe_runs: usize,
     pub build_time_s: f64,
@@ -230,6 +245,7 @@ impl RealTimeSurrogate {
             qlv_validation: Vec::new(),
             training_failures: Vec::new(),
             validation_failures: Vec::new(),
+            runs: Vec::new(),
             fe_runs: 0,
             build_time_s: 0.0,
             state: State::default(),
@@ -347,6 +363,7 @@ impl RealTimeSurrogate {
         out.qlv_validation = s.qlv_validation;
         out.training_failures = s.training_failures;
         out.validation_failures = s.validation_failures;
+        out.runs = s.runs;
         out.reset();
         out.fe_runs = s.fe_runs;
         out.build_time_s = s.build_time_s;

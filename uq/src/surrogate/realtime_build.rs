@@ -7,7 +7,7 @@
 
 use super::depth_history::{random_history, History};
 use super::memory_kernel::{MemoryKernel, TrainingRun};
-use super::realtime::{HistoryError, MonotoneCubic, RealTimeSurrogate};
+use super::realtime::{HistoryError, MonotoneCubic, RealTimeSurrogate, StoredRun};
 
 /// What a build runs: the elastic and viscoelastic forms of one model (the
 /// same FE model without and with its Prony series), their parameters, the
@@ -150,6 +150,17 @@ impl RealTimeSurrogate {
             ));
         }
         s.validation_failures = held_failed;
+        s.runs = jobs
+            .iter()
+            .zip(&fe_ok)
+            .filter_map(|((name, h, _), st)| {
+                st.as_ref().map(|st| StoredRun {
+                    name: name.clone(),
+                    knots: h.knots.clone(),
+                    stations: st.clone(),
+                })
+            })
+            .collect();
         let held = (train..jobs.len())
             .filter_map(|j| fe_ok[j].as_ref().map(|st| (&jobs[j].0, &jobs[j].1, st)));
         if train > 0 {
@@ -191,6 +202,49 @@ impl RealTimeSurrogate {
         s.fe_runs = total;
         s.build_time_s = t0.elapsed().as_secs_f64();
         Ok(s)
+    }
+
+    /// Fits the memory again, with `kernel_knots` hat functions, to the
+    /// stored FE training runs of the build (no FE run), and recomputes the
+    /// held-out errors on the stored held-out runs. An error if the file
+    /// holds no runs (a build older than the stored runs) or too few.
+    pub fn refit(&mut self, kernel_knots: usize) -> Result<(), String> {
+        let hist = |r: &StoredRun| History::from_knots(r.knots.clone(), 1e-3);
+        let training: Vec<(History, &StoredRun)> = self
+            .runs
+            .iter()
+            .filter(|r| r.name.starts_with("training"))
+            .map(|r| (hist(r), r))
+            .collect();
+        if training.is_empty() {
+            return Err("the surrogate file holds no FE training runs to refit to (built before they were stored, or with --train 0)".into());
+        }
+        let runs: Vec<TrainingRun<'_>> = training
+            .iter()
+            .map(|(h, r)| TrainingRun {
+                history: h,
+                stations: &r.stations,
+            })
+            .collect();
+        let taus: Vec<f64> = self.prony.iter().map(|p| p.1).collect();
+        self.kernel = Some(MemoryKernel::fit(
+            self.depth_max,
+            kernel_knots,
+            &taus,
+            &runs,
+        )?);
+        let held: Vec<StoredRun> = self
+            .runs
+            .iter()
+            .filter(|r| r.name.starts_with("random"))
+            .cloned()
+            .collect();
+        self.validation = held
+            .iter()
+            .map(|r| self.error_on(&r.name, &hist(r), &r.stations))
+            .collect::<Result<_, _>>()?;
+        self.reset();
+        Ok(())
     }
 
     /// Runs `history` through the FE model (stations: the segment ends and
@@ -405,10 +459,24 @@ mod tests {
             assert!(v.max_relative_error < 1e-2, "{v:?}");
             assert!(q.max_relative_error > 2e-2, "{q:?}");
         }
+        // the stored FE runs come back from the file and refit the same
+        // memory without an FE run
+        assert_eq!(s.runs.len(), 15);
+        let mut back = RealTimeSurrogate::from_json(&s.to_json()).unwrap();
+        assert_eq!(back.runs, s.runs);
+        back.refit(10).unwrap();
+        for (a, b) in back.validation.iter().zip(&s.validation) {
+            assert!(
+                (a.max_relative_error - b.max_relative_error).abs() < 1e-12,
+                "{a:?} {b:?}"
+            );
+        }
         // without training histories: plain QLV, as before
         let plain =
             RealTimeSurrogate::build(&tissue_request(&elastic, &viscoelastic, 0), None).unwrap();
         assert!(plain.kernel.is_none() && plain.qlv_validation.is_empty());
+        let mut none = RealTimeSurrogate::from_json(&plain.to_json()).unwrap();
+        assert!(none.refit(10).unwrap_err().contains("no FE training runs"));
         for (p, q) in plain.validation.iter().zip(&s.qlv_validation) {
             assert_eq!(p.max_relative_error, q.max_relative_error);
         }
