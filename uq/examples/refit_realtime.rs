@@ -26,10 +26,11 @@ fn main() {
     );
     for v in &s.validation {
         println!(
-            "{}: {:.2} % of peak {:.4} N",
+            "{}: {:.2} % of peak {:.4} N at (s, mm) {:?}",
             v.history,
             100.0 * v.max_relative_error,
-            v.peak_force_n
+            v.peak_force_n,
+            v.worst_at
         );
     }
     if std::env::var("STATIONS").is_ok() {

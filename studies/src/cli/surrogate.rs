@@ -267,22 +267,24 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
         let _ = writeln!(r, "not in the error table: {f}\n");
     }
     r.push_str(
-        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak |",
+        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak | where (s, mm) |",
     );
     r.push_str(if with_qlv {
-        " plain QLV: max error / peak |\n|---|---|---|---|---|---|\n"
+        " plain QLV: max error / peak |\n|---|---|---|---|---|---|---|\n"
     } else {
-        "\n|---|---|---|---|---|\n"
+        "\n|---|---|---|---|---|---|\n"
     });
     for (j, h) in s.validation.iter().enumerate() {
         let _ = write!(
             r,
-            "| {} | {} | {:.4e} | {:.3e} | {:.2} % |",
+            "| {} | {} | {:.4e} | {:.3e} | {:.2} % | {} |",
             h.history,
             h.samples,
             h.peak_force_n,
             h.max_abs_error_n,
-            100.0 * h.max_relative_error
+            100.0 * h.max_relative_error,
+            h.worst_at
+                .map_or("-".to_string(), |(t, d)| format!("{t:.2}, {d:.2}"))
         );
         if with_qlv {
             let _ = write!(

@@ -146,6 +146,10 @@ pub struct HistoryError {
     pub peak_force_n: f64,
     pub max_abs_error_n: f64,
     pub max_relative_error: f64,
+    /// Where that error is: the station's `(time_s, depth_mm)`; none in
+    /// older files.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub worst_at: Option<(f64, f64)>,
 }
 
 /// One FE history of a build: its name (`training k` or `random k`), its

@@ -274,16 +274,21 @@ impl RealTimeSurrogate {
             .run(&history.time, &history.depth)
             .map_err(|(k, e)| format!("{name}, sample {k}: {e}"))?;
         let peak = stations.iter().map(|s| s.1).fold(0.0, f64::max);
-        let worst = stations
-            .iter()
-            .map(|&(t, f)| (forces[history.sample_at(t)] - f).abs())
-            .fold(0.0, f64::max);
+        let (mut worst, mut at) = (0.0, None);
+        for &(t, f) in stations {
+            let k = history.sample_at(t);
+            let e = (forces[k] - f).abs();
+            if e > worst || at.is_none() {
+                (worst, at) = (e, Some((t, history.depth[k])));
+            }
+        }
         Ok(HistoryError {
             history: name.to_string(),
             samples: stations.len(),
             peak_force_n: peak,
             max_abs_error_n: worst,
             max_relative_error: worst / peak,
+            worst_at: at,
         })
     }
 }
@@ -456,6 +461,8 @@ mod tests {
         assert_eq!(s.validation.len(), 3);
         assert!(s.training_failures.is_empty() && s.validation_failures.is_empty());
         for (v, q) in s.validation.iter().zip(&s.qlv_validation) {
+            let (t, d) = v.worst_at.expect("where the largest error is");
+            assert!(t > 0.0 && (0.0..=1.0).contains(&d), "{v:?}");
             assert!(v.max_relative_error < 1e-2, "{v:?}");
             assert!(q.max_relative_error > 2e-2, "{q:?}");
         }
