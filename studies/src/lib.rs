@@ -26,3 +26,5 @@ pub mod sample_step;
 pub mod shard;
 pub mod surrogate;
 pub mod two_stage;
+pub mod two_stage_report;
+pub mod two_stage_step;

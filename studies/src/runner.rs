@@ -318,7 +318,7 @@ pub fn run_study_counted(
                 crate::predict_step::run_predict(&run, p, &results.steps, &mut report)?
             }
             Step::Anova(a) => crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?,
-            Step::TwoStage(t) => crate::two_stage::run_two_stage(&run, t, &mut report)?,
+            Step::TwoStage(t) => crate::two_stage_step::run_two_stage(&run, t, &mut report)?,
             Step::Localize(l) => crate::localize_step::run_localize(&run, l, &mut report)?,
             Step::Sample(p) => crate::sample_step::run_sample(&run, p, &mut report)?,
         };
