@@ -144,6 +144,35 @@ impl TwoStageOptions {
         Ok(stages)
     }
 
+    /// Sets the number of Prony terms (1 to 4), or says why not.
+    pub fn set_terms(&mut self, n: usize) -> Result<(), String> {
+        if !(1..=4).contains(&n) {
+            return Err("give 1 to 4 Prony terms".into());
+        }
+        self.terms = n;
+        Ok(())
+    }
+
+    /// Sets the fit mesh's element size under the punch (mm, 0.02..1), or
+    /// says why not.
+    pub fn set_fit_mesh(&mut self, h: f64) -> Result<(), String> {
+        if !(h.is_finite() && (0.02..=1.0).contains(&h)) {
+            return Err("the element size under the punch must lie in 0.02..1 mm".into());
+        }
+        self.h_fine = h;
+        Ok(())
+    }
+
+    /// Sets the largest time step of the viscoelastic fits (s, > 0), or
+    /// says why not.
+    pub fn set_time_step(&mut self, dt: f64) -> Result<(), String> {
+        if !(dt.is_finite() && dt > 0.0) {
+            return Err("must be a positive number of seconds".into());
+        }
+        self.max_time_step = dt;
+        Ok(())
+    }
+
     /// Sets the punch's edge radius (mm), or says why `rho` is not one
     /// ([`Q1Punch::set_edge_radius`]).
     pub fn set_edge_radius(&mut self, rho: f64) -> Result<(), String> {
@@ -663,6 +692,28 @@ fn profiles(set: &DataSet, polish: &StageResult, options: &TwoStageOptions) -> V
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The setters both option builders (CLI, manifest step) share refuse
+    /// what they should and keep the old value when they do.
+    #[test]
+    fn the_setters_check_their_ranges() {
+        let mut o = TwoStageOptions::new(Law::NeoHookean);
+        o.set_terms(3).unwrap();
+        assert_eq!(o.terms, 3);
+        assert!(o.set_terms(0).unwrap_err().contains("1 to 4"));
+        assert!(o.set_terms(5).is_err());
+        assert_eq!(o.terms, 3);
+        o.set_fit_mesh(0.15).unwrap();
+        for bad in [0.01, 1.5, f64::NAN] {
+            assert!(o.set_fit_mesh(bad).unwrap_err().contains("0.02..1 mm"));
+        }
+        assert_eq!(o.h_fine, 0.15);
+        o.set_time_step(0.5).unwrap();
+        for bad in [0.0, -1.0, f64::INFINITY] {
+            assert!(o.set_time_step(bad).unwrap_err().contains("positive"));
+        }
+        assert_eq!(o.max_time_step, 0.5);
+    }
 
     #[test]
     fn the_edge_radius_reaches_both_fit_models() {

@@ -55,22 +55,16 @@ impl TwoStageStep {
                 TwoStageOptions::parse_stages(s).map_err(|e| anyhow::anyhow!("stages: {e}"))?;
         }
         if let Some(n) = self.prony_terms {
-            anyhow::ensure!((1..=4).contains(&n), "prony_terms = {n}: give 1 to 4");
-            o.terms = n;
+            o.set_terms(n)
+                .map_err(|e| anyhow::anyhow!("prony_terms = {n}: {e}"))?;
         }
         if let Some(h) = self.fit_mesh {
-            anyhow::ensure!(
-                h.is_finite() && (0.02..=1.0).contains(&h),
-                "fit_mesh = {h}: the element size under the punch must lie in 0.02..1 mm"
-            );
-            o.h_fine = h;
+            o.set_fit_mesh(h)
+                .map_err(|e| anyhow::anyhow!("fit_mesh = {h}: {e}"))?;
         }
         if let Some(dt) = self.time_step {
-            anyhow::ensure!(
-                dt.is_finite() && dt > 0.0,
-                "time_step = {dt}: must be > 0 s"
-            );
-            o.max_time_step = dt;
+            o.set_time_step(dt)
+                .map_err(|e| anyhow::anyhow!("time_step = {dt}: {e}"))?;
         }
         if let Some(rho) = self.edge_radius {
             o.set_edge_radius(rho)

@@ -322,22 +322,16 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
         o.stages = TwoStageOptions::parse_stages(s)?;
     }
     if let Some(n) = args.prony_terms {
-        anyhow::ensure!((1..=4).contains(&n), "--prony-terms {n}: give 1 to 4 terms");
-        o.terms = n;
+        o.set_terms(n)
+            .map_err(|e| anyhow::anyhow!("--prony-terms {n}: {e}"))?;
     }
     if let Some(h) = args.fit_mesh {
-        anyhow::ensure!(
-            h.is_finite() && (0.02..=1.0).contains(&h),
-            "--fit-mesh {h}: the element size under the punch must lie in 0.02..1 mm"
-        );
-        o.h_fine = h;
+        o.set_fit_mesh(h)
+            .map_err(|e| anyhow::anyhow!("--fit-mesh {h}: {e}"))?;
     }
     if let Some(dt) = args.time_step {
-        anyhow::ensure!(
-            dt.is_finite() && dt > 0.0,
-            "--time-step {dt}: must be a positive number of seconds"
-        );
-        o.max_time_step = dt;
+        o.set_time_step(dt)
+            .map_err(|e| anyhow::anyhow!("--time-step {dt}: {e}"))?;
     }
     if let Some(rho) = args.edge_radius {
         o.set_edge_radius(rho)
