@@ -38,6 +38,7 @@ pub mod boundary_polish;
 pub mod covariance;
 pub mod dataset;
 pub mod error;
+pub mod fidelity_correction;
 pub mod fit;
 pub mod jacobian;
 pub mod lm;
@@ -57,6 +58,7 @@ pub use covariance::{
 };
 pub use dataset::DataSet;
 pub use error::InverseError;
+pub use fidelity_correction::{CorrectedModel, FidelityCorrection};
 pub use fit::{fit, start_points, statistics, FitOptions, MultiStart};
 pub use jacobian::{jacobian_unbounded, FdOptions, JacobianEval};
 pub use lm::{LevenbergMarquardt, LmOptions, LmState};

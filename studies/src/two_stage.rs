@@ -41,7 +41,8 @@ use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
 use palpate_inverse::{
-    fit, DataSet, FdOptions, FitOptions, FitReport, LmOptions, Method, Objective, ResidualKind,
+    fit, CorrectedModel, DataSet, FdOptions, FidelityCorrection, FitOptions, FitReport, LmOptions,
+    Method, Objective, ResidualKind,
 };
 use palpate_material::Law;
 use serde::Serialize;
@@ -55,6 +56,10 @@ pub use crate::two_stage_step::TwoStageStep;
 /// (Venzon & Moolgavkar 1988), as `palpate_uq::gap`'s profiles.
 pub const CHI2_1_95: f64 = 3.841_458_820_694_124;
 
+/// The correction rounds stop when every estimate moves by less than this
+/// part of its standard error.
+pub const ROUND_TOLERANCE: f64 = 0.1;
+
 /// The stages `--stages` can name.
 pub const STAGES: [&str; 2] = ["elastic", "relaxation"];
 
@@ -67,6 +72,15 @@ pub struct TwoStageOptions {
     /// Element size under the punch of the fits' mesh (mm), growing by
     /// `1 + h_fine` beyond the 3 mm fine zone.
     pub h_fine: f64,
+    /// Element size under the punch of the mesh that corrects the fits
+    /// (mm; `None`: no correction): each stage fits the fit mesh's model
+    /// corrected, sample by sample, to this mesh at an anchor point
+    /// (`palpate_inverse::FidelityCorrection`, output space mapping).
+    pub correct_h: Option<f64>,
+    /// Rounds of the polish and the one-stage fit with the correction: the
+    /// anchor moves to each round's estimate until the estimates move by
+    /// less than [`ROUND_TOLERANCE`] of their standard errors.
+    pub correction_rounds: usize,
     /// Time step of the viscoelastic runs (s), fixed for every parameter.
     pub max_time_step: f64,
     /// Radius of the punch's rounded edge (mm; `Q1Punch::edge_radius`).
@@ -97,6 +111,8 @@ impl TwoStageOptions {
             law,
             terms: 2,
             h_fine: 0.3,
+            correct_h: None,
+            correction_rounds: 3,
             max_time_step: 1.0,
             edge_radius: palpate_fe::q1::DEFAULT_EDGE_RADIUS,
             stages: STAGES.iter().map(|s| s.to_string()).collect(),
@@ -163,6 +179,22 @@ impl TwoStageOptions {
         Ok(())
     }
 
+    /// Sets the element size under the punch of the correcting mesh (mm,
+    /// 0.02..1, finer than the fit mesh: set that first), or says why not.
+    pub fn set_correct_mesh(&mut self, h: f64) -> Result<(), String> {
+        if !(h.is_finite() && (0.02..=1.0).contains(&h)) {
+            return Err("the element size under the punch must lie in 0.02..1 mm".into());
+        }
+        if h >= self.h_fine {
+            return Err(format!(
+                "the correcting mesh must be finer than the fit mesh ({} mm)",
+                self.h_fine
+            ));
+        }
+        self.correct_h = Some(h);
+        Ok(())
+    }
+
     /// Sets the largest time step of the viscoelastic fits (s, > 0), or
     /// says why not.
     pub fn set_time_step(&mut self, dt: f64) -> Result<(), String> {
@@ -183,19 +215,29 @@ impl TwoStageOptions {
 
     /// The elastic FE model of the fits.
     pub fn elastic_model(&self) -> Q1Punch {
-        let mut m = Q1Punch::new(self.law);
-        m.edge_radius = self.edge_radius;
-        m.grading = Some(Grading {
-            h_fine: self.h_fine,
-            fine_length: 3.0,
-            growth: 1.0 + self.h_fine,
-        });
-        m
+        self.elastic_model_at(self.h_fine)
     }
 
     /// The viscoelastic FE model of the fits (law, then `g_i, tau_i_s`).
     pub fn viscoelastic_model(&self) -> Q1Punch {
-        let mut m = self.elastic_model().with_prony_parameters(self.terms);
+        self.viscoelastic_model_at(self.h_fine)
+    }
+
+    /// The elastic FE model with elements of `h` mm under the punch.
+    pub fn elastic_model_at(&self, h: f64) -> Q1Punch {
+        let mut m = Q1Punch::new(self.law);
+        m.edge_radius = self.edge_radius;
+        m.grading = Some(Grading {
+            h_fine: h,
+            fine_length: 3.0,
+            growth: 1.0 + h,
+        });
+        m
+    }
+
+    /// The viscoelastic FE model with elements of `h` mm under the punch.
+    pub fn viscoelastic_model_at(&self, h: f64) -> Q1Punch {
+        let mut m = self.elastic_model_at(h).with_prony_parameters(self.terms);
         m.options.max_time_step = Some(self.max_time_step);
         m
     }
@@ -308,7 +350,22 @@ pub struct StageResult {
     /// Stage 1: the factor on the moduli from the force-level QLV
     /// correction of the ramp ([`ramp_correction`]), when made.
     pub correction: Option<f64>,
+    /// The mesh corrections, one per round (empty without `correct_h`).
+    pub mesh_corrections: Vec<MeshCorrection>,
+    /// LM iterations of each round (one round without `correct_h`).
+    pub round_iterations: Vec<u64>,
     pub fit: FitReport,
+}
+
+/// One correction of the fit mesh's model to the correcting mesh.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeshCorrection {
+    /// The parameters both meshes ran at.
+    pub anchor: Vec<f64>,
+    /// The largest |fine / coarse - 1| over the samples.
+    pub max_relative_change: f64,
+    /// Wall time of the two runs (s).
+    pub wall_s: f64,
 }
 
 /// A 95 % profile-likelihood interval: `min over the others SSE(x) / sigma^2`
@@ -340,6 +397,8 @@ pub struct TwoStageResult {
     pub stages: Vec<StageResult>,
     pub profiles: Vec<Profile>,
     pub one_stage: Option<StageResult>,
+    /// The correcting mesh's element size under the punch (mm), if any.
+    pub correcting_mesh_mm: Option<f64>,
     /// Totals of the staged route (stages, polish, without profiles).
     pub staged_fe_runs: usize,
     pub staged_wall_s: f64,
@@ -367,26 +426,134 @@ fn lm_fit(
     Ok((report, t0.elapsed().as_secs_f64()))
 }
 
-fn stage_result(
-    stage: &str,
-    objective: &Objective,
-    report: FitReport,
-    wall_s: f64,
-    theta: Vec<f64>,
-) -> StageResult {
-    StageResult {
-        stage: stage.into(),
+/// The models a stage fits: the fit mesh's, and the correcting mesh's when
+/// asked.
+struct StageModels {
+    coarse: Arc<dyn ForwardModel>,
+    fine: Option<Arc<dyn ForwardModel>>,
+}
+
+/// What one stage fits.
+struct StageData<'a> {
+    stage: &'a str,
+    name: String,
+    loading: Loading,
+    observed: Vec<f64>,
+    /// Parameters held, by name.
+    fixed: Vec<(String, f64)>,
+}
+
+/// Runs one stage: LM from `start` (every parameter of the models' space).
+/// With a correcting mesh, the fit mesh's model is corrected to it at the
+/// start, then (up to `rounds` rounds) at each round's estimate, until the
+/// estimates move by less than [`ROUND_TOLERANCE`] of their standard
+/// errors. Returns the result and the data set of the last round (the
+/// profiles refit it).
+fn run_stage(
+    data: &StageData<'_>,
+    models: &StageModels,
+    start: Vec<f64>,
+    rounds: usize,
+    options: &TwoStageOptions,
+    say: Say<'_>,
+) -> anyhow::Result<(StageResult, DataSet)> {
+    let mut theta = start;
+    let (mut fe_runs, mut wall_s) = (0, 0.0);
+    let (mut corrections, mut round_iterations) = (Vec::new(), Vec::new());
+    let mut last = None;
+    for round in 0..rounds.max(1) {
+        let model: Arc<dyn ForwardModel> = match &models.fine {
+            None => models.coarse.clone(),
+            Some(fine) => {
+                let t0 = Instant::now();
+                let c = FidelityCorrection::at(
+                    fine.as_ref(),
+                    models.coarse.as_ref(),
+                    &theta,
+                    &data.loading,
+                )
+                .map_err(|e| {
+                    anyhow::anyhow!(
+                        "{}: the correcting mesh's run at {theta:?}: {e}",
+                        data.stage
+                    )
+                })?;
+                let w = t0.elapsed().as_secs_f64();
+                let (lo, hi) = c
+                    .ratio
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &r| {
+                        (l.min(r), h.max(r))
+                    });
+                say(&format!(
+                    "  round {}: the fit mesh's force corrected by x {lo:.4} .. {hi:.4} at [{}] ({w:.0} s)",
+                    round + 1,
+                    theta
+                        .iter()
+                        .map(|v| format!("{v:.4e}"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+                corrections.push(MeshCorrection {
+                    anchor: theta.clone(),
+                    max_relative_change: c.max_relative_change(),
+                    wall_s: w,
+                });
+                fe_runs += 1;
+                wall_s += w;
+                Arc::new(CorrectedModel::new(
+                    models.coarse.clone(),
+                    c,
+                    data.loading.clone(),
+                    &fine.name(),
+                ))
+            }
+        };
+        let set = DataSet::new(
+            data.name.clone(),
+            model,
+            data.loading.clone(),
+            data.observed.clone(),
+        );
+        let objective = Objective::new(vec![set.clone()], ResidualKind::Absolute, &data.fixed)?;
+        let (report, w) = lm_fit(&objective, theta.clone(), options, options.lm)?;
+        fe_runs += report.evaluations;
+        wall_s += w;
+        round_iterations.push(report.iterations);
+        let settled = round > 0
+            && report
+                .parameters
+                .iter()
+                .zip(&theta)
+                .filter(|(e, _)| !e.fixed)
+                .all(|(e, &old)| match e.standard_error {
+                    Some(se) if se > 0.0 => (e.value - old).abs() <= ROUND_TOLERANCE * se,
+                    _ => (e.value - old).abs() <= 1e-3 * old.abs(),
+                });
+        theta = report.parameters.iter().map(|p| p.value).collect();
+        let stop = models.fine.is_none() || settled;
+        last = Some((objective, report, set));
+        if stop {
+            break;
+        }
+    }
+    let (objective, report, set) = last.expect("at least one round");
+    let result = StageResult {
+        stage: data.stage.into(),
         free: objective.free_names(),
         samples: objective.n_residuals(),
-        iterations: report.iterations,
-        fe_runs: report.evaluations,
+        iterations: round_iterations.iter().sum(),
+        fe_runs,
         wall_s,
         converged: report.converged,
         termination: report.termination.to_string(),
         theta,
         correction: None,
+        mesh_corrections: corrections,
+        round_iterations,
         fit: report,
-    }
+    };
+    Ok((result, set))
 }
 
 /// The elastic force curve of stage 1 scaled by the parameter `s`, at the
@@ -496,41 +663,63 @@ pub fn identify(
     options: &TwoStageOptions,
     say: Say<'_>,
 ) -> anyhow::Result<TwoStageResult> {
+    if let Some(h) = options.correct_h {
+        anyhow::ensure!(
+            h < options.h_fine,
+            "the correcting mesh ({h} mm under the punch) must be finer than the fit mesh ({} mm)",
+            options.h_fine
+        );
+    }
     let visco: Arc<dyn ForwardModel> = Arc::new(options.viscoelastic_model());
-    let elastic: Arc<dyn ForwardModel> = Arc::new(options.elastic_model());
+    let elastic = StageModels {
+        coarse: Arc::new(options.elastic_model()),
+        fine: options
+            .correct_h
+            .map(|h| Arc::new(options.elastic_model_at(h)) as Arc<dyn ForwardModel>),
+    };
+    let viscous = StageModels {
+        coarse: visco.clone(),
+        fine: options
+            .correct_h
+            .map(|h| Arc::new(options.viscoelastic_model_at(h)) as Arc<dyn ForwardModel>),
+    };
     let space = visco.space().clone();
     let names = space.names();
-    let n_law = elastic.space().len();
+    let n_law = elastic.coarse.space().len();
     let mut theta: Vec<f64> = space.params.iter().map(|p| p.initial).collect();
-    let full = DataSet::new(
-        &record.name,
-        visco.clone(),
-        record.loading(),
-        record.force.clone(),
-    );
+    let whole = |stage, fixed| StageData {
+        stage,
+        name: record.name.clone(),
+        loading: record.loading(),
+        observed: record.force.clone(),
+        fixed,
+    };
+    let done = |s: &StageResult| {
+        say(&format!(
+            "  {} iterations {:?}, {} FE runs, {:.1} s",
+            s.iterations, s.round_iterations, s.fe_runs, s.wall_s
+        ))
+    };
     let mut stages = Vec::new();
     for stage in &options.stages {
         match stage.as_str() {
             "elastic" => {
                 let (loading, observed) = record.ramp();
-                let set = DataSet::new(
-                    format!("{} (ramp)", record.name),
-                    elastic.clone(),
+                let data = StageData {
+                    stage,
+                    name: format!("{} (ramp)", record.name),
                     loading,
                     observed,
-                );
-                let objective = Objective::new(vec![set], ResidualKind::Absolute, &[])?;
+                    fixed: Vec::new(),
+                };
                 say(&format!(
                     "stage 1 (elastic): {} on the ramp ({} samples), elastic FE",
-                    objective.free_names().join(", "),
-                    objective.n_residuals()
+                    names[..n_law].join(", "),
+                    data.observed.len()
                 ));
-                let (report, wall) =
-                    lm_fit(&objective, theta[..n_law].to_vec(), options, options.lm)?;
-                for (t, e) in theta[..n_law].iter_mut().zip(&report.parameters) {
-                    *t = e.value;
-                }
-                let mut result = stage_result(stage, &objective, report, wall, theta.clone());
+                let (mut result, _) =
+                    run_stage(&data, &elastic, theta[..n_law].to_vec(), 1, options, say)?;
+                theta[..n_law].copy_from_slice(&result.theta);
                 let t0 = Instant::now();
                 if let Some((scale, prony)) =
                     ramp_correction(record, &result.fit.sets[0].predicted, options.terms)
@@ -542,50 +731,48 @@ pub fn identify(
                     }
                     theta[n_law..].copy_from_slice(&prony);
                     result.correction = Some(scale);
-                    result.theta = theta.clone();
                     say(&format!(
                         "  force-level QLV correction of the ramp (no FE run): moduli x {scale:.4}, Prony start {prony:.4?}"
                     ));
                 }
+                result.theta = theta.clone();
                 result.wall_s += t0.elapsed().as_secs_f64();
                 stages.push(result);
             }
             _ => {
                 let fixed: Vec<(String, f64)> =
                     (0..n_law).map(|k| (names[k].clone(), theta[k])).collect();
-                let objective = Objective::new(vec![full.clone()], ResidualKind::Absolute, &fixed)?;
                 say(&format!(
                     "stage 2 (relaxation): {} on the whole record ({} samples), the law held",
-                    objective.free_names().join(", "),
-                    objective.n_residuals()
+                    names[n_law..].join(", "),
+                    record.force.len()
                 ));
-                let (report, wall) = lm_fit(&objective, theta.clone(), options, options.lm)?;
-                theta = report.parameters.iter().map(|p| p.value).collect();
-                stages.push(stage_result(stage, &objective, report, wall, theta.clone()));
+                let (result, _) = run_stage(
+                    &whole(stage, fixed),
+                    &viscous,
+                    theta.clone(),
+                    1,
+                    options,
+                    say,
+                )?;
+                theta = result.theta.clone();
+                stages.push(result);
             }
         }
-        let s = stages.last().expect("a stage");
-        say(&format!(
-            "  {} iterations, {} FE runs, {:.1} s",
-            s.iterations, s.fe_runs, s.wall_s
-        ));
+        done(stages.last().expect("a stage"));
     }
-    let objective = Objective::new(vec![full.clone()], ResidualKind::Absolute, &[])?;
     say("polish: every parameter on the whole record");
-    let (report, wall) = lm_fit(&objective, theta.clone(), options, options.lm)?;
-    theta = report.parameters.iter().map(|p| p.value).collect();
-    stages.push(stage_result(
-        "polish",
-        &objective,
-        report,
-        wall,
-        theta.clone(),
-    ));
-    let polish = stages.last().expect("the polish").clone();
-    say(&format!(
-        "  {} iterations, {} FE runs, {:.1} s",
-        polish.iterations, polish.fe_runs, polish.wall_s
-    ));
+    let rounds = options.correction_rounds;
+    let (polish, full) = run_stage(
+        &whole("polish", Vec::new()),
+        &viscous,
+        theta,
+        rounds,
+        options,
+        say,
+    )?;
+    done(&polish);
+    stages.push(polish.clone());
     let staged_fe_runs = stages.iter().map(|s| s.fe_runs).sum();
     let staged_wall_s = stages.iter().map(|s| s.wall_s).sum();
     let profiles = if options.profile {
@@ -597,13 +784,15 @@ pub fn identify(
     let one_stage = if options.one_stage {
         say("one-stage comparison: every parameter from the default start");
         let start: Vec<f64> = space.params.iter().map(|p| p.initial).collect();
-        let (report, wall) = lm_fit(&objective, start, options, options.lm)?;
-        let th = report.parameters.iter().map(|p| p.value).collect();
-        let s = stage_result("one-stage", &objective, report, wall, th);
-        say(&format!(
-            "  {} iterations, {} FE runs, {:.1} s",
-            s.iterations, s.fe_runs, s.wall_s
-        ));
+        let (s, _) = run_stage(
+            &whole("one-stage", Vec::new()),
+            &viscous,
+            start,
+            rounds,
+            options,
+            say,
+        )?;
+        done(&s);
         Some(s)
     } else {
         None
@@ -615,6 +804,7 @@ pub fn identify(
         stages,
         profiles,
         one_stage,
+        correcting_mesh_mm: options.correct_h,
         staged_fe_runs,
         staged_wall_s,
     })
@@ -713,6 +903,14 @@ mod tests {
             assert!(o.set_time_step(bad).unwrap_err().contains("positive"));
         }
         assert_eq!(o.max_time_step, 0.5);
+        // the correcting mesh: in range and finer than the fit mesh (0.15)
+        for bad in [0.01, 0.15, 0.2] {
+            assert!(o.set_correct_mesh(bad).is_err(), "{bad}");
+        }
+        assert!(o.set_correct_mesh(0.2).unwrap_err().contains("finer"));
+        assert_eq!(o.correct_h, None);
+        o.set_correct_mesh(0.1).unwrap();
+        assert_eq!(o.correct_h, Some(0.1));
     }
 
     #[test]

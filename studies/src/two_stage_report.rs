@@ -24,23 +24,51 @@ fn prony_by_tau(theta: &[f64], names: &[String]) -> (Vec<f64>, bool) {
     (out, pairs != before)
 }
 
+/// A stage's LM iterations, each round's in brackets when there were
+/// several.
+fn iterations(s: &StageResult) -> String {
+    if s.round_iterations.len() > 1 {
+        let each: Vec<String> = s.round_iterations.iter().map(|i| i.to_string()).collect();
+        format!("{} ({})", s.iterations, each.join(" + "))
+    } else {
+        s.iterations.to_string()
+    }
+}
+
 /// The result as a Markdown report: one row per stage, the estimates with
 /// standard errors and profile intervals, and, given the truth, the errors.
 pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
     use std::fmt::Write;
     let mut r = String::new();
     let _ = writeln!(r, "record `{}`, model {}\n", result.record, result.model);
+    if let Some(h) = result.correcting_mesh_mm {
+        let _ = writeln!(
+            r,
+            "Each fit ran on the fit mesh's model corrected, sample by sample, to a mesh of {h} mm \
+             under the punch at an anchor (output space mapping); the polish and the one-stage fit \
+             moved the anchor to their estimate, round by round, until the estimates moved by less \
+             than {} of their standard errors. LM iterations are summed over the rounds (each round's \
+             in brackets); FE runs are the fit mesh's, the correcting mesh's runs are counted apart.\n",
+            crate::two_stage::ROUND_TOLERANCE
+        );
+    }
+    let corrected = result.correcting_mesh_mm.is_some();
     let _ = writeln!(
         r,
-        "| route | free | samples | LM iterations | FE runs | wall (s) | converged | RMS (N) | {} |",
+        "| route | free | samples | LM iterations | FE runs |{} wall (s) | converged | RMS (N) | {} |",
+        if corrected { " correcting-mesh runs |" } else { "" },
         result.names.join(" | ")
     );
-    let _ = writeln!(r, "|{}", "---|".repeat(8 + result.names.len()));
+    let _ = writeln!(
+        r,
+        "|{}",
+        "---|".repeat(8 + usize::from(corrected) + result.names.len())
+    );
     let row = |r: &mut String, s: &StageResult| {
         let (theta, reordered) = prony_by_tau(&s.theta, &result.names);
         let _ = writeln!(
             r,
-            "| {}{} | {} | {} | {} | {} | {:.1} | {} | {:.3e} | {} |",
+            "| {}{} | {} | {} | {} | {} |{} {:.1} | {} | {:.3e} | {} |",
             s.stage,
             if reordered {
                 " (its Prony terms swapped into tau order)"
@@ -49,8 +77,13 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
             },
             s.free.join(", "),
             s.samples,
-            s.iterations,
+            iterations(s),
             s.fe_runs,
+            if corrected {
+                format!(" {} |", s.mesh_corrections.len())
+            } else {
+                String::new()
+            },
             s.wall_s,
             if s.converged {
                 "yes"
@@ -70,9 +103,21 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
     }
     let _ = writeln!(
         r,
-        "| two-stage total | | | {} | {} | {:.1} | | | |",
+        "| two-stage total | | | {} | {} |{} {:.1} | | | |",
         result.stages.iter().map(|s| s.iterations).sum::<u64>(),
         result.staged_fe_runs,
+        if corrected {
+            format!(
+                " {} |",
+                result
+                    .stages
+                    .iter()
+                    .map(|s| s.mesh_corrections.len())
+                    .sum::<usize>()
+            )
+        } else {
+            String::new()
+        },
         result.staged_wall_s
     );
     if let Some(s) = &result.one_stage {
@@ -81,7 +126,8 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
     if let Some(t) = truth {
         let _ = writeln!(
             r,
-            "| truth | | | | | | | | {} |",
+            "| truth |{} {} |",
+            " |".repeat(7 + usize::from(corrected)),
             t.iter()
                 .map(|v| format!("{v:.5}"))
                 .collect::<Vec<_>>()

@@ -25,6 +25,10 @@ pub struct TwoStageStep {
     /// Element size under the punch of the fits' mesh (mm, default 0.3).
     #[serde(default)]
     pub fit_mesh: Option<f64>,
+    /// Element size under the punch of the mesh that corrects the fits (mm,
+    /// finer than `fit_mesh`; default none: `--correct-mesh`).
+    #[serde(default)]
+    pub correct_mesh: Option<f64>,
     /// Time step of the viscoelastic runs (s, default 1).
     #[serde(default)]
     pub time_step: Option<f64>,
@@ -61,6 +65,10 @@ impl TwoStageStep {
         if let Some(h) = self.fit_mesh {
             o.set_fit_mesh(h)
                 .map_err(|e| anyhow::anyhow!("fit_mesh = {h}: {e}"))?;
+        }
+        if let Some(h) = self.correct_mesh {
+            o.set_correct_mesh(h)
+                .map_err(|e| anyhow::anyhow!("correct_mesh = {h}: {e}"))?;
         }
         if let Some(dt) = self.time_step {
             o.set_time_step(dt)

@@ -23,6 +23,9 @@
 //! With env `Q1_RECORD_DEPTH=D` (mm) the ramp goes to D instead, into
 //! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of BENCHMARKS.md runs
 //! since session 16's contact; its fit is a study, not a test).
+//! With env `Q1_RECORD_LEVEL=L` the record is made on mesh level L instead
+//! of 2 (the 5 mm record is level 3, finer than the level-2 mesh that
+//! corrects its fits: `--correct-mesh`).
 //! (`-- --time LEVEL DT` instead times one run of the record's history).
 
 use palpate_core::{Drive, ForwardModel, Loading};
@@ -42,6 +45,12 @@ fn depth() -> f64 {
     std::env::var("Q1_RECORD_DEPTH").ok().map_or(DEPTH, |v| {
         v.parse().expect("Q1_RECORD_DEPTH: a depth in mm")
     })
+}
+/// The record's mesh level: 2 unless env `Q1_RECORD_LEVEL` says.
+fn level() -> usize {
+    std::env::var("Q1_RECORD_LEVEL")
+        .ok()
+        .map_or(2, |v| v.parse().expect("Q1_RECORD_LEVEL: a mesh level"))
 }
 const RAMP: f64 = 0.5;
 const HOLD: f64 = 60.0;
@@ -107,7 +116,8 @@ fn main() {
     };
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(&sub);
     std::fs::create_dir_all(&dir).expect("create the record's folder");
-    let f = model(2, 0.25)
+    let level = level();
+    let f = model(level, 0.25)
         .predict(&TRUTH[..1], &loading)
         .expect("the fine run");
     let fmax = f.iter().cloned().fold(0.0, f64::max);
@@ -117,7 +127,7 @@ fn main() {
     let mut csv = format!(
         "# synthetic Q1 ramp-and-hold record (tests/examples/make_two_stage_q1.rs): flat punch r 2 mm \
          (edge 0.2 mm), neo-Hookean C10 = {} MPa, Prony g1 = {}, tau1 = {} s, g2 = {}, tau2 = {} s, \
-         {depth} mm in {RAMP} s, hold {HOLD} s, mesh level 2, time step 0.25 s, noise sd {sd:.4e} N (seed 13)\n\
+         {depth} mm in {RAMP} s, hold {HOLD} s, mesh level {level}, time step 0.25 s, noise sd {sd:.4e} N (seed 13)\n\
          time_s,displacement_mm,force_N\n",
         TRUTH[0], TRUTH[1], TRUTH[2], TRUTH[3], TRUTH[4]
     );
@@ -130,7 +140,7 @@ fn main() {
     std::fs::write(dir.join("record.csv"), csv).expect("write the record");
     let truth = format!(
         "{{\"parameters\": {{\"C10\": {}, \"g1\": {}, \"tau1_s\": {}, \"g2\": {}, \"tau2_s\": {}}},\n \
-         \"depth_mm\": {depth}, \"ramp_s\": {RAMP}, \"hold_s\": {HOLD}, \"mesh_level\": 2, \
+         \"depth_mm\": {depth}, \"ramp_s\": {RAMP}, \"hold_s\": {HOLD}, \"mesh_level\": {level}, \
          \"max_time_step_s\": 0.25, \"noise_sd_N\": {sd:.6e}, \"seed\": 13,\n \
          \"noise_free_force_N\": [{}]}}\n",
         TRUTH[0],

@@ -89,6 +89,12 @@ pub struct Args {
     /// --benchmark Q1: element size under the punch of the fits' mesh, mm (default 0.3).
     #[arg(long, value_name = "MM")]
     pub fit_mesh: Option<f64>,
+    /// --benchmark Q1: correct each fit to a finer mesh with this element size under the punch, mm
+    /// (off by default): the fit mesh's force is scaled, sample by sample, to this mesh's at an
+    /// anchor, which the polish moves to its estimate round by round (output space mapping; a few
+    /// runs on this mesh instead of every run). For deep records, where the fit mesh is stiff.
+    #[arg(long, value_name = "MM")]
+    pub correct_mesh: Option<f64>,
     /// --benchmark Q1: time step of the viscoelastic FE runs, s (default 1).
     #[arg(long, value_name = "S")]
     pub time_step: Option<f64>,
@@ -244,6 +250,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         (args.stages.is_some(), "--stages"),
         (args.prony_terms.is_some(), "--prony-terms"),
         (args.fit_mesh.is_some(), "--fit-mesh"),
+        (args.correct_mesh.is_some(), "--correct-mesh"),
         (args.time_step.is_some(), "--time-step"),
         (args.edge_radius.is_some(), "--edge-radius"),
         (args.compare, "--compare"),
@@ -328,6 +335,10 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
     if let Some(h) = args.fit_mesh {
         o.set_fit_mesh(h)
             .map_err(|e| anyhow::anyhow!("--fit-mesh {h}: {e}"))?;
+    }
+    if let Some(h) = args.correct_mesh {
+        o.set_correct_mesh(h)
+            .map_err(|e| anyhow::anyhow!("--correct-mesh {h}: {e}"))?;
     }
     if let Some(dt) = args.time_step {
         o.set_time_step(dt)

@@ -26,6 +26,11 @@ fn options() -> TwoStageOptions {
 }
 
 fn record() -> Q1Record {
+    record_on(&options())
+}
+
+/// The record made on `made_on`'s viscoelastic model.
+fn record_on(made_on: &TwoStageOptions) -> Q1Record {
     let mut t: Vec<f64> = (0..=8).map(|i| 0.5 * i as f64 / 8.0).collect();
     let mut d: Vec<f64> = (0..=8).map(|i| 0.5 * i as f64 / 8.0).collect();
     for k in 0..10 {
@@ -33,7 +38,7 @@ fn record() -> Q1Record {
         d.push(0.5);
     }
     let loading = Loading::timed(Drive::DisplacementMm, t.clone(), d.clone());
-    let f = options()
+    let f = made_on
         .viscoelastic_model()
         .predict(&TRUTH, &loading)
         .expect("the record's run");
@@ -149,4 +154,47 @@ fn the_study_manifest_is_valid() {
         e.contains("steps[0].two_stage (\"q1-liver\").time_step = 0"),
         "{e}"
     );
+}
+
+/// A record from a finer mesh than the fits' (0.5 mm under the punch, the
+/// fits 1 mm): the plain fit is biased by the fit mesh's stiffness; the fit
+/// corrected to the record's mesh (`correct_h`, output space mapping) lands
+/// on the truth, as the fine mesh's own fit would, with few runs of it.
+#[test]
+fn the_mesh_correction_removes_the_fit_mesh_bias() {
+    let fine = {
+        let mut o = options();
+        o.h_fine = 0.5;
+        o
+    };
+    let rec = record_on(&fine);
+    let mut plain = options();
+    plain.stages = vec!["elastic".into()];
+    plain.one_stage = false;
+    plain.profile = false;
+    let mut corrected = plain.clone();
+    corrected.set_correct_mesh(0.5).unwrap();
+    let biased = identify(&rec, &plain, &|_| {}).expect("the plain fit");
+    let result = identify(&rec, &corrected, &|s| eprintln!("{s}")).expect("the corrected fit");
+    eprintln!("{}", report(&biased, Some(&TRUTH)));
+    eprintln!("{}", report(&result, Some(&TRUTH)));
+    let polish = result.stages.last().unwrap();
+    let stiff = biased.stages.last().unwrap();
+    let mut worst_plain = 0.0f64;
+    for (k, e) in polish.fit.parameters.iter().enumerate() {
+        let se = e.standard_error.expect("a standard error");
+        assert!(
+            (e.value - TRUTH[k]).abs() <= 2.0 * se,
+            "{} = {} +- {se}, truth {}",
+            e.name,
+            e.value,
+            TRUTH[k]
+        );
+        worst_plain = worst_plain.max((stiff.theta[k] - TRUTH[k]).abs() / se);
+    }
+    assert!(worst_plain > 4.0, "the plain fit is {worst_plain} SE off");
+    // one correcting run per stage, and a polish that settles in 2-3 rounds
+    assert_eq!(result.stages[0].mesh_corrections.len(), 1);
+    assert!((2..=3).contains(&polish.mesh_corrections.len()));
+    assert!(polish.round_iterations[1..].iter().all(|&i| i <= 2));
 }
