@@ -137,9 +137,28 @@ fn stages_are_parsed_and_checked() {
     assert!(e.to_string().contains("unknown stage `viscous`"), "{e}");
 }
 
-/// The study manifest parses and validates (the record exists, the options hold).
+/// The study manifests parse and validate (the record exists, the options
+/// hold); a correcting mesh no finer than the fit mesh is refused by field.
 #[test]
 fn the_study_manifest_is_valid() {
+    let deep = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("two-stage-q1-5mm.toml");
+    let m = palpate_studies::manifest::Manifest::read(&deep).unwrap();
+    m.validate(&deep).unwrap();
+    let coarse = std::fs::read_to_string(&deep)
+        .unwrap()
+        .replace("correct_mesh = 0.1", "correct_mesh = 0.3");
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("coarse.toml");
+    std::fs::write(&p, coarse).unwrap();
+    let e = palpate_studies::manifest::Manifest::read(&p)
+        .unwrap()
+        .validate(&p)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("correct_mesh = 0.3") && e.contains("finer than the fit mesh"),
+        "{e}"
+    );
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("two-stage-q1.toml");
     let m = palpate_studies::manifest::Manifest::read(&path).unwrap();
     m.validate(&path).unwrap();
