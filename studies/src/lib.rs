@@ -14,6 +14,8 @@ pub mod limits;
 pub mod localize;
 pub mod localize_step;
 pub mod manifest;
+pub mod model_defaults;
+pub mod model_fields;
 pub mod models;
 pub mod output;
 pub mod plot;

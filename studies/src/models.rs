@@ -67,14 +67,21 @@ use crate::calibration::TestKind;
 use palpate_analytic::{
     C1Compression, GeneralBiaxial, Homogeneous, Mode, SimpleShear, ViscousUniaxial,
 };
-use palpate_core::{Effect, ForwardModel};
+use palpate_core::ForwardModel;
 use palpate_fe::{
-    Base, Bulk, C1Fe, MeshDensity, N1Element, N1Needle, N3Element, N3Mesh, N3Needle, Nodule,
-    Platens, Prony, Q1Punch, R2Rolling, ToolShape,
+    Base, C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch,
+    R2Rolling,
 };
 use palpate_material::Law;
 use serde::Deserialize;
 use std::fmt;
+
+pub use crate::model_defaults::{
+    check_effects, default_effects, for_test, gap_base, gap_base_for, parse_effects,
+    spans_tension_and_compression,
+};
+use crate::model_fields::{parse_bulk, parse_element, parse_mode, parse_prony, parse_tool};
+pub use crate::model_fields::{parse_mesh, text_or_number};
 
 /// Default Coulomb friction between the N1 needle and the material (BENCHMARKS.md).
 pub const DEFAULT_FRICTION: f64 = 0.8;
@@ -323,22 +330,6 @@ pub const N3_DEFAULT_MESH: &str = "coarse";
 /// would need more memory and time than a 2-core, few-GiB machine has.
 pub const N3_MAX_LEVEL: usize = 2;
 
-/// A TOML setting given as text or as a number (`mesh = 2`, `bulk = 1000`).
-pub fn text_or_number<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Option<String>, D::Error> {
-    #[derive(Deserialize)]
-    #[serde(untagged)]
-    enum V {
-        Int(i64),
-        Float(f64),
-        Text(String),
-    }
-    Ok(Some(match V::deserialize(d)? {
-        V::Int(i) => i.to_string(),
-        V::Float(x) => x.to_string(),
-        V::Text(s) => s,
-    }))
-}
-
 /// A value of a spec that is wrong: the kind, the field, the value given and
 /// what was expected.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -351,7 +342,7 @@ pub struct ModelError {
 }
 
 impl ModelError {
-    fn new(
+    pub(crate) fn new(
         kind: &'static str,
         field: &'static str,
         value: impl fmt::Display,
@@ -619,15 +610,6 @@ impl ModelSpec {
     }
 }
 
-/// A `prony = "g1=..,tau1=.."` field; errors name it.
-fn parse_prony(kind: &'static str, text: Option<&str>) -> Result<Option<Prony>, ModelError> {
-    text.map(|p| {
-        p.parse::<Prony>()
-            .map_err(|e| ModelError::new(kind, "prony", p, e.to_string()))
-    })
-    .transpose()
-}
-
 /// The R2 model of a spec: every field checked, the geometry (nodules
 /// inside the block, not overlapping, RD) by building the mesh once.
 fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
@@ -770,376 +752,6 @@ fn homogeneous_model(law: Law, s: &HomogeneousSpec) -> Result<Model, ModelError>
     })
 }
 
-fn parse_mode(s: &str) -> Result<Mode, ModelError> {
-    s.parse::<Mode>().map_err(|_| {
-        ModelError::new(
-            "homogeneous",
-            "mode",
-            s,
-            "expected uniaxial, biaxial (equibiaxial), planar (pure_shear), general_biaxial or simple_shear",
-        )
-    })
-}
-
-/// The mesh level of `coarse` (1), `medium` (2), `fine` (3) or `N` (1..=12);
-/// absent: [`DEFAULT_MESH`]. The one mesh parser of every command.
-pub fn parse_mesh(kind: &'static str, s: Option<&str>) -> Result<usize, ModelError> {
-    let s = s.unwrap_or(DEFAULT_MESH);
-    match s {
-        "coarse" => Ok(MeshDensity::COARSE.level),
-        "medium" => Ok(MeshDensity::MEDIUM.level),
-        "fine" => Ok(MeshDensity::FINE.level),
-        n => match n.parse::<usize>() {
-            Ok(k) if (1..=MAX_MESH_LEVEL).contains(&k) => Ok(k),
-            _ => Err(ModelError::new(
-                kind,
-                "mesh",
-                s,
-                format!("expected coarse, medium, fine or a level 1..{MAX_MESH_LEVEL}"),
-            )),
-        },
-    }
-}
-
-fn parse_element(kind: &'static str, s: Option<&str>) -> Result<N1Element, ModelError> {
-    match s.unwrap_or("quad4") {
-        "quad4" => Ok(N1Element::Quad4),
-        "quad9" => Ok(N1Element::Quad9),
-        other => Err(ModelError::new(
-            kind,
-            "element",
-            other,
-            "expected quad4 or quad9",
-        )),
-    }
-}
-
-fn parse_bulk(kind: &'static str, s: Option<&str>) -> Result<Bulk, ModelError> {
-    let s = s.unwrap_or("exact");
-    if s == "exact" {
-        return Ok(Bulk::Exact);
-    }
-    match s.parse::<f64>() {
-        // Above 1e9 (Poisson's ratio 0.4999999995) the penalty swamps the
-        // shear stiffness and the stresses overflow: use `exact`.
-        Ok(r) if r > 0.0 && r <= 1e9 => Ok(Bulk::Ratio(r)),
-        _ => Err(ModelError::new(
-            kind,
-            "bulk",
-            s,
-            "expected `exact` or a ratio K/mu in (0, 1e9] such as 1000",
-        )),
-    }
-}
-
-fn parse_tool(kind: &'static str, s: &str) -> Result<ToolShape, ModelError> {
-    let num = |v: &str| -> Result<f64, ModelError> {
-        v.parse::<f64>()
-            .ok()
-            .filter(|r| *r > 0.0 && r.is_finite())
-            .ok_or_else(|| {
-                ModelError::new(
-                    kind,
-                    "tool",
-                    s,
-                    format!("`{v}` is not a positive radius in mm"),
-                )
-            })
-    };
-    match s.split_once(':') {
-        None if s == "needle" => Ok(ToolShape::n1_needle()),
-        None if s == "platen" => Ok(ToolShape::Platen),
-        Some(("sphere", r)) => Ok(ToolShape::Sphere { radius: num(r)? }),
-        Some(("punch", r)) => {
-            let radius = num(r)?;
-            Ok(ToolShape::FlatPunch {
-                radius,
-                edge_radius: (0.1f64).min(0.5 * radius),
-            })
-        }
-        _ => Err(ModelError::new(
-            kind,
-            "tool",
-            s,
-            "expected needle, sphere:RADIUS, punch:RADIUS or platen",
-        )),
-    }
-}
-
-/// The model of a data set's test for a law (the legacy manifest form
-/// `law = "..."` and the commands' `--benchmark`): the analytic homogeneous
-/// test, analytic C1, or N1 with the BENCHMARKS.md needle (friction 0.8) on
-/// the coarse mesh, since every evaluation of a fit is a full FE run.
-pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
-    let law = law.to_string();
-    match test {
-        TestKind::Homogeneous(mode) => ModelSpec::Homogeneous(HomogeneousSpec {
-            law,
-            mode: mode.name().to_string(),
-            axial_stretch: None,
-            viscoelastic: None,
-        }),
-        TestKind::GeneralBiaxial | TestKind::SimpleShear => {
-            ModelSpec::Homogeneous(HomogeneousSpec {
-                law,
-                mode: if test == TestKind::SimpleShear {
-                    "simple_shear"
-                } else {
-                    "general_biaxial"
-                }
-                .to_string(),
-                axial_stretch: None,
-                viscoelastic: None,
-            })
-        }
-        TestKind::C1 => ModelSpec::C1(C1Spec { law }),
-        TestKind::N1 => ModelSpec::N1Needle(N1NeedleSpec {
-            law,
-            mesh: Some("coarse".into()),
-            ..Default::default()
-        }),
-    }
-}
-
-/// The base model of the gap diagnosis for a record of `test`: C1 analytic
-/// (lubricated platens), N1 with a frictionless needle on the coarse mesh
-/// and a bonded base, so that `friction` and `boundary_condition` are
-/// effects to find, or the analytic homogeneous test of the record's kind
-/// (elastic: viscoelasticity is an effect to find). A record's own options
-/// (a simple-shear record's axial stretch) are set by [`gap_base_for`].
-pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
-    let spec_law = law.to_string();
-    match test {
-        TestKind::C1 => Ok(ModelSpec::C1(C1Spec { law: spec_law })),
-        TestKind::N1 => Ok(ModelSpec::N1Needle(N1NeedleSpec {
-            law: spec_law,
-            friction: Some(0.0),
-            mesh: Some("coarse".into()),
-            ..Default::default()
-        })),
-        TestKind::Homogeneous(_) | TestKind::GeneralBiaxial | TestKind::SimpleShear => {
-            Ok(for_test(test, law))
-        }
-    }
-}
-
-/// [`gap_base`] for one record read by [`crate::calibration::TestData`]:
-/// a simple-shear record keeps the axial stretch it was read with.
-pub fn gap_base_for(record: &crate::calibration::TestData, law: Law) -> anyhow::Result<ModelSpec> {
-    if record.test.is_homogeneous() {
-        Ok(record.spec(law, None))
-    } else {
-        gap_base(record.test, law)
-    }
-}
-
-/// The default candidate effects of the gap diagnosis for a base model and
-/// the record it is diagnosed on (`None`: every effect the model offers).
-///
-/// - N1: GAP.md's `friction` and `boundary_condition`; the N1 model also
-///   offers `material_form` and `zero_offset`, but on one force-depth curve
-///   friction and a stiffening law are confounded (docs/gap-diagnosis.md),
-///   so they are candidates on request only.
-/// - Homogeneous records: those of the model's effects the record can show:
-///   `viscoelasticity` only on a timed record (a `time_s` column), and
-///   `tension_compression_asymmetry` only when the stretches lie on both
-///   sides of 1 (elsewhere its sensitivity is zero, [`spans_tension_and_compression`]).
-///   `material_form` and (stretch-driven tests) `zero_offset` always.
-/// - C1: every effect the model offers.
-pub fn default_effects(
-    base: &ModelSpec,
-    model: &dyn ForwardModel,
-    loading: &palpate_core::Loading,
-) -> Option<Vec<Effect>> {
-    match base {
-        ModelSpec::N1Needle(_) => Some(vec![Effect::Friction, Effect::BoundaryCondition]),
-        ModelSpec::Homogeneous(_) => Some(
-            palpate_core::enrichable::effects_of(model)
-                .into_iter()
-                .filter(|e| match e {
-                    Effect::Viscoelasticity => loading.time.is_some(),
-                    Effect::TensionCompressionAsymmetry => {
-                        spans_tension_and_compression(&loading.drive)
-                    }
-                    _ => true,
-                })
-                .collect(),
-        ),
-        _ => None,
-    }
-}
-
-/// Whether a stretch history has samples in compression (< 1) and in
-/// tension (> 1), two at least on each side (one sample is not a slope).
-pub fn spans_tension_and_compression(stretch: &[f64]) -> bool {
-    const EPS: f64 = 1e-9;
-    let below = stretch.iter().filter(|&&s| s < 1.0 - EPS).count();
-    let above = stretch.iter().filter(|&&s| s > 1.0 + EPS).count();
-    below >= 2 && above >= 2
-}
-
-/// Checks that a model offers every requested effect; the error (`E: ...`)
-/// names the first one it does not offer and lists those it does.
-pub fn check_effects(model: &dyn ForwardModel, effects: &[Effect]) -> Result<(), String> {
-    let offered = palpate_core::enrichable::effects_of(model);
-    match effects.iter().find(|e| !offered.contains(e)) {
-        None => Ok(()),
-        Some(e) => {
-            let names: Vec<String> = offered.iter().map(|e| e.to_string()).collect();
-            Err(format!(
-                "{e}: {} does not offer this effect (it offers: {})",
-                model.name(),
-                if names.is_empty() {
-                    "none".into()
-                } else {
-                    names.join(", ")
-                }
-            ))
-        }
-    }
-}
-
-/// Effect names (GAP.md) parsed, the error naming the bad one.
-pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
-    names
-        .iter()
-        .map(|e| e.parse::<Effect>().map_err(|m| anyhow::anyhow!("{m}")))
-        .collect()
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn a_spec_reads_from_its_own_toml_table() {
-        let s: ModelSpec = toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nmesh = 4\n").unwrap();
-        assert_eq!(
-            s,
-            ModelSpec::C1Fe(C1FeSpec {
-                law: "yeoh".into(),
-                mesh: Some("4".into()),
-                ..Default::default()
-            })
-        );
-        assert!(matches!(s.validate(), Ok(Model::C1Fe(m)) if m.elements == (76, 36)));
-        let e = toml::from_str::<ModelSpec>("[c1]\nlaw = \"yeoh\"\nmesh = 4\n")
-            .unwrap_err()
-            .to_string();
-        assert!(e.contains("mesh"), "{e}");
-    }
-
-    /// `[n3_needle]`: coarse by default, friction and mesh checked by name.
-    #[test]
-    fn n3_needle_spec() {
-        let s: ModelSpec =
-            toml::from_str("[n3_needle]\nlaw = \"neo-hookean\"\nfriction = 0\n").unwrap();
-        assert_eq!(s.kind(), "n3_needle");
-        assert!(
-            matches!(s.validate(), Ok(Model::N3Needle(m)) if m.level == 1 && m.friction == 0.0)
-        );
-        let n3 = |f: fn(&mut N3NeedleSpec)| {
-            let mut s = N3NeedleSpec {
-                law: "neo-hookean".into(),
-                ..Default::default()
-            };
-            f(&mut s);
-            ModelSpec::N3Needle(s).validate().unwrap_err().to_string()
-        };
-        assert!(n3(|s| s.friction = Some(-0.1)).starts_with("n3_needle.friction"));
-        let e = n3(|s| s.mesh = Some("fine".into()));
-        assert!(
-            e.starts_with("n3_needle.mesh") && e.contains("241703 equations"),
-            "{e}"
-        );
-        assert!(n3(|s| s.tool = Some("cone".into())).starts_with("n3_needle.tool"));
-        assert!(n3(|s| s.element = Some("hex20".into())).starts_with("n3_needle.element"));
-        let s: ModelSpec =
-            toml::from_str("[n3_needle]\nlaw = \"neo-hookean\"\nelement = \"hex27\"\n").unwrap();
-        assert!(matches!(s.validate(),
-            Ok(Model::N3Needle(m)) if m.element == N3Element::Hex27 && m.mesh == N3Mesh::OGrid && m.level == 1));
-    }
-
-    #[test]
-    fn c1_fe_takes_a_prony_series() {
-        let s: ModelSpec =
-            toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nprony = \"g1=0.3,tau1=0.5\"\n").unwrap();
-        assert!(matches!(s.validate(),
-            Ok(Model::C1Fe(m)) if m.prony.as_ref().map(|p| p.terms().to_vec()) == Some(vec![(0.3, 0.5)])));
-        let s: ModelSpec =
-            toml::from_str("[c1_fe]\nlaw = \"yeoh\"\nprony = \"g1=0.7,tau1=1,g2=0.3,tau2=2\"\n")
-                .unwrap();
-        let e = s.validate().unwrap_err().to_string();
-        assert!(e.contains("prony") && e.contains("sum to 1"), "{e}");
-    }
-
-    #[test]
-    fn q1_reads_its_mesh_element_and_prony() {
-        let s: ModelSpec = toml::from_str(
-            "[q1]\nlaw = \"neo-hookean\"\nmesh = 1\nelement = \"quad9\"\nprony = \"g1=0.3,tau1=0.5\"\n",
-        )
-        .unwrap();
-        assert_eq!(s.kind(), "q1");
-        assert!(matches!(s.validate(),
-            Ok(Model::Q1(m)) if m.level == 1 && m.element == N1Element::Quad9 && m.prony.is_some()));
-        assert!(s.test().unwrap_err().to_string().contains("Q1 records"));
-        let s: ModelSpec =
-            toml::from_str("[q1]\nlaw = \"neo-hookean\"\nelement = \"tri3\"\n").unwrap();
-        assert!(s
-            .validate()
-            .unwrap_err()
-            .to_string()
-            .starts_with("q1.element"));
-    }
-
-    #[test]
-    fn q1_reads_its_edge_radius() {
-        let q1 = |extra: &str| -> ModelSpec {
-            toml::from_str(&format!("[q1]\nlaw = \"neo-hookean\"\n{extra}")).unwrap()
-        };
-        assert!(matches!(q1("").validate(),
-            Ok(Model::Q1(m)) if m.edge_radius == palpate_fe::q1::DEFAULT_EDGE_RADIUS));
-        assert!(matches!(q1("edge_radius = 1.0\n").validate(),
-            Ok(Model::Q1(m)) if m.edge_radius == 1.0));
-        for bad in ["0", "-0.2", "2.0", "5.0", "nan"] {
-            let e = q1(&format!("edge_radius = {bad}\n"))
-                .validate()
-                .unwrap_err();
-            assert_eq!(e.field, "edge_radius", "{bad}");
-            assert!(e.to_string().starts_with("q1.edge_radius"), "{e}");
-        }
-    }
-
-    #[test]
-    fn the_one_mesh_parser() {
-        for (s, level) in [("coarse", 1), ("medium", 2), ("fine", 3), ("12", 12)] {
-            assert_eq!(parse_mesh("n1_needle", Some(s)), Ok(level));
-        }
-        assert_eq!(parse_mesh("n1_needle", None), Ok(2));
-        for bad in ["0", "13", "-1", "1.5", "Coarse"] {
-            let e = parse_mesh("n1_needle", Some(bad)).unwrap_err();
-            assert_eq!((e.field, e.value.as_str()), ("mesh", bad));
-        }
-    }
-
-    #[test]
-    fn bad_values_name_their_field() {
-        let n1 = |f: fn(&mut N1NeedleSpec)| {
-            let mut s = N1NeedleSpec {
-                law: "neo-hookean".into(),
-                ..Default::default()
-            };
-            f(&mut s);
-            ModelSpec::N1Needle(s).validate().unwrap_err().to_string()
-        };
-        assert!(n1(|s| s.law = "neo".into()).starts_with("n1_needle.law = \"neo\""));
-        assert!(
-            n1(|s| s.element = Some("quad8".into())).contains("element"),
-            "a misspelled element is named"
-        );
-        assert!(n1(|s| s.friction = Some(-0.1)).starts_with("n1_needle.friction"));
-        assert!(n1(|s| s.bulk = Some("0".into())).starts_with("n1_needle.bulk"));
-        assert!(n1(|s| s.base = Some("glued".into())).starts_with("n1_needle.base"));
-        assert!(n1(|s| s.tool = Some("sphere:-1".into())).starts_with("n1_needle.tool"));
-    }
-}
+#[path = "models_tests.rs"]
+mod tests;
