@@ -656,6 +656,27 @@ pub fn ramp_correction(
     })
 }
 
+/// Past this depth (mm) a fit mesh coarser than [`DEEP_FIT_MESH`] is stiff
+/// under the punch's rounded edge (18 % at 5 mm for 0.3 mm cells, 7 % for
+/// 0.15 mm; docs/guide.md).
+pub const DEEP_RECORD: f64 = 2.0;
+/// The element size under the punch below which deep fits are left alone.
+pub const DEEP_FIT_MESH: f64 = 0.15;
+
+/// A note for a record deeper than [`DEEP_RECORD`] fitted on a mesh coarser
+/// than [`DEEP_FIT_MESH`] without a correcting mesh, naming the remedy.
+pub fn deep_record_note(record: &Q1Record, options: &TwoStageOptions) -> Option<String> {
+    let depth = record.depth[record.ramp_end()];
+    (depth > DEEP_RECORD && options.h_fine > DEEP_FIT_MESH && options.correct_h.is_none()).then(|| {
+        format!(
+            "note: the record reaches {depth} mm; past {DEEP_RECORD} mm the {} mm fit mesh is stiff under the \
+             punch's edge (18 % at 5 mm for 0.3 mm cells), and the estimates carry its error: \
+             --correct-mesh 0.1 (manifest: correct_mesh) corrects each fit to a 0.1 mm mesh at a few runs of it",
+            options.h_fine
+        )
+    })
+}
+
 /// Runs the stages, the polish, the profiles and the one-stage comparison
 /// on `record`.
 pub fn identify(
@@ -669,6 +690,9 @@ pub fn identify(
             "the correcting mesh ({h} mm under the punch) must be finer than the fit mesh ({} mm)",
             options.h_fine
         );
+    }
+    if let Some(note) = deep_record_note(record, options) {
+        say(&note);
     }
     let visco: Arc<dyn ForwardModel> = Arc::new(options.viscoelastic_model());
     let elastic = StageModels {
@@ -911,6 +935,33 @@ mod tests {
         assert_eq!(o.correct_h, None);
         o.set_correct_mesh(0.1).unwrap();
         assert_eq!(o.correct_h, Some(0.1));
+    }
+
+    /// A deep record on the default fit mesh gets the note; a shallow one,
+    /// a corrected fit or a fine fit mesh do not.
+    #[test]
+    fn a_deep_record_is_told_of_the_correcting_mesh() {
+        let rec = |depth: f64| {
+            Q1Record::new(
+                "r",
+                vec![0.0, 0.5, 10.0],
+                vec![0.0, depth, depth],
+                vec![0.0, 0.1, 0.05],
+            )
+            .unwrap()
+        };
+        let mut o = TwoStageOptions::new(Law::NeoHookean);
+        let note = deep_record_note(&rec(5.0), &o).expect("a note at 5 mm");
+        assert!(
+            note.contains("5 mm") && note.contains("--correct-mesh"),
+            "{note}"
+        );
+        assert!(deep_record_note(&rec(1.0), &o).is_none());
+        o.set_correct_mesh(0.1).unwrap();
+        assert!(deep_record_note(&rec(5.0), &o).is_none());
+        let mut fine = TwoStageOptions::new(Law::NeoHookean);
+        fine.set_fit_mesh(0.1).unwrap();
+        assert!(deep_record_note(&rec(5.0), &fine).is_none());
     }
 
     #[test]
