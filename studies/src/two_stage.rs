@@ -354,6 +354,10 @@ pub struct StageResult {
     pub mesh_corrections: Vec<MeshCorrection>,
     /// LM iterations of each round (one round without `correct_h`).
     pub round_iterations: Vec<u64>,
+    /// Whether LM accepted any step: `false` when every round ended where
+    /// it started (every trial step raised the SSE until the step test
+    /// stopped it), which a report flags.
+    pub moved: bool,
     pub fit: FitReport,
 }
 
@@ -457,7 +461,7 @@ fn run_stage(
     options: &TwoStageOptions,
     say: Say<'_>,
 ) -> anyhow::Result<(StageResult, DataSet)> {
-    let mut theta = start;
+    let mut theta = start.clone();
     let (mut fe_runs, mut wall_s) = (0, 0.0);
     let (mut corrections, mut round_iterations) = (Vec::new(), Vec::new());
     let mut last = None;
@@ -547,6 +551,12 @@ fn run_stage(
         wall_s,
         converged: report.converged,
         termination: report.termination.to_string(),
+        // (the round trip through LM's unbounded coordinates moves a value
+        // that stayed by round-off)
+        moved: theta
+            .iter()
+            .zip(&start)
+            .any(|(a, b)| (a - b).abs() > 1e-9 * b.abs()),
         theta,
         correction: None,
         mesh_corrections: corrections,

@@ -134,6 +134,19 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
                 .join(" | ")
         );
     }
+    for s in result.stages.iter().chain(&result.one_stage) {
+        if !s.moved && !s.free.is_empty() {
+            let _ = writeln!(
+                r,
+                "\n**{}: no LM step was accepted**: every trial step raised the SSE until the step \
+                 test stopped LM where it started. Either the start is the optimum, or the FE model is \
+                 not smooth in its parameters there (a run that takes another branch); its standard \
+                 errors come from a finite-difference Jacobian that may have crossed such a jump. \
+                 Compare with the other route.",
+                s.stage
+            );
+        }
+    }
     let polish = result.stages.last().expect("the polish");
     let _ =
         writeln!(

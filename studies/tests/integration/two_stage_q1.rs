@@ -217,3 +217,32 @@ fn the_mesh_correction_removes_the_fit_mesh_bias() {
     assert!((2..=3).contains(&polish.mesh_corrections.len()));
     assert!(polish.round_iterations[1..].iter().all(|&i| i <= 2));
 }
+
+/// A polish that starts at its optimum accepts no step, and the report says
+/// so (the sign of a start at the optimum or of a model with jumps).
+#[test]
+fn a_polish_that_does_not_move_is_flagged() {
+    let mut o = options();
+    o.stages = Vec::new();
+    o.one_stage = false;
+    o.profile = false;
+    let model = o.viscoelastic_model();
+    let start: Vec<f64> = model.space().params.iter().map(|p| p.initial).collect();
+    let t: Vec<f64> = vec![0.0, 0.25, 0.5, 1.0, 2.0];
+    let d: Vec<f64> = vec![0.0, 0.25, 0.5, 0.5, 0.5];
+    let loading = Loading::timed(Drive::DisplacementMm, t.clone(), d.clone());
+    let f = model.predict(&start, &loading).expect("the record's run");
+    let rec = Q1Record::new("at the start", t, d, f).unwrap();
+    let result = identify(&rec, &o, &|_| {}).expect("identification");
+    let polish = result.stages.last().unwrap();
+    assert!(!polish.moved, "{:?}", polish.theta);
+    for (a, b) in polish.theta.iter().zip(&start) {
+        assert!((a / b - 1.0).abs() < 1e-12, "{:?}", polish.theta);
+    }
+    let text = report(&result, None);
+    assert!(text.contains("polish: no LM step was accepted"), "{text}");
+    // a fit that moves is not flagged
+    let moved = identify(&record(), &options(), &|_| {}).expect("identification");
+    assert!(moved.stages.iter().all(|s| s.moved));
+    assert!(!report(&moved, None).contains("no LM step"));
+}
