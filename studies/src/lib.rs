@@ -6,10 +6,12 @@
 
 pub mod anova_step;
 pub mod arrays;
+pub mod calibrate_step;
 pub mod calibration;
 pub mod checks;
 pub mod cli;
 pub mod columns;
+pub mod diagnose_step;
 pub mod limits;
 pub mod localize;
 pub mod localize_step;
