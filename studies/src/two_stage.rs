@@ -49,12 +49,10 @@ use serde::Serialize;
 use std::sync::Arc;
 use std::time::Instant;
 
+pub use crate::two_stage_profile::{Profile, CHI2_1_95};
+pub use crate::two_stage_ramp::ramp_correction;
 pub use crate::two_stage_report::report;
 pub use crate::two_stage_step::TwoStageStep;
-
-/// The chi-square(1) 95 % quantile: the profile-likelihood threshold
-/// (Venzon & Moolgavkar 1988), as `palpate_uq::gap`'s profiles.
-pub const CHI2_1_95: f64 = 3.841_458_820_694_124;
 
 /// The correction rounds stop when every estimate moves by less than this
 /// part of its standard error.
@@ -372,26 +370,6 @@ pub struct MeshCorrection {
     pub wall_s: f64,
 }
 
-/// A 95 % profile-likelihood interval: `min over the others SSE(x) / sigma^2`
-/// within [`CHI2_1_95`] of its minimum. Each side is evaluated at
-/// `estimate -/+ 2 SE` (the other parameters refitted by LM from the
-/// optimum) and the crossing interpolated linearly in the signed root
-/// `sqrt(delta chi2)` from the optimum (exact for a quadratic profile); a
-/// side whose first point stays below the threshold is tried at 4 SE, and
-/// is `None` (not bounded) if it still does, or if the point leaves the
-/// parameter's bounds or fails.
-#[derive(Debug, Clone, Serialize)]
-pub struct Profile {
-    pub param: String,
-    pub estimate: f64,
-    pub standard_error: Option<f64>,
-    pub lower: Option<f64>,
-    pub upper: Option<f64>,
-    /// (value, delta chi2) evaluated.
-    pub points: Vec<(f64, f64)>,
-    pub fe_runs: usize,
-}
-
 /// The whole identification.
 #[derive(Debug, Clone, Serialize)]
 pub struct TwoStageResult {
@@ -411,7 +389,7 @@ pub struct TwoStageResult {
 /// Progress of the stages (the CLI prints it).
 pub type Say<'a> = &'a (dyn Fn(&str) + Sync);
 
-fn lm_fit(
+pub(crate) fn lm_fit(
     objective: &Objective,
     start: Vec<f64>,
     options: &TwoStageOptions,
@@ -566,106 +544,6 @@ fn run_stage(
     Ok((result, set))
 }
 
-/// The elastic force curve of stage 1 scaled by the parameter `s`, at the
-/// samples of the record: `s F_e(k)` (the ramp's elastic FE predictions,
-/// then the end-of-ramp value through the hold). The base of the
-/// force-level QLV of [`ramp_correction`].
-struct ScaledCurve {
-    fe: Vec<f64>,
-    space: palpate_core::ParamSpace,
-}
-
-impl ForwardModel for ScaledCurve {
-    fn name(&self) -> String {
-        "scaled elastic force curve of stage 1".into()
-    }
-    fn space(&self) -> &palpate_core::ParamSpace {
-        &self.space
-    }
-    fn observable(&self) -> palpate_core::Observable {
-        palpate_core::Observable::ForceN
-    }
-    fn evaluator(&self) -> Box<dyn palpate_core::Evaluator + '_> {
-        Box::new(ScaledEvaluator(self))
-    }
-}
-
-struct ScaledEvaluator<'a>(&'a ScaledCurve);
-
-impl palpate_core::Evaluator for ScaledEvaluator<'_> {
-    fn predict_into(
-        &mut self,
-        theta: &[f64],
-        loading: &Loading,
-        out: &mut [f64],
-    ) -> Result<(), palpate_core::ForwardError> {
-        if out.len() != self.0.fe.len() || loading.len() != out.len() {
-            return Err(palpate_core::ForwardError::InvalidLoading(
-                "the scaled curve answers only for its record".into(),
-            ));
-        }
-        for (o, f) in out.iter_mut().zip(&self.0.fe) {
-            *o = theta[0] * f;
-        }
-        Ok(())
-    }
-}
-
-/// The relaxation during the ramp lowers the ramp force, so stage 1's
-/// elastic fit underestimates the instantaneous moduli. Force-level QLV
-/// (`palpate_enrich::Viscoelastic`, Fung's QLV on the force: exact for the
-/// punch in the linear range by the correspondence principle) of the stage-1
-/// elastic curve `s F_e(t)` is fitted to the whole record by LM in
-/// `s, g_i, tau_i` from `s = 1` and the default Prony start; it costs no FE
-/// run (the curve is stage 1's). Returns `s` (the factor on the moduli:
-/// the force is proportional to them for a law with one modulus, e.g.
-/// neo-Hookean, under exact incompressibility) and the Prony terms,
-/// increasing in tau, as the start of stage 2. `None` when the record is
-/// not a ramp then a hold at constant depth, or the fit fails.
-pub fn ramp_correction(
-    record: &Q1Record,
-    fe_ramp: &[f64],
-    terms: usize,
-) -> Option<(f64, Vec<f64>)> {
-    let k = record.ramp_end();
-    if fe_ramp.len() != k + 1 || record.depth[k..].iter().any(|&d| d != record.depth[k]) {
-        return None;
-    }
-    let mut fe = fe_ramp.to_vec();
-    fe.resize(record.depth.len(), fe_ramp[k]);
-    let base = ScaledCurve {
-        fe,
-        space: palpate_core::ParamSpace::new(vec![palpate_core::ParamSpec::new(
-            "scale",
-            "1",
-            0.0,
-            f64::INFINITY,
-            1.0,
-        )]),
-    };
-    let qlv = palpate_enrich::Viscoelastic::new(Box::new(base), terms);
-    let set = DataSet::new(
-        "ramp correction",
-        Arc::new(qlv),
-        record.loading(),
-        record.force.clone(),
-    );
-    let objective = Objective::new(vec![set], ResidualKind::Absolute, &[]).ok()?;
-    let report = fit(&objective, &FitOptions::default()).ok()?;
-    let theta: Vec<f64> = report.parameters.iter().map(|p| p.value).collect();
-    let mut pairs: Vec<(f64, f64)> = (0..terms)
-        .map(|i| (theta[1 + 2 * i], theta[2 + 2 * i]))
-        .collect();
-    pairs.sort_by(|a, b| a.1.total_cmp(&b.1));
-    let sum: f64 = pairs.iter().map(|p| p.0).sum();
-    (report.converged && sum < 1.0 && theta[0] > 0.0).then(|| {
-        (
-            theta[0],
-            pairs.into_iter().flat_map(|(g, t)| [g, t]).collect(),
-        )
-    })
-}
-
 /// Past this depth (mm) a fit mesh coarser than [`DEEP_FIT_MESH`] is stiff
 /// under the punch's rounded edge (18 % at 5 mm for 0.3 mm cells, 7 % for
 /// 0.15 mm; docs/guide.md).
@@ -811,7 +689,7 @@ pub fn identify(
     let staged_wall_s = stages.iter().map(|s| s.wall_s).sum();
     let profiles = if options.profile {
         say("profile-likelihood intervals of the polished parameters");
-        profiles(&full, &polish, options)
+        crate::two_stage_profile::profiles(&full, &polish, options)
     } else {
         Vec::new()
     };
@@ -844,149 +722,6 @@ pub fn identify(
     })
 }
 
-/// The profile of each free parameter of the polish ([`Profile`]).
-fn profiles(set: &DataSet, polish: &StageResult, options: &TwoStageOptions) -> Vec<Profile> {
-    let report = &polish.fit;
-    let n = report.n_residuals as f64;
-    let p = report.free.len() as f64;
-    let sigma2 = report.sse / (n - p).max(1.0);
-    let mut lm = options.lm;
-    lm.max_iterations = 5;
-    report
-        .parameters
-        .iter()
-        .filter(|e| !e.fixed)
-        .map(|e| {
-            let mut prof = Profile {
-                param: e.name.clone(),
-                estimate: e.value,
-                standard_error: e.standard_error,
-                lower: None,
-                upper: None,
-                points: Vec::new(),
-                fe_runs: 0,
-            };
-            let Some(se) = e.standard_error.filter(|s| *s > 0.0) else {
-                return prof;
-            };
-            for side in [-1.0, 1.0] {
-                let mut end = None;
-                for m in [2.0, 4.0] {
-                    let x = e.value + side * m * se;
-                    if !(x > e.lower && x < e.upper) {
-                        break;
-                    }
-                    let Ok(objective) = Objective::new(
-                        vec![set.clone()],
-                        ResidualKind::Absolute,
-                        &[(e.name.clone(), x)],
-                    ) else {
-                        break;
-                    };
-                    let mut start = polish.theta.clone();
-                    let k = report
-                        .parameters
-                        .iter()
-                        .position(|q| q.name == e.name)
-                        .expect("a parameter of the fit");
-                    start[k] = x;
-                    let Ok((r, _)) = lm_fit(&objective, start, options, lm) else {
-                        break;
-                    };
-                    prof.fe_runs += r.evaluations;
-                    let d = ((r.sse - report.sse) / sigma2).max(0.0);
-                    prof.points.push((x, d));
-                    if d >= CHI2_1_95 {
-                        // linear in sqrt(delta chi2) from 0 at the estimate
-                        end = Some(e.value + side * m * se * (CHI2_1_95 / d).sqrt());
-                        break;
-                    }
-                }
-                if side < 0.0 {
-                    prof.lower = end;
-                } else {
-                    prof.upper = end;
-                }
-            }
-            prof
-        })
-        .collect()
-}
-
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// The setters both option builders (CLI, manifest step) share refuse
-    /// what they should and keep the old value when they do.
-    #[test]
-    fn the_setters_check_their_ranges() {
-        let mut o = TwoStageOptions::new(Law::NeoHookean);
-        o.set_terms(3).unwrap();
-        assert_eq!(o.terms, 3);
-        assert!(o.set_terms(0).unwrap_err().contains("1 to 4"));
-        assert!(o.set_terms(5).is_err());
-        assert_eq!(o.terms, 3);
-        o.set_fit_mesh(0.15).unwrap();
-        for bad in [0.01, 1.5, f64::NAN] {
-            assert!(o.set_fit_mesh(bad).unwrap_err().contains("0.02..1 mm"));
-        }
-        assert_eq!(o.h_fine, 0.15);
-        o.set_time_step(0.5).unwrap();
-        for bad in [0.0, -1.0, f64::INFINITY] {
-            assert!(o.set_time_step(bad).unwrap_err().contains("positive"));
-        }
-        assert_eq!(o.max_time_step, 0.5);
-        // the correcting mesh: in range and finer than the fit mesh (0.15)
-        for bad in [0.01, 0.15, 0.2] {
-            assert!(o.set_correct_mesh(bad).is_err(), "{bad}");
-        }
-        assert!(o.set_correct_mesh(0.2).unwrap_err().contains("finer"));
-        assert_eq!(o.correct_h, None);
-        o.set_correct_mesh(0.1).unwrap();
-        assert_eq!(o.correct_h, Some(0.1));
-    }
-
-    /// A deep record on the default fit mesh gets the note; a shallow one,
-    /// a corrected fit or a fine fit mesh do not.
-    #[test]
-    fn a_deep_record_is_told_of_the_correcting_mesh() {
-        let rec = |depth: f64| {
-            Q1Record::new(
-                "r",
-                vec![0.0, 0.5, 10.0],
-                vec![0.0, depth, depth],
-                vec![0.0, 0.1, 0.05],
-            )
-            .unwrap()
-        };
-        let mut o = TwoStageOptions::new(Law::NeoHookean);
-        let note = deep_record_note(&rec(5.0), &o).expect("a note at 5 mm");
-        assert!(
-            note.contains("5 mm") && note.contains("--correct-mesh"),
-            "{note}"
-        );
-        assert!(deep_record_note(&rec(1.0), &o).is_none());
-        o.set_correct_mesh(0.1).unwrap();
-        assert!(deep_record_note(&rec(5.0), &o).is_none());
-        let mut fine = TwoStageOptions::new(Law::NeoHookean);
-        fine.set_fit_mesh(0.1).unwrap();
-        assert!(deep_record_note(&rec(5.0), &fine).is_none());
-    }
-
-    #[test]
-    fn the_edge_radius_reaches_both_fit_models() {
-        let mut o = TwoStageOptions::new(Law::NeoHookean);
-        assert_eq!(
-            o.elastic_model().edge_radius,
-            palpate_fe::q1::DEFAULT_EDGE_RADIUS
-        );
-        o.set_edge_radius(1.0).unwrap();
-        assert_eq!(o.elastic_model().edge_radius, 1.0);
-        assert_eq!(o.viscoelastic_model().edge_radius, 1.0);
-        for bad in [0.0, -1.0, 2.0, f64::NAN] {
-            assert!(o.set_edge_radius(bad).is_err(), "{bad}");
-            assert_eq!(o.edge_radius, 1.0);
-        }
-    }
-}
+#[path = "two_stage_tests.rs"]
+mod tests;

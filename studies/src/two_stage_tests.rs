@@ -1,0 +1,76 @@
+//! Unit tests of `two_stage.rs`.
+
+use super::*;
+
+/// The setters both option builders (CLI, manifest step) share refuse
+/// what they should and keep the old value when they do.
+#[test]
+fn the_setters_check_their_ranges() {
+    let mut o = TwoStageOptions::new(Law::NeoHookean);
+    o.set_terms(3).unwrap();
+    assert_eq!(o.terms, 3);
+    assert!(o.set_terms(0).unwrap_err().contains("1 to 4"));
+    assert!(o.set_terms(5).is_err());
+    assert_eq!(o.terms, 3);
+    o.set_fit_mesh(0.15).unwrap();
+    for bad in [0.01, 1.5, f64::NAN] {
+        assert!(o.set_fit_mesh(bad).unwrap_err().contains("0.02..1 mm"));
+    }
+    assert_eq!(o.h_fine, 0.15);
+    o.set_time_step(0.5).unwrap();
+    for bad in [0.0, -1.0, f64::INFINITY] {
+        assert!(o.set_time_step(bad).unwrap_err().contains("positive"));
+    }
+    assert_eq!(o.max_time_step, 0.5);
+    // the correcting mesh: in range and finer than the fit mesh (0.15)
+    for bad in [0.01, 0.15, 0.2] {
+        assert!(o.set_correct_mesh(bad).is_err(), "{bad}");
+    }
+    assert!(o.set_correct_mesh(0.2).unwrap_err().contains("finer"));
+    assert_eq!(o.correct_h, None);
+    o.set_correct_mesh(0.1).unwrap();
+    assert_eq!(o.correct_h, Some(0.1));
+}
+
+/// A deep record on the default fit mesh gets the note; a shallow one,
+/// a corrected fit or a fine fit mesh do not.
+#[test]
+fn a_deep_record_is_told_of_the_correcting_mesh() {
+    let rec = |depth: f64| {
+        Q1Record::new(
+            "r",
+            vec![0.0, 0.5, 10.0],
+            vec![0.0, depth, depth],
+            vec![0.0, 0.1, 0.05],
+        )
+        .unwrap()
+    };
+    let mut o = TwoStageOptions::new(Law::NeoHookean);
+    let note = deep_record_note(&rec(5.0), &o).expect("a note at 5 mm");
+    assert!(
+        note.contains("5 mm") && note.contains("--correct-mesh"),
+        "{note}"
+    );
+    assert!(deep_record_note(&rec(1.0), &o).is_none());
+    o.set_correct_mesh(0.1).unwrap();
+    assert!(deep_record_note(&rec(5.0), &o).is_none());
+    let mut fine = TwoStageOptions::new(Law::NeoHookean);
+    fine.set_fit_mesh(0.1).unwrap();
+    assert!(deep_record_note(&rec(5.0), &fine).is_none());
+}
+
+#[test]
+fn the_edge_radius_reaches_both_fit_models() {
+    let mut o = TwoStageOptions::new(Law::NeoHookean);
+    assert_eq!(
+        o.elastic_model().edge_radius,
+        palpate_fe::q1::DEFAULT_EDGE_RADIUS
+    );
+    o.set_edge_radius(1.0).unwrap();
+    assert_eq!(o.elastic_model().edge_radius, 1.0);
+    assert_eq!(o.viscoelastic_model().edge_radius, 1.0);
+    for bad in [0.0, -1.0, 2.0, f64::NAN] {
+        assert!(o.set_edge_radius(bad).is_err(), "{bad}");
+        assert_eq!(o.edge_radius, 1.0);
+    }
+}
