@@ -13,6 +13,7 @@ pub mod run;
 pub mod sample;
 pub mod sample_fe;
 pub mod simulate;
+mod simulate_estimate;
 pub mod simulate_r2;
 pub mod surrogate;
 
