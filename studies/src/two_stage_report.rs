@@ -51,6 +51,13 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
              in brackets); FE runs are the fit mesh's, the correcting mesh's runs are counted apart.\n",
             crate::two_stage::ROUND_TOLERANCE
         );
+        if let Some(rho) = result.fit_edge_radius_mm {
+            let _ = writeln!(
+                r,
+                "The fit mesh's punch has an edge rounded {rho} mm (resolved by its cells, so that its \
+                 force is smooth in the parameters); the correcting mesh's is the record's punch.\n"
+            );
+        }
     }
     let corrected = result.correcting_mesh_mm.is_some();
     let _ = writeln!(

@@ -35,6 +35,10 @@ pub struct TwoStageStep {
     /// Radius of the punch's rounded edge (mm, default 0.2).
     #[serde(default)]
     pub edge_radius: Option<f64>,
+    /// Radius of the edge of the fit mesh's punch (mm; needs
+    /// `correct_mesh`, which keeps `edge_radius`; default `edge_radius`).
+    #[serde(default)]
+    pub fit_edge_radius: Option<f64>,
     /// The one-stage comparison (default true).
     #[serde(default)]
     pub compare: Option<bool>,
@@ -77,6 +81,10 @@ impl TwoStageStep {
         if let Some(rho) = self.edge_radius {
             o.set_edge_radius(rho)
                 .map_err(|e| anyhow::anyhow!("edge_radius = {rho}: {e}"))?;
+        }
+        if let Some(rho) = self.fit_edge_radius {
+            o.set_fit_edge_radius(rho)
+                .map_err(|e| anyhow::anyhow!("fit_edge_radius = {rho}: {e}"))?;
         }
         o.one_stage = self.compare.unwrap_or(true);
         o.profile = self.profile.unwrap_or(true);

@@ -74,3 +74,35 @@ fn the_edge_radius_reaches_both_fit_models() {
         assert_eq!(o.edge_radius, 1.0);
     }
 }
+
+/// The fit mesh's own punch edge: only with a correcting mesh, which keeps
+/// the record's punch; the fit models take it.
+#[test]
+fn the_fit_edge_needs_a_correcting_mesh_that_keeps_the_records_punch() {
+    let mut o = TwoStageOptions::new(Law::NeoHookean);
+    let e = o.set_fit_edge_radius(0.6).unwrap_err();
+    assert!(e.contains("correcting mesh"), "{e}");
+    assert_eq!(o.fit_edge_radius, None);
+    o.set_correct_mesh(0.1).unwrap();
+    for bad in [0.0, 2.0, f64::NAN] {
+        assert!(o.set_fit_edge_radius(bad).is_err(), "{bad}");
+    }
+    o.set_fit_edge_radius(0.6).unwrap();
+    assert_eq!(o.elastic_model().edge_radius, 0.6);
+    assert_eq!(o.viscoelastic_model().edge_radius, 0.6);
+    let rec = palpate_fe::q1::DEFAULT_EDGE_RADIUS;
+    assert_eq!(o.elastic_model_at(0.1).edge_radius, rec);
+    assert_eq!(o.viscoelastic_model_at(0.1).edge_radius, rec);
+    // a fit edge set on the struct without a correcting mesh is refused by
+    // the run
+    o.correct_h = None;
+    let r = Q1Record::new(
+        "r",
+        vec![0.0, 0.5, 1.0],
+        vec![0.0, 0.5, 0.5],
+        vec![0.0, 1.0, 0.9],
+    )
+    .unwrap();
+    let e = identify(&r, &o, &|_| {}).unwrap_err().to_string();
+    assert!(e.contains("only with a correcting mesh"), "{e}");
+}

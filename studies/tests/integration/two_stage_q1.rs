@@ -218,6 +218,64 @@ fn the_mesh_correction_removes_the_fit_mesh_bias() {
     assert!(polish.round_iterations[1..].iter().all(|&i| i <= 2));
 }
 
+/// The fit mesh with a punch of its own (a 1.5 mm edge, which the 1 mm cells
+/// resolve; the record's is 0.2 mm), corrected to the record's punch on the
+/// 0.5 mm mesh: the estimates land on the truth as with the fit mesh's
+/// punch the record's (the test above), and the report names the fit edge.
+#[test]
+fn a_fit_mesh_with_its_own_punch_edge_is_corrected_to_the_records() {
+    let fine = {
+        let mut o = options();
+        o.h_fine = 0.5;
+        o
+    };
+    let rec = record_on(&fine);
+    let mut o = options();
+    o.stages = vec!["elastic".into()];
+    o.one_stage = false;
+    o.profile = false;
+    o.set_correct_mesh(0.5).unwrap();
+    o.set_fit_edge_radius(1.5).unwrap();
+    let result = identify(&rec, &o, &|s| eprintln!("{s}")).expect("the corrected fit");
+    let text = report(&result, Some(&TRUTH));
+    eprintln!("{text}");
+    assert!(text.contains("edge rounded 1.5 mm"), "{text}");
+    let polish = result.stages.last().unwrap();
+    for (k, e) in polish.fit.parameters.iter().enumerate() {
+        let se = e.standard_error.expect("a standard error");
+        assert!(
+            (e.value - TRUTH[k]).abs() <= 2.0 * se,
+            "{} = {} +- {se}, truth {}",
+            e.name,
+            e.value,
+            TRUTH[k]
+        );
+    }
+    // the uncorrected fit mesh with this punch is far off: the correction
+    // did the work
+    let mut own = options();
+    own.edge_radius = 1.5;
+    let f_own = own
+        .viscoelastic_model()
+        .predict(&TRUTH, &record_loading(&rec))
+        .unwrap();
+    let f_rec = fine
+        .viscoelastic_model()
+        .predict(&TRUTH, &record_loading(&rec))
+        .unwrap();
+    let k = rec.ramp_end();
+    assert!(
+        f_own[k] < 0.9 * f_rec[k],
+        "{} against {}",
+        f_own[k],
+        f_rec[k]
+    );
+}
+
+fn record_loading(rec: &Q1Record) -> Loading {
+    Loading::timed(Drive::DisplacementMm, rec.time.clone(), rec.depth.clone())
+}
+
 /// A polish that starts at its optimum accepts no step, and the report says
 /// so (the sign of a start at the optimum or of a model with jumps).
 #[test]
