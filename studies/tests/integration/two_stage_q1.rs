@@ -175,22 +175,25 @@ fn the_study_manifest_is_valid() {
     );
 }
 
+/// A record made on a 0.5 mm mesh, and options that fit it on the 1 mm mesh
+/// with the elastic stage and the polish only.
+fn fine_record_and_elastic_stage() -> (Q1Record, TwoStageOptions) {
+    let mut fine = options();
+    fine.h_fine = 0.5;
+    let mut o = options();
+    o.stages = vec!["elastic".into()];
+    o.one_stage = false;
+    o.profile = false;
+    (record_on(&fine), o)
+}
+
 /// A record from a finer mesh than the fits' (0.5 mm under the punch, the
 /// fits 1 mm): the plain fit is biased by the fit mesh's stiffness; the fit
 /// corrected to the record's mesh (`correct_h`, output space mapping) lands
 /// on the truth, as the fine mesh's own fit would, with few runs of it.
 #[test]
 fn the_mesh_correction_removes_the_fit_mesh_bias() {
-    let fine = {
-        let mut o = options();
-        o.h_fine = 0.5;
-        o
-    };
-    let rec = record_on(&fine);
-    let mut plain = options();
-    plain.stages = vec!["elastic".into()];
-    plain.one_stage = false;
-    plain.profile = false;
+    let (rec, plain) = fine_record_and_elastic_stage();
     let mut corrected = plain.clone();
     corrected.set_correct_mesh(0.5).unwrap();
     let biased = identify(&rec, &plain, &|_| {}).expect("the plain fit");
@@ -224,16 +227,7 @@ fn the_mesh_correction_removes_the_fit_mesh_bias() {
 /// punch the record's (the test above), and the report names the fit edge.
 #[test]
 fn a_fit_mesh_with_its_own_punch_edge_is_corrected_to_the_records() {
-    let fine = {
-        let mut o = options();
-        o.h_fine = 0.5;
-        o
-    };
-    let rec = record_on(&fine);
-    let mut o = options();
-    o.stages = vec!["elastic".into()];
-    o.one_stage = false;
-    o.profile = false;
+    let (rec, mut o) = fine_record_and_elastic_stage();
     o.set_correct_mesh(0.5).unwrap();
     o.set_fit_edge_radius(1.5).unwrap();
     let result = identify(&rec, &o, &|s| eprintln!("{s}")).expect("the corrected fit");
