@@ -253,6 +253,8 @@ fn a_fit_mesh_with_its_own_punch_edge_is_corrected_to_the_records() {
         .viscoelastic_model()
         .predict(&TRUTH, &record_loading(&rec))
         .unwrap();
+    let mut fine = options();
+    fine.h_fine = 0.5;
     let f_rec = fine
         .viscoelastic_model()
         .predict(&TRUTH, &record_loading(&rec))
