@@ -392,6 +392,15 @@ pub struct StageResult {
     /// it started (every trial step raised the SSE until the step test
     /// stopped it), which a report flags.
     pub moved: bool,
+    /// With a correcting mesh: whether the last round's estimate stayed
+    /// within [`ROUND_TOLERANCE`] SE of its anchor (a stage corrected once,
+    /// or without correction: true). `false`: the rounds ran out with the
+    /// anchor still moving, so the estimate is not the correcting mesh's
+    /// optimum, which a report flags.
+    pub settled: bool,
+    /// The largest move of the last round, in standard errors of the
+    /// estimate (0 without correction rounds).
+    pub last_round_move_se: f64,
     pub fit: FitReport,
 }
 
@@ -482,6 +491,7 @@ fn run_stage(
     let (mut fe_runs, mut wall_s) = (0, 0.0);
     let (mut corrections, mut round_iterations) = (Vec::new(), Vec::new());
     let mut last = None;
+    let (mut settled, mut last_move) = (true, 0.0f64);
     for round in 0..rounds.max(1) {
         let model: Arc<dyn ForwardModel> = match &models.fine {
             None => models.coarse.clone(),
@@ -541,18 +551,21 @@ fn run_stage(
         fe_runs += report.evaluations;
         wall_s += w;
         round_iterations.push(report.iterations);
-        let settled = round > 0
-            && report
-                .parameters
-                .iter()
-                .zip(&theta)
-                .filter(|(e, _)| !e.fixed)
-                .all(|(e, &old)| match e.standard_error {
-                    Some(se) if se > 0.0 => (e.value - old).abs() <= ROUND_TOLERANCE * se,
-                    _ => (e.value - old).abs() <= 1e-3 * old.abs(),
-                });
+        // the move of each free estimate from the anchor, in its SE (or, with
+        // no SE, in 1e-3 of the value, against the tolerance's scale)
+        last_move = report
+            .parameters
+            .iter()
+            .zip(&theta)
+            .filter(|(e, _)| !e.fixed)
+            .map(|(e, &old)| match e.standard_error {
+                Some(se) if se > 0.0 => (e.value - old).abs() / se,
+                _ => (e.value - old).abs() / (1e-3 * old.abs()) * ROUND_TOLERANCE,
+            })
+            .fold(0.0, f64::max);
+        settled = models.fine.is_none() || rounds <= 1 || last_move <= ROUND_TOLERANCE;
         theta = report.parameters.iter().map(|p| p.value).collect();
-        let stop = models.fine.is_none() || settled;
+        let stop = models.fine.is_none() || (round > 0 && settled);
         last = Some((objective, report, set));
         if stop {
             break;
@@ -574,6 +587,12 @@ fn run_stage(
             .iter()
             .zip(&start)
             .any(|(a, b)| (a - b).abs() > 1e-9 * b.abs()),
+        settled,
+        last_round_move_se: if models.fine.is_some() && rounds > 1 {
+            last_move
+        } else {
+            0.0
+        },
         theta,
         correction: None,
         mesh_corrections: corrections,

@@ -153,6 +153,18 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
                 s.stage
             );
         }
+        if !s.settled {
+            let _ = writeln!(
+                r,
+                "\n**{}: the correction rounds ran out before the anchor settled**: the last round \
+                 moved an estimate by {:.1} standard errors from the anchor its correction was made \
+                 at (the rounds stop below {}), so the estimate is not yet the correcting mesh's \
+                 optimum. More rounds, or a start nearer the optimum (the staged route's), settle it.",
+                s.stage,
+                s.last_round_move_se,
+                crate::two_stage::ROUND_TOLERANCE
+            );
+        }
     }
     let polish = result.stages.last().expect("the polish");
     let _ =

@@ -272,6 +272,34 @@ fn record_loading(rec: &Q1Record) -> Loading {
     Loading::timed(Drive::DisplacementMm, rec.time.clone(), rec.depth.clone())
 }
 
+/// Correction rounds that run out with the anchor still moving are flagged:
+/// the one-stage fit from the default start, allowed 2 rounds, moves far in
+/// its first (its correction made at the start) and still more than 0.1 SE
+/// in its second; the polish, from the elastic stage, settles.
+#[test]
+fn correction_rounds_that_run_out_are_flagged() {
+    let (rec, mut o) = fine_record_and_elastic_stage();
+    o.set_correct_mesh(0.5).unwrap();
+    o.set_fit_edge_radius(1.5).unwrap();
+    o.one_stage = true;
+    o.correction_rounds = 2;
+    let result = identify(&rec, &o, &|s| eprintln!("{s}")).expect("the corrected fits");
+    let text = report(&result, Some(&TRUTH));
+    eprintln!("{text}");
+    let polish = result.stages.last().unwrap();
+    assert!(polish.settled, "{}", polish.last_round_move_se);
+    assert!(polish.last_round_move_se <= 0.1);
+    let one = result.one_stage.as_ref().unwrap();
+    assert_eq!(one.mesh_corrections.len(), 2);
+    assert!(!one.settled, "{}", one.last_round_move_se);
+    assert!(one.last_round_move_se > 0.1);
+    assert!(
+        text.contains("one-stage: the correction rounds ran out"),
+        "{text}"
+    );
+    assert!(!text.contains("polish: the correction rounds ran out"));
+}
+
 /// A polish that starts at its optimum accepts no step, and the report says
 /// so (the sign of a start at the optimum or of a model with jumps).
 #[test]
