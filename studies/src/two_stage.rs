@@ -775,7 +775,12 @@ pub fn identify(
     };
     Ok(TwoStageResult {
         record: record.name.clone(),
-        model: visco.name(),
+        // the model the estimates are of: the correcting mesh's (the
+        // record's punch) when the fits were corrected
+        model: viscous
+            .fine
+            .as_ref()
+            .map_or_else(|| visco.name(), |f| f.name()),
         names,
         stages,
         profiles,

@@ -234,6 +234,8 @@ fn a_fit_mesh_with_its_own_punch_edge_is_corrected_to_the_records() {
     let text = report(&result, Some(&TRUTH));
     eprintln!("{text}");
     assert!(text.contains("edge rounded 1.5 mm"), "{text}");
+    // the estimates are of the record's punch: the header names it
+    assert!(result.model.contains("edge 0.2 mm"), "{}", result.model);
     let polish = result.stages.last().unwrap();
     for (k, e) in polish.fit.parameters.iter().enumerate() {
         let se = e.standard_error.expect("a standard error");
