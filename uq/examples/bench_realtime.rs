@@ -27,10 +27,12 @@ fn main() {
             "memory kernel: {} knots, {} time constants, loss of contact {}",
             k.knots,
             k.taus.len(),
-            if k.lift_off {
-                "frees the surface"
+            if !k.lift_off {
+                "clamps".to_string()
+            } else if k.soft_contact[0] == 0.0 {
+                "frees the surface".to_string()
             } else {
-                "clamps"
+                format!("compliant over {:.3} mm", k.soft_contact[0])
             }
         ),
         None => println!("plain QLV on the force curve"),

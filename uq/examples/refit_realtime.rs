@@ -3,6 +3,7 @@
 //! `cargo run --release -p palpate-uq --example refit_realtime -- SURROGATE.json [KNOTS]`
 //! (a file from `palpate surrogate build`, which stores its FE runs).
 //! For studying the kernel's form on FE data that took minutes to make.
+//! With env `OUT=FILE` the refitted surrogate is written there.
 
 use palpate_uq::surrogate::realtime::{History, RealTimeSurrogate};
 
@@ -17,12 +18,14 @@ fn main() {
     s.refit(knots).expect("refit");
     let k = s.kernel.as_ref().expect("a kernel");
     println!(
-        "{} knots: training RMS {:.3e} N over {} stations, cv {:?}, lift_off {}",
+        "{} knots: training RMS {:.3e} N over {} stations, cv {:?} {:?}, lift_off {} {:?}",
         k.knots,
         k.training.rms_n,
         k.training.stations,
         k.training.cv_max_relative_error,
-        k.lift_off
+        k.training.cv_contacts,
+        k.lift_off,
+        k.soft_contact
     );
     for v in &s.validation {
         println!(
@@ -32,6 +35,9 @@ fn main() {
             v.peak_force_n,
             v.worst_at
         );
+    }
+    if let Ok(out) = std::env::var("OUT") {
+        std::fs::write(&out, s.to_json()).expect("write the refitted surrogate");
     }
     if std::env::var("STATIONS").is_ok() {
         for r in s.runs.clone() {

@@ -242,6 +242,20 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// How the fitted memory meets the punch, in words.
+pub fn contact_words(k: &palpate_uq::surrogate::memory_kernel::MemoryKernel) -> String {
+    let [g, a] = k.soft_contact;
+    if !k.lift_off {
+        "follows the punch".into()
+    } else if g == 0.0 {
+        "follows the free surface".into()
+    } else {
+        format!(
+            "follows a surface that lets go over a gap of {g:.3} mm (compliant contact, press {a:.3e} N)"
+        )
+    }
+}
+
 /// The held-out error table (Markdown), with plain QLV's error beside the
 /// fitted memory's when the surrogate has one.
 pub fn error_table(s: &RealTimeSurrogate) -> String {
@@ -254,19 +268,23 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
             k.training.histories,
             k.training.stations,
             k.training.rms_n,
-            if k.lift_off {
-                "follows the free surface"
-            } else {
-                "follows the punch"
-            },
+            contact_words(k),
         );
         if let Some([without, with]) = k.training.cv_max_relative_error {
             let _ = write!(
                 r,
-                " (cross-validated mean max error {:.2} % following the punch, {:.2} % the surface)",
+                " (cross-validated mean max error {:.2} % following the punch, {:.2} % the best loss of contact",
                 100.0 * without,
                 100.0 * with
             );
+            for ([g, a], e) in &k.training.cv_contacts {
+                let _ = if *g == 0.0 {
+                    write!(r, "; hard {:.2} %", 100.0 * e)
+                } else {
+                    write!(r, "; gap {g} D, press {a} peak {:.2} %", 100.0 * e)
+                };
+            }
+            r.push(')');
         }
         r.push_str("\n\n");
     }

@@ -40,10 +40,26 @@
 //! `e = d` is negative, the surface is free; its depth `e > d` solves
 //! `F(e) = 0` (bisection: `F` is piecewise quadratic in `e`), the memory
 //! follows `e`, and the answer is 0. Without `lift_off` the memory follows
-//! the punch and the force is clamped at 0. Which one holds is chosen by
-//! cross-validation on the training histories ([`MemoryKernel::fit`]): it
-//! is physics for a flat punch, whose contact is all or nothing, and less
-//! so for a needle, whose contact shrinks gradually.
+//! the punch and the force is clamped at 0.
+//!
+//! A compliant contact (`soft_contact = [g0, A]`, with `lift_off`): the
+//! contact does not end at once, as neither the needle's (a shrinking
+//! contact patch) nor the rounded punch's does (the tissue lets go of the
+//! face and the edge at different times). The surface's depth `e` lags
+//! the punch by a gap `g = e - d` at which the punch presses with
+//! `H(g) = A (g0 / g - 1)` (`g < g0`; 0 beyond): `e` solves `F(e) = H(e - d)`
+//! (bisection: `F(e) - H` rises from minus infinity at `e = d`), the memory
+//! follows `e`, and the answer is `F(e)`. Deep in contact the gap is small
+//! (`g ~ A g0 / F`); as the force falls the gap opens and the force fades to
+//! 0 over `g0` instead of stopping; beyond `g0` it is the hard rule's free
+//! surface. `g0 -> 0` is the hard contact. `H` is an empirical law, not a
+//! contact solution: its two constants are chosen with the rest.
+//!
+//! Which one holds (the punch, the hard contact or one of four compliant
+//! ones, [`COMPLIANT`]) is chosen by cross-validation on the training
+//! histories ([`MemoryKernel::fit`]): the free surface is physics for a
+//! flat punch, whose contact is all or nothing in the linear range, and
+//! less so for a needle or a rounded edge at depth.
 //!
 //! # Fit
 //!
@@ -64,6 +80,14 @@ use super::depth_history::History;
 const PRESENT: usize = 2;
 /// Fixed-point passes of the lift-off path in a fit.
 const LIFT_PASSES: usize = 3;
+/// Bisections of a surface depth (to `depth_max / 2^40`).
+const BISECTIONS: usize = 40;
+/// The compliant contacts the cross-validation tries besides the hard one:
+/// `[g0 / depth_max, A / peak force]` (session 20: on the 11 stored builds
+/// of the guide, the cross-validated choice among these four lowered the
+/// worst held-out error on 6, e.g. N1 frictionless to 10 mm 5.12 to 2.84
+/// %, Q1 to 5 mm on mesh 2 8.61 to 3.42 %, and raised it on 2).
+pub const COMPLIANT: [[f64; 2]; 4] = [[0.05, 0.03], [0.1, 0.03], [0.1, 0.1], [0.2, 0.03]];
 /// Folds of the cross-validation that chooses `lift_off`.
 const FOLDS: usize = 4;
 /// Stations whose FE force is below this fraction of the run's peak are
@@ -90,6 +114,11 @@ pub struct KernelTraining {
     /// the held-out runs of each one's largest), without and with loss of
     /// contact (the smaller one chose `lift_off`); none if not fitted.
     pub cv_max_relative_error: Option<[f64; 2]>,
+    /// Each loss-of-contact form the cross-validation tried after the
+    /// punch-following one: `[g0 / depth_max, A / peak force]` (`[0, 0]`
+    /// the hard contact) and its score as above.
+    #[serde(default)]
+    pub cv_contacts: Vec<([f64; 2], f64)>,
 }
 
 /// The fitted memory and its state (the state is not stored).
@@ -107,6 +136,11 @@ pub struct MemoryKernel {
     pub memory: Vec<f64>,
     /// Loss of contact (see the module doc).
     pub lift_off: bool,
+    /// A compliant contact with `lift_off`: `[g0 (mm), A (N)]` of the
+    /// press `H(g) = A (g0 / g - 1)` at a gap `g = e - d < g0` (module
+    /// doc); `g0 = 0` is the hard contact (files written before it).
+    #[serde(default)]
+    pub soft_contact: [f64; 2],
     pub training: KernelTraining,
     #[serde(skip)]
     state: KernelState,
@@ -141,11 +175,13 @@ impl MemoryKernel {
             equilibrium: vec![0.0; knots],
             memory: vec![0.0; taus.len() * knots * PRESENT],
             lift_off,
+            soft_contact: [0.0; 2],
             training: KernelTraining {
                 histories: 0,
                 stations: 0,
                 rms_n: 0.0,
                 cv_max_relative_error: None,
+                cv_contacts: Vec::new(),
             },
             state: KernelState::default(),
         }
@@ -218,7 +254,8 @@ impl MemoryKernel {
         let nk = self.knots;
         let st = &mut self.state;
         let h = hats(self.depth_max, nk, e);
-        let chi = [1.0 - e / self.depth_max, e / self.depth_max];
+        let r = e.min(self.depth_max) / self.depth_max;
+        let chi = [1.0 - r, r];
         let mut f = 0.0;
         if let Some(r) = row.as_deref_mut() {
             r.iter_mut().for_each(|v| *v = 0.0);
@@ -271,6 +308,9 @@ impl MemoryKernel {
     /// the force and the surface depth. The caller checks the range.
     pub(crate) fn step(&mut self, depth: f64, dt: f64) -> (f64, f64) {
         self.set_step(dt);
+        if self.lift_off && self.soft_contact[0] > 0.0 {
+            return self.step_compliant(depth);
+        }
         let f = self.trial(depth, None);
         if f >= 0.0 {
             self.commit(depth);
@@ -285,7 +325,7 @@ impl MemoryKernel {
         let e = if self.trial(hi, None) < 0.0 {
             hi
         } else {
-            for _ in 0..48 {
+            for _ in 0..BISECTIONS {
                 let mid = 0.5 * (lo + hi);
                 if self.trial(mid, None) < 0.0 {
                     lo = mid;
@@ -298,6 +338,34 @@ impl MemoryKernel {
         self.trial(e, None);
         self.commit(e);
         (0.0, e)
+    }
+
+    /// A step with the compliant contact: the surface depth `e` in
+    /// `(d, depth_max + g0]` where `F(e) = H(e - d)`, by bisection (`F(e) -
+    /// H` rises from minus infinity at `e = d`); beyond `g0` it is the free
+    /// surface's `F(e) = 0`. The force is `max(F(e), 0)`. (The depth
+    /// functions are constant beyond `depth_max`, so a punch at the range's
+    /// end keeps its gap.)
+    fn step_compliant(&mut self, depth: f64) -> (f64, f64) {
+        let [g0, a] = self.soft_contact;
+        let press = |g: f64| if g < g0 { a * (g0 / g - 1.0) } else { 0.0 };
+        let (mut lo, mut hi) = (depth, self.depth_max + g0);
+        let e = if self.trial(hi, None) < press(hi - depth) {
+            hi
+        } else {
+            for _ in 0..BISECTIONS {
+                let mid = 0.5 * (lo + hi);
+                if self.trial(mid, None) < press(mid - depth) {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            hi
+        };
+        let f = self.trial(e, None).max(0.0);
+        self.commit(e);
+        (f, e)
     }
 
     /// The forces and surface depths of a whole history from rest.
@@ -393,16 +461,20 @@ impl MemoryKernel {
         Ok(((res.norm_squared() / n as f64).sqrt(), n))
     }
 
-    /// Fits with or without loss of contact (module doc).
+    /// Fits with the surface following the punch (`contact` none) or with
+    /// loss of contact, hard (`[0, 0]`) or compliant (`[g0 (mm), A (N)]`)
+    /// (module doc).
     fn fit_with(
         depth_max: f64,
         knots: usize,
         taus: &[f64],
         runs: &[TrainingRun<'_>],
-        lift_off: bool,
+        contact: Option<[f64; 2]>,
         smoothing: f64,
     ) -> Result<(MemoryKernel, f64, usize), String> {
+        let lift_off = contact.is_some();
         let mut k = MemoryKernel::shape(depth_max, knots, taus, lift_off);
+        k.soft_contact = contact.unwrap_or([0.0; 2]);
         let mut paths: Vec<Vec<f64>> = runs.iter().map(|r| r.history.depth.clone()).collect();
         let (mut rms, mut n) = k.solve(runs, &paths, smoothing)?;
         if lift_off {
@@ -429,11 +501,12 @@ impl MemoryKernel {
 
     /// Fits the kernel to FE training runs (at least `FOLDS + 1` = 5; the first
     /// should reach `depth_max`): `knots` hat functions on `[0, depth_max]`,
-    /// the material's time constants `taus`. Whether the memory follows a
-    /// free surface on loss of contact is chosen by a 4-fold
-    /// cross-validation over the runs after the first (which stays in every
-    /// fold): the smaller mean of the held-out runs' largest errors. Then
-    /// the chosen form is fitted to all of them.
+    /// the material's time constants `taus`. How the memory meets the punch
+    /// (following it, a hard loss of contact, or one of the compliant ones
+    /// of [`COMPLIANT`]) is chosen by a 4-fold cross-validation over the runs
+    /// after the first (which stays in every fold): the smallest mean of the
+    /// held-out runs' largest errors, the simpler form on a tie. Then the
+    /// chosen form is fitted to all of them.
     pub fn fit(
         depth_max: f64,
         knots: usize,
@@ -466,8 +539,16 @@ impl MemoryKernel {
         let smoothing = 0.01 * peak;
         // run 0 (the ramp and hold to depth_max) stays in every fold: it
         // alone reaches the range's end and holds long
-        let mut cv = [0.0f64; 2];
-        for (slot, lift_off) in [false, true].into_iter().enumerate() {
+        let contacts: Vec<Option<[f64; 2]>> = [None, Some([0.0; 2])]
+            .into_iter()
+            .chain(
+                COMPLIANT
+                    .iter()
+                    .map(|c| Some([c[0] * depth_max, c[1] * peak])),
+            )
+            .collect();
+        let mut cv = vec![0.0f64; contacts.len()];
+        for (slot, &contact) in contacts.iter().enumerate() {
             let mut scored = 0usize;
             for fold in 0..FOLDS {
                 let held = |r: usize| r > 0 && (r - 1) % FOLDS == fold;
@@ -478,7 +559,7 @@ impl MemoryKernel {
                     .map(|(_, r)| r.clone())
                     .collect();
                 let (mut k, _, _) =
-                    Self::fit_with(depth_max, knots, taus, &train, lift_off, smoothing)?;
+                    Self::fit_with(depth_max, knots, taus, &train, contact, smoothing)?;
                 for (_, run) in runs.iter().enumerate().filter(|(r, _)| held(*r)) {
                     cv[slot] += k.max_relative_error(run);
                     scored += 1;
@@ -486,13 +567,20 @@ impl MemoryKernel {
             }
             cv[slot] /= scored.max(1) as f64;
         }
-        let lift_off = cv[1] <= cv[0];
-        let (mut k, rms, n) = Self::fit_with(depth_max, knots, taus, runs, lift_off, smoothing)?;
+        // the first smallest score: the simpler form on a tie
+        let best = (0..cv.len()).fold(0, |b, j| if cv[j] < cv[b] { j } else { b });
+        let (mut k, rms, n) =
+            Self::fit_with(depth_max, knots, taus, runs, contacts[best], smoothing)?;
+        let lifted = cv[1..].iter().copied().fold(f64::INFINITY, f64::min);
         k.training = KernelTraining {
             histories: runs.len(),
             stations: n,
             rms_n: rms,
-            cv_max_relative_error: Some(cv),
+            cv_max_relative_error: Some([cv[0], lifted]),
+            cv_contacts: std::iter::once([0.0; 2])
+                .chain(COMPLIANT)
+                .zip(cv[1..].iter().copied())
+                .collect(),
         };
         Ok(k)
     }
@@ -527,6 +615,16 @@ impl MemoryKernel {
         }
         if let Some(t) = self.taus.iter().find(|t| **t <= 0.0) {
             return Err(format!("memory kernel: time constant {t} s"));
+        }
+        if self
+            .soft_contact
+            .iter()
+            .any(|v| !(*v >= 0.0 && v.is_finite()))
+        {
+            return Err(format!(
+                "memory kernel: compliant contact {:?} (gap mm, force N): need values >= 0",
+                self.soft_contact
+            ));
         }
         Ok(())
     }
@@ -611,6 +709,134 @@ mod tests {
                 });
                 assert!(e < 2e-3, "lift_off {lift_off}: held-out error {e}");
             }
+        }
+    }
+
+    /// The compliant contact: deep in contact it answers as the hard one
+    /// (the gap is `~ A g0 / F`), on a withdrawal its force fades to 0 where
+    /// the hard one's stops at once, and a vanishing `g0` is the hard
+    /// contact.
+    #[test]
+    fn a_compliant_contact_fades_where_the_hard_one_lets_go() {
+        let (dmax, knots) = (2.0, 8);
+        let prony = [(0.3, 0.5), (0.2, 10.0)];
+        let elastic: Vec<f64> = (1..=knots)
+            .map(|k| {
+                let x = dmax * k as f64 / knots as f64;
+                x + 0.5 * x * x
+            })
+            .collect();
+        let hard = MemoryKernel::qlv(dmax, &elastic, &prony, true);
+        // a ramp to 2 mm in 0.5 s, a hold, a withdrawal in 0.2 s
+        let h = History::from_knots(
+            vec![(0.0, 0.0), (0.5, 2.0), (1.5, 2.0), (1.7, 0.0), (3.0, 0.0)],
+            1e-3,
+        );
+        let run = |k: &MemoryKernel| {
+            let mut k = k.clone();
+            k.run(&h)
+        };
+        let (fh, _) = run(&hard);
+        let peak = fh.iter().copied().fold(0.0, f64::max);
+        let mut soft = hard.clone();
+        soft.soft_contact = [0.1 * dmax, 0.03 * peak];
+        let (fs, es) = run(&soft);
+        let at = |t: f64| h.sample_at(t);
+        // at the end of the ramp and the hold: within 1 % of the peak
+        for t in [0.5, 1.5] {
+            let (a, b) = (fh[at(t)], fs[at(t)]);
+            assert!(
+                (a - b).abs() < 0.01 * peak,
+                "t {t}: hard {a}, compliant {b}"
+            );
+            assert!(es[at(t)] > h.depth[at(t)], "the surface lags by a gap");
+        }
+        // the hard contact lets go during the withdrawal; the compliant one
+        // still presses there, less than at the start of the withdrawal
+        let gone = (at(1.5)..at(1.7))
+            .find(|&j| fh[j] == 0.0)
+            .expect("the hard contact lets go before the punch is out");
+        assert!(
+            fs[gone] > 0.0 && fs[gone] < fs[at(1.5)],
+            "compliant {} where the hard one is 0",
+            fs[gone]
+        );
+        // and no jump: the largest change of a 1 ms sample is small
+        let jump = fs
+            .windows(2)
+            .map(|w| (w[1] - w[0]).abs())
+            .fold(0.0, f64::max);
+        assert!(jump < 0.02 * peak, "largest 1 ms change {jump} N");
+        // a vanishing g0 is the hard contact
+        let mut thin = hard.clone();
+        thin.soft_contact = [1e-9 * dmax, 0.03 * peak];
+        let (ft, _) = run(&thin);
+        let worst = ft
+            .iter()
+            .zip(&fh)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            worst < 1e-3 * peak,
+            "g0 -> 0 differs from the hard contact by {worst} N"
+        );
+        let mut bad = hard.clone();
+        bad.soft_contact = [f64::NAN, 1.0];
+        assert!(bad.check().unwrap_err().contains("compliant contact"));
+    }
+
+    /// Data made with a compliant contact: the cross-validation chooses a
+    /// compliant form, and the fit reproduces unseen histories.
+    #[test]
+    fn the_cross_validation_finds_a_compliant_contact() {
+        let (dmax, knots) = (2.0, 6);
+        let taus = [0.3, 4.0];
+        let mut truth = MemoryKernel::shape(dmax, knots, &taus, true);
+        for k in 0..knots {
+            let x = dmax * (k + 1) as f64 / knots as f64;
+            truth.equilibrium[k] = 0.5 * x + 0.2 * x * x;
+            for i in 0..taus.len() {
+                let base = (i * knots + k) * PRESENT;
+                truth.memory[base] = [0.3, 0.2][i] * (0.5 * x + 0.2 * x * x);
+                truth.memory[base + 1] = truth.memory[base];
+            }
+        }
+        let hs = histories(dmax, 12);
+        let peak = |k: &mut MemoryKernel| hs.iter().flat_map(|h| k.run(h).0).fold(0.0, f64::max);
+        // the compliant form [0.1, 0.1] of COMPLIANT at the data's peak
+        let p = peak(&mut truth.clone());
+        truth.soft_contact = [0.1 * dmax, 0.1 * p];
+        let forces: Vec<Vec<f64>> = hs.iter().map(|h| truth.run(h).0).collect();
+        let st: Vec<Vec<(f64, f64)>> = hs
+            .iter()
+            .zip(&forces)
+            .map(|(h, f)| stations(h, f))
+            .collect();
+        let runs: Vec<TrainingRun<'_>> = hs[..8]
+            .iter()
+            .zip(&st)
+            .map(|(history, s)| TrainingRun {
+                history,
+                stations: s,
+            })
+            .collect();
+        let mut fit = MemoryKernel::fit(dmax, knots, &taus, &runs).unwrap();
+        let cv = fit.training.cv_contacts.clone();
+        assert!(
+            fit.lift_off && fit.soft_contact[0] > 0.0,
+            "chose {:?}; cv {cv:?}",
+            fit.soft_contact
+        );
+        assert!(
+            cv[0].1 > 2.0 * cv[3].1,
+            "hard against the truth's form: {cv:?}"
+        );
+        for (h, s) in hs[8..].iter().zip(&st[8..]) {
+            let e = fit.max_relative_error(&TrainingRun {
+                history: h,
+                stations: s,
+            });
+            assert!(e < 1e-2, "held-out error {e}; cv {cv:?}");
         }
     }
 
