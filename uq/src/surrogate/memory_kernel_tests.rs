@@ -147,6 +147,18 @@ fn a_compliant_contact_fades_where_the_hard_one_lets_go() {
         .map(|w| (w[1] - w[0]).abs())
         .fold(0.0, f64::max);
     assert!(jump < 0.02 * peak, "largest 1 ms change {jump} N");
+    // at the surface after the withdrawal and at rest, no force; and it
+    // goes to 0 with the depth
+    assert_eq!(*fs.last().unwrap(), 0.0);
+    let mut rest = soft.clone();
+    rest.reset();
+    assert_eq!(
+        rest.step(0.0, 1e-3).0,
+        0.0,
+        "a force at the surface at rest"
+    );
+    let tiny = rest.step(1e-4, 1e-3).0;
+    assert!(tiny > 0.0 && tiny < 1e-3 * peak, "at 1e-4 mm: {tiny} N");
     // a vanishing g0 is the hard contact
     let mut thin = hard.clone();
     thin.soft_contact = [1e-9 * dmax, 0.03 * peak];
