@@ -325,23 +325,29 @@ impl MemoryKernel {
             return (0.0, depth);
         }
         // the free surface: F(e) = 0 for e in (depth, depth_max]
-        let (mut lo, mut hi) = (depth, self.depth_max);
-        let e = if self.trial(hi, None) < 0.0 {
-            hi
-        } else {
-            for _ in 0..BISECTIONS {
-                let mid = 0.5 * (lo + hi);
-                if self.trial(mid, None) < 0.0 {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
-            }
-            hi
-        };
+        let e = self.surface_depth(depth, self.depth_max, |_| 0.0);
         self.trial(e, None);
         self.commit(e);
         (0.0, e)
+    }
+
+    /// The surface depth `e` in `(lo, hi]` where the force `F(e)` meets the
+    /// punch's `press(e)` (`F - press` rising in `e`, negative at `lo`), by
+    /// bisection; `hi` if `F` stays below. Leaves the trial state at some
+    /// depth: the caller sets it at `e`.
+    fn surface_depth(&mut self, mut lo: f64, mut hi: f64, press: impl Fn(f64) -> f64) -> f64 {
+        if self.trial(hi, None) < press(hi) {
+            return hi;
+        }
+        for _ in 0..BISECTIONS {
+            let mid = 0.5 * (lo + hi);
+            if self.trial(mid, None) < press(mid) {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        hi
     }
 
     /// A step with the compliant contact: the surface depth `e` in
@@ -356,21 +362,15 @@ impl MemoryKernel {
     fn step_compliant(&mut self, depth: f64) -> (f64, f64) {
         let [g0, a] = self.soft_contact;
         let g0 = g0.min(depth);
-        let press = |g: f64| if g < g0 { a * (g0 / g - 1.0) } else { 0.0 };
-        let (mut lo, mut hi) = (depth, self.depth_max + g0);
-        let e = if self.trial(hi, None) < press(hi - depth) {
-            hi
-        } else {
-            for _ in 0..BISECTIONS {
-                let mid = 0.5 * (lo + hi);
-                if self.trial(mid, None) < press(mid - depth) {
-                    lo = mid;
-                } else {
-                    hi = mid;
-                }
+        let press = |e: f64| {
+            let g = e - depth;
+            if g < g0 {
+                a * (g0 / g - 1.0)
+            } else {
+                0.0
             }
-            hi
         };
+        let e = self.surface_depth(depth, self.depth_max + g0, press);
         let f = self.trial(e, None).max(0.0);
         self.commit(e);
         (f, e)
