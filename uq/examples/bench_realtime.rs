@@ -42,17 +42,19 @@ fn main() {
         per * 1e9,
         1e-6 / per
     );
-    println!("\n| held-out FE history | stations | peak force (N) | max error / peak | plain QLV |\n|---|---|---|---|---|");
+    println!("\n| held-out FE history | stations | peak force (N) | max error / peak | RMS error / peak | plain QLV |\n|---|---|---|---|---|---|");
     for (j, v) in s.validation.iter().enumerate() {
         let qlv = s.qlv_validation.get(j).map_or("".to_string(), |q| {
             format!("{:.2} %", 100.0 * q.max_relative_error)
         });
         println!(
-            "| {} | {} | {:.4e} | {:.2} % | {qlv} |",
+            "| {} | {} | {:.4e} | {:.2} % | {} | {qlv} |",
             v.history,
             v.samples,
             v.peak_force_n,
-            100.0 * v.max_relative_error
+            100.0 * v.max_relative_error,
+            v.rms_relative_error
+                .map_or("-".to_string(), |e| format!("{:.2} %", 100.0 * e))
         );
     }
     eprintln!("(checksum {sum:.3e})");

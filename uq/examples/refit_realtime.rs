@@ -29,11 +29,12 @@ fn main() {
     );
     for v in &s.validation {
         println!(
-            "{}: {:.2} % of peak {:.4} N at (s, mm) {:?}",
+            "{}: {:.2} % of peak {:.4} N at (s, mm) {:?}, RMS {:.2} %",
             v.history,
             100.0 * v.max_relative_error,
             v.peak_force_n,
-            v.worst_at
+            v.worst_at,
+            100.0 * v.rms_relative_error.unwrap_or(f64::NAN)
         );
     }
     if let Ok(out) = std::env::var("OUT") {

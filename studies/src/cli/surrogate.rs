@@ -296,24 +296,26 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
         let _ = writeln!(r, "not in the error table: {f}\n");
     }
     r.push_str(
-        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak | where (s, mm) |",
+        "| held-out FE history | stations | peak force (N) | max error (N) | max error / peak | where (s, mm) | RMS error / peak |",
     );
     r.push_str(if with_qlv {
-        " plain QLV: max error / peak |\n|---|---|---|---|---|---|---|\n"
+        " plain QLV: max error / peak |\n|---|---|---|---|---|---|---|---|\n"
     } else {
-        "\n|---|---|---|---|---|---|\n"
+        "\n|---|---|---|---|---|---|---|\n"
     });
     for (j, h) in s.validation.iter().enumerate() {
         let _ = write!(
             r,
-            "| {} | {} | {:.4e} | {:.3e} | {:.2} % | {} |",
+            "| {} | {} | {:.4e} | {:.3e} | {:.2} % | {} | {} |",
             h.history,
             h.samples,
             h.peak_force_n,
             h.max_abs_error_n,
             100.0 * h.max_relative_error,
             h.worst_at
-                .map_or("-".to_string(), |(t, d)| format!("{t:.2}, {d:.2}"))
+                .map_or("-".to_string(), |(t, d)| format!("{t:.2}, {d:.2}")),
+            h.rms_relative_error
+                .map_or("-".to_string(), |e| format!("{:.2} %", 100.0 * e))
         );
         if with_qlv {
             let _ = write!(
