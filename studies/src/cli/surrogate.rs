@@ -96,6 +96,12 @@ pub struct BuildArgs {
     /// Segments (ramps, holds, unloadings) per held-out history (default 6).
     #[arg(long, default_value_t = 6)]
     pub segments: usize,
+    /// The error the surrogate is meant to keep on held-out histories, as
+    /// the largest station error over the history's peak force, in per cent
+    /// [default: 2, issue 13's target]. A build that misses it is still
+    /// stored, with a warning naming the histories over it.
+    #[arg(long, value_name = "PCT", default_value_t = 2.0)]
+    pub target: f64,
     /// Where to store the surrogate (JSON).
     #[arg(long, value_name = "OUT.json")]
     pub out: PathBuf,
@@ -157,6 +163,9 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
             a.holdout,
             a.segments
         );
+    }
+    if !(a.target > 0.0 && a.target.is_finite()) {
+        bail!("--target {}: give a per cent > 0", a.target);
     }
     check_outputs(&[], &given(&[("--out", &Some(a.out.clone()))]))?;
     if a.friction.is_some() && !a.benchmark.eq_ignore_ascii_case("N1") {
@@ -234,6 +243,9 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
     let s = built.map_err(|e| anyhow!("building the surrogate of {}: {e}", visco.name()))?;
     write_atomic(&a.out, s.to_json().as_bytes())?;
     println!("{}", error_table(&s));
+    if let Some(w) = target_warning(&s, a.target) {
+        eprintln!("{w}");
+    }
     eprintln!(
         "built from {} FE runs in {:.1} s, stored in {}",
         s.fe_runs,
@@ -241,6 +253,39 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         a.out.display()
     );
     Ok(())
+}
+
+/// A warning naming the held-out histories whose largest error over their
+/// peak is above `target` per cent (with the RMS error, which says whether
+/// the history is off or a few stations are); none if all are within it.
+pub fn target_warning(s: &RealTimeSurrogate, target: f64) -> Option<String> {
+    let over: Vec<String> = s
+        .validation
+        .iter()
+        .filter(|h| 100.0 * h.max_relative_error > target)
+        .map(|h| {
+            let at = h
+                .worst_at
+                .map_or(String::new(), |(t, d)| format!(" at {t:.2} s, {d:.2} mm"));
+            let rms = h
+                .rms_relative_error
+                .map_or(String::new(), |e| format!(", RMS {:.2} %", 100.0 * e));
+            format!(
+                "{} {:.2} %{at}{rms}",
+                h.history,
+                100.0 * h.max_relative_error
+            )
+        })
+        .collect();
+    if over.is_empty() {
+        return None;
+    }
+    Some(format!(
+        "warning: {} of {} held-out histories above the {target} % target (largest error over the peak): {}. The surrogate is stored; at depth the largest errors sit where the contact ends or starts again (docs/guide.md, the real-time surrogate)",
+        over.len(),
+        s.validation.len(),
+        over.join("; ")
+    ))
 }
 
 /// How the fitted memory meets the punch, in words.
@@ -419,4 +464,47 @@ fn read_depths(path: &Path) -> anyhow::Result<(Vec<f64>, Vec<f64>)> {
         bail!("{}: no rows after the header", path.display());
     }
     Ok((time, depth))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use palpate_uq::surrogate::realtime::{HistoryError, MonotoneCubic};
+
+    fn row(name: &str, max: f64, rms: Option<f64>) -> HistoryError {
+        HistoryError {
+            history: name.into(),
+            samples: 20,
+            peak_force_n: 0.1,
+            max_abs_error_n: 0.1 * max,
+            max_relative_error: max,
+            rms_relative_error: rms,
+            worst_at: Some((13.8, 1.61)),
+        }
+    }
+
+    /// The warning names exactly the held-out histories over the target,
+    /// with where and the RMS; none when all are within it.
+    #[test]
+    fn the_build_warns_of_the_histories_over_the_target() {
+        let curve = MonotoneCubic::new(vec![0.0, 0.5, 1.0], vec![0.0, 0.01, 0.03]).unwrap();
+        let mut s = RealTimeSurrogate::new("test".into(), curve, vec![(0.3, 0.5)]).unwrap();
+        s.validation = vec![
+            row("random 1", 0.012, Some(0.004)),
+            row("random 3", 0.0381, Some(0.0103)),
+            row("random 4", 0.025, None),
+        ];
+        let w = target_warning(&s, 2.0).expect("two over 2 %");
+        assert!(
+            w.starts_with("warning: 2 of 3 held-out histories above the 2 % target"),
+            "{w}"
+        );
+        assert!(
+            w.contains("random 3 3.81 % at 13.80 s, 1.61 mm, RMS 1.03 %"),
+            "{w}"
+        );
+        assert!(w.contains("random 4 2.50 % at 13.80 s, 1.61 mm"), "{w}");
+        assert!(!w.contains("random 1"), "{w}");
+        assert_eq!(target_warning(&s, 4.0), None);
+    }
 }

@@ -151,6 +151,13 @@ fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
     };
     refused(&with_friction("Q1", "0"), &["--friction", "N1 only"]);
     refused(&with_friction("N1", "-0.2"), &["--friction -0.2", ">= 0"]);
+    // the error target is a per cent > 0
+    for bad in ["0", "-2", "NaN"] {
+        refused(
+            &surrogate_build(&s, "Q1", "g1=0.3,tau1=1", "1", &["--target", bad]),
+            &["--target", "per cent > 0"],
+        );
+    }
     assert!(!s.path("rt.json").exists());
     // a hold shorter than one step of the ramp
     let o = s.run(&[
