@@ -30,6 +30,7 @@ pub mod sample_step;
 pub mod shard;
 pub mod surrogate;
 pub mod two_stage;
+pub mod two_stage_mesh_check;
 pub mod two_stage_profile;
 pub mod two_stage_ramp;
 pub mod two_stage_report;

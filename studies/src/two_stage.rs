@@ -37,6 +37,7 @@
 //! ([`TwoStageOptions::fd`]); the time step is fixed (`max_time_step`), so
 //! the discretisation does not move with `tau_i`.
 
+use crate::two_stage_mesh_check::MeshCheck;
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
@@ -75,6 +76,11 @@ pub struct TwoStageOptions {
     /// corrected, sample by sample, to this mesh at an anchor point
     /// (`palpate_inverse::FidelityCorrection`, output space mapping).
     pub correct_h: Option<f64>,
+    /// Element size under the punch of a mesh the polish is checked on
+    /// (mm; `None`: no check): one more round of the polish corrected to it
+    /// gives the estimates' shift on that mesh
+    /// ([`crate::two_stage_mesh_check`]).
+    pub check_h: Option<f64>,
     /// Rounds of the polish and the one-stage fit with the correction: the
     /// anchor moves to each round's estimate until the estimates move by
     /// less than [`ROUND_TOLERANCE`] of their standard errors.
@@ -118,6 +124,7 @@ impl TwoStageOptions {
             terms: 2,
             h_fine: 0.3,
             correct_h: None,
+            check_h: None,
             correction_rounds: 3,
             max_time_step: 1.0,
             edge_radius: palpate_fe::q1::DEFAULT_EDGE_RADIUS,
@@ -199,6 +206,23 @@ impl TwoStageOptions {
             ));
         }
         self.correct_h = Some(h);
+        Ok(())
+    }
+
+    /// Sets the element size under the punch of the check mesh (mm,
+    /// 0.02..1, not the mesh the estimates are of: the correcting mesh, or
+    /// the fit mesh without one; set those first), or says why not.
+    pub fn set_mesh_check(&mut self, h: f64) -> Result<(), String> {
+        if !(h.is_finite() && (0.02..=1.0).contains(&h)) {
+            return Err("the element size under the punch must lie in 0.02..1 mm".into());
+        }
+        let of = self.correct_h.unwrap_or(self.h_fine);
+        if h == of {
+            return Err(format!(
+                "the estimates are already of the {of} mm mesh: check them on another"
+            ));
+        }
+        self.check_h = Some(h);
         Ok(())
     }
 
@@ -424,6 +448,10 @@ pub struct TwoStageResult {
     pub stages: Vec<StageResult>,
     pub profiles: Vec<Profile>,
     pub one_stage: Option<StageResult>,
+    /// The polish's estimates on the check mesh, if asked.
+    pub mesh_check: Option<MeshCheck>,
+    /// The fit mesh's element size under the punch (mm).
+    pub fit_mesh_mm: f64,
     /// The correcting mesh's element size under the punch (mm), if any.
     pub correcting_mesh_mm: Option<f64>,
     /// The edge radius of the fit mesh's punch when it differs from the
@@ -458,13 +486,13 @@ pub(crate) fn lm_fit(
 
 /// The models a stage fits: the fit mesh's, and the correcting mesh's when
 /// asked.
-struct StageModels {
-    coarse: Arc<dyn ForwardModel>,
-    fine: Option<Arc<dyn ForwardModel>>,
+pub(crate) struct StageModels {
+    pub(crate) coarse: Arc<dyn ForwardModel>,
+    pub(crate) fine: Option<Arc<dyn ForwardModel>>,
 }
 
 /// What one stage fits.
-struct StageData<'a> {
+pub(crate) struct StageData<'a> {
     stage: &'a str,
     name: String,
     loading: Loading,
@@ -479,7 +507,7 @@ struct StageData<'a> {
 /// estimates move by less than [`ROUND_TOLERANCE`] of their standard
 /// errors. Returns the result and the data set of the last round (the
 /// profiles refit it).
-fn run_stage(
+pub(crate) fn run_stage(
     data: &StageData<'_>,
     models: &StageModels,
     start: Vec<f64>,
@@ -751,6 +779,27 @@ pub fn identify(
     stages.push(polish.clone());
     let staged_fe_runs = stages.iter().map(|s| s.fe_runs).sum();
     let staged_wall_s = stages.iter().map(|s| s.wall_s).sum();
+    let mesh_check = match options.check_h {
+        Some(h) => {
+            say(&format!(
+                "mesh check: the polish corrected to a {h} mm mesh at its estimate"
+            ));
+            let c = crate::two_stage_mesh_check::mesh_check(
+                &whole("mesh-check", Vec::new()),
+                viscous.coarse.clone(),
+                &polish,
+                h,
+                options,
+                say,
+            )?;
+            say(&format!(
+                "  {} iterations, {} FE runs, {:.1} s",
+                c.iterations, c.fit_mesh_runs, c.wall_s
+            ));
+            Some(c)
+        }
+        None => None,
+    };
     let profiles = if options.profile {
         say("profile-likelihood intervals of the polished parameters");
         crate::two_stage_profile::profiles(&full, &polish, options)
@@ -785,6 +834,8 @@ pub fn identify(
         stages,
         profiles,
         one_stage,
+        mesh_check,
+        fit_mesh_mm: options.h_fine,
         correcting_mesh_mm: options.correct_h,
         fit_edge_radius_mm: options.fit_edge_radius,
         staged_fe_runs,

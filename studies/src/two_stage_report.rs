@@ -166,6 +166,13 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
             );
         }
     }
+    if let Some(c) = &result.mesh_check {
+        r += &crate::two_stage_mesh_check::report(
+            c,
+            &result.names,
+            Some(result.correcting_mesh_mm.unwrap_or(result.fit_mesh_mm)),
+        );
+    }
     let polish = result.stages.last().expect("the polish");
     let _ =
         writeln!(

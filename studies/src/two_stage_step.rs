@@ -39,6 +39,10 @@ pub struct TwoStageStep {
     /// `correct_mesh`, which keeps `edge_radius`; default `edge_radius`).
     #[serde(default)]
     pub fit_edge_radius: Option<f64>,
+    /// Element size under the punch of a mesh the polish is checked on (mm;
+    /// default none: `--mesh-check`).
+    #[serde(default)]
+    pub mesh_check: Option<f64>,
     /// The one-stage comparison (default true).
     #[serde(default)]
     pub compare: Option<bool>,
@@ -85,6 +89,10 @@ impl TwoStageStep {
         if let Some(rho) = self.fit_edge_radius {
             o.set_fit_edge_radius(rho)
                 .map_err(|e| anyhow::anyhow!("fit_edge_radius = {rho}: {e}"))?;
+        }
+        if let Some(h) = self.mesh_check {
+            o.set_mesh_check(h)
+                .map_err(|e| anyhow::anyhow!("mesh_check = {h}: {e}"))?;
         }
         o.one_stage = self.compare.unwrap_or(true);
         o.profile = self.profile.unwrap_or(true);

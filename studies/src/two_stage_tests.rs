@@ -30,6 +30,17 @@ fn the_setters_check_their_ranges() {
     assert_eq!(o.correct_h, None);
     o.set_correct_mesh(0.1).unwrap();
     assert_eq!(o.correct_h, Some(0.1));
+    // the check mesh: in range and not the mesh the estimates are of
+    for bad in [0.0, 0.01, 2.0, f64::NAN] {
+        assert!(o.set_mesh_check(bad).unwrap_err().contains("0.02..1 mm"));
+    }
+    assert!(o.set_mesh_check(0.1).unwrap_err().contains("already"));
+    assert_eq!(o.check_h, None);
+    o.set_mesh_check(0.0667).unwrap();
+    assert_eq!(o.check_h, Some(0.0667));
+    let mut plain = TwoStageOptions::new(Law::NeoHookean);
+    assert!(plain.set_mesh_check(0.3).unwrap_err().contains("0.3 mm"));
+    plain.set_mesh_check(0.15).unwrap();
 }
 
 /// A deep record on the default fit mesh gets the note; a shallow one,

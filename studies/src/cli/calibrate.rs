@@ -107,6 +107,12 @@ pub struct Args {
     /// 0.2 mm edge makes it jump branch.
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub fit_edge_radius: Option<f64>,
+    /// --benchmark Q1: after the polish, refit it once corrected to a mesh with this element size
+    /// under the punch, mm (off by default; level L of palpate simulate is 0.2/L): the report gives
+    /// how far each estimate moves on that mesh, in its standard errors (the mesh's error in the
+    /// estimates, which the standard errors do not hold). One run of that mesh.
+    #[arg(long, value_name = "MM", allow_hyphen_values = true)]
+    pub mesh_check: Option<f64>,
     /// --benchmark Q1: also fit every parameter at once from the default start (comparison).
     #[arg(long)]
     pub compare: bool,
@@ -260,6 +266,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         (args.time_step.is_some(), "--time-step"),
         (args.edge_radius.is_some(), "--edge-radius"),
         (args.fit_edge_radius.is_some(), "--fit-edge-radius"),
+        (args.mesh_check.is_some(), "--mesh-check"),
         (args.compare, "--compare"),
         (args.profile, "--profile"),
     ] {
@@ -358,6 +365,10 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
     if let Some(rho) = args.fit_edge_radius {
         o.set_fit_edge_radius(rho)
             .map_err(|e| anyhow::anyhow!("--fit-edge-radius {rho}: {e}"))?;
+    }
+    if let Some(h) = args.mesh_check {
+        o.set_mesh_check(h)
+            .map_err(|e| anyhow::anyhow!("--mesh-check {h}: {e}"))?;
     }
     o.one_stage = args.compare;
     o.profile = args.profile;

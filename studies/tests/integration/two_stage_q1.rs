@@ -328,3 +328,44 @@ fn a_polish_that_does_not_move_is_flagged() {
     assert!(moved.stages.iter().all(|s| s.moved));
     assert!(!report(&moved, None).contains("no LM step"));
 }
+
+/// The mesh check: a plain fit on the 1 mm mesh of a record made on the
+/// 0.5 mm mesh is biased (the test above); its check on the record's mesh
+/// (`check_h`, one corrected round from the polish) moves the estimates by
+/// several standard errors onto the truth, as the record's mesh's own fit
+/// would, and the report gives each shift.
+#[test]
+fn the_mesh_check_moves_a_biased_fit_onto_the_records_mesh() {
+    let (rec, mut o) = fine_record_and_elastic_stage();
+    o.set_mesh_check(0.5).unwrap();
+    let result = identify(&rec, &o, &|s| eprintln!("{s}")).expect("the fit and its check");
+    let text = report(&result, Some(&TRUTH));
+    eprintln!("{text}");
+    let check = result.mesh_check.as_ref().expect("a mesh check");
+    let polish = result.stages.last().unwrap();
+    let largest = check
+        .shift_se
+        .iter()
+        .map(|s| s.expect("a standard error").abs())
+        .fold(0.0, f64::max);
+    assert!(largest > 4.0, "{:?}", check.shift_se);
+    for (k, e) in polish.fit.parameters.iter().enumerate() {
+        let se = e.standard_error.unwrap();
+        assert!(
+            (check.theta[k] - TRUTH[k]).abs() <= 2.0 * se,
+            "{}: {} on the check mesh, truth {}",
+            e.name,
+            check.theta[k],
+            TRUTH[k]
+        );
+    }
+    assert!(
+        text.contains("**Mesh check**") && text.contains("on the 0.5 mm mesh"),
+        "{text}"
+    );
+    // no check unless asked
+    assert!(identify(&record(), &options(), &|_| {})
+        .unwrap()
+        .mesh_check
+        .is_none());
+}
