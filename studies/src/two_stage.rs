@@ -782,7 +782,8 @@ pub fn identify(
     let mesh_check = match options.check_h {
         Some(h) => {
             say(&format!(
-                "mesh check: the polish corrected to a {h} mm mesh at its estimate"
+                "mesh check: the polish corrected to a {} mm mesh at its estimate",
+                crate::two_stage_mesh_check::mm(h)
             ));
             let c = crate::two_stage_mesh_check::mesh_check(
                 &whole("mesh-check", Vec::new()),

@@ -98,6 +98,11 @@ fn compare(h: f64, theta: &[f64], polish: &[f64], se: &[Option<f64>]) -> MeshChe
     }
 }
 
+/// A mesh size to 4 significant digits (level 3, `0.2 / 3`, as 0.06667).
+pub fn mm(h: f64) -> String {
+    format!("{}", format!("{h:.3e}").parse::<f64>().unwrap_or(h))
+}
+
 /// The check as Markdown: what it is, and one row per parameter.
 pub fn report(check: &MeshCheck, names: &[String], estimate_mesh: Option<f64>) -> String {
     use std::fmt::Write;
@@ -109,7 +114,7 @@ pub fn report(check: &MeshCheck, names: &[String], estimate_mesh: Option<f64>) -
          run of the check mesh, {:.1} s, RMS {:.3e} N). The shift is what the estimates would move \
          by on that mesh (to first order); a shift of a standard error or more is the mesh's error \
          in the estimate, which the standard errors do not hold.\n",
-        check.mesh_mm,
+        mm(check.mesh_mm),
         estimate_mesh.map_or(String::new(), |h| format!(" of {h} mm")),
         check.iterations,
         if check.converged { "" } else { ", not converged" },
@@ -120,7 +125,7 @@ pub fn report(check: &MeshCheck, names: &[String], estimate_mesh: Option<f64>) -
     let _ = writeln!(
         r,
         "| parameter | polish | on the {} mm mesh | shift | shift / SE |\n|---|---|---|---|---|",
-        check.mesh_mm
+        mm(check.mesh_mm)
     );
     for (k, name) in names.iter().enumerate() {
         let _ = writeln!(
@@ -171,5 +176,7 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("12 fit-mesh runs"), "{md}");
+        assert_eq!(mm(0.2 / 3.0), "0.06667");
+        assert_eq!(mm(0.5), "0.5");
     }
 }
