@@ -493,12 +493,12 @@ pub(crate) struct StageModels {
 
 /// What one stage fits.
 pub(crate) struct StageData<'a> {
-    stage: &'a str,
-    name: String,
-    loading: Loading,
-    observed: Vec<f64>,
+    pub(crate) stage: &'a str,
+    pub(crate) name: String,
+    pub(crate) loading: Loading,
+    pub(crate) observed: Vec<f64>,
     /// Parameters held, by name.
-    fixed: Vec<(String, f64)>,
+    pub(crate) fixed: Vec<(String, f64)>,
 }
 
 /// Runs one stage: LM from `start` (every parameter of the models' space).
@@ -782,20 +782,25 @@ pub fn identify(
     let mesh_check = match options.check_h {
         Some(h) => {
             say(&format!(
-                "mesh check: the polish corrected to a {} mm mesh at its estimate",
+                "mesh check: the polish corrected to a {} mm mesh from its estimate",
                 crate::two_stage_mesh_check::mm(h)
             ));
-            let c = crate::two_stage_mesh_check::mesh_check(
-                &whole("mesh-check", Vec::new()),
-                viscous.coarse.clone(),
-                &polish,
-                h,
+            let se: Vec<Option<f64>> = polish
+                .fit
+                .parameters
+                .iter()
+                .map(|e| e.standard_error)
+                .collect();
+            let c = crate::two_stage_mesh_check::check_estimate(
+                record,
                 options,
+                &polish.theta,
+                &se,
                 say,
             )?;
             say(&format!(
-                "  {} iterations, {} FE runs, {:.1} s",
-                c.iterations, c.fit_mesh_runs, c.wall_s
+                "  {} iterations in {} rounds, {} FE runs, {:.1} s",
+                c.iterations, c.rounds, c.fit_mesh_runs, c.wall_s
             ));
             Some(c)
         }

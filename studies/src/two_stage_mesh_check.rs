@@ -2,27 +2,30 @@
 //! would move on another mesh: the discretisation error of the estimates,
 //! which their standard errors (noise only) do not hold.
 //!
-//! After the polish, one more round of it is corrected to the check mesh
-//! instead (`palpate_inverse::FidelityCorrection` at the polish estimate
-//! `theta`, output space mapping, theory.md 5.9) and refitted by LM from
-//! `theta`. To first order that lands on the check mesh's own optimum: with
-//! `F_h` the forces of the mesh the estimate is of and `F_c` the check
-//! mesh's, the optimum moves by
+//! After the polish, the polish is refitted with its fit mesh's model
+//! corrected to the check mesh instead (`palpate_inverse::FidelityCorrection`,
+//! output space mapping, theory.md 5.9), from the polish's estimate `theta`
+//! and round by round as the polish, until the estimates move by less than
+//! 0.1 SE: the check mesh's output-space-mapping fixed point, as the
+//! polish's estimate is the correcting mesh's. Its first round takes, to
+//! first order, the Gauss-Newton step to the check mesh's optimum
 //!
 //! ```text
 //! delta = -(J^T J)^-1 J^T (F_c(theta) - F_h(theta)),
 //! ```
 //!
-//! the least-squares image of the force difference (a Gauss-Newton step,
-//! e.g. Bates & Watts 1988, *Nonlinear regression analysis*, ch. 2), and
-//! one corrected round takes that step with the fit mesh's sensitivities
-//! scaled to the check mesh's forces. It costs one run of the check mesh
-//! and one LM of the fit mesh. A shift of more than a standard error says
-//! the estimate is limited by the mesh, not by the noise: at 5 mm with the
-//! punch's 0.2 mm edge, tau1 (docs/guide.md, two-stage, session 22).
+//! the least-squares image of the two meshes' force difference (`F_h` the
+//! mesh the estimate is of, `F_c` the check mesh; e.g. Bates & Watts 1988,
+//! *Nonlinear regression analysis*, ch. 2), with `J` the fit mesh's
+//! sensitivities scaled to the check mesh's forces. Each round costs one
+//! run of the check mesh and one LM of the fit mesh. A shift of more than a
+//! standard error says the estimate is limited by the mesh, not by the
+//! noise. It is read through the fit mesh's sensitivities: where their
+//! shape differs from the check mesh's (a fit mesh with its own punch edge,
+//! at depth), the fixed point is not the check mesh's own optimum (5 mm
+//! record, tau1: docs/guide.md, two-stage, session 22).
 
-use crate::two_stage::{run_stage, Say, StageData, StageModels, StageResult, TwoStageOptions};
-use palpate_core::ForwardModel;
+use crate::two_stage::{run_stage, Q1Record, Say, StageData, StageModels, TwoStageOptions};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -34,6 +37,11 @@ pub struct MeshCheck {
     /// The corrected round: LM iterations, fit-mesh runs, wall time (the
     /// check mesh's run included), RMS (N), whether LM converged.
     pub iterations: u64,
+    /// Rounds (runs of the check mesh), whether the last moved the
+    /// estimates by less than the tolerance, and its largest move in SE.
+    pub rounds: usize,
+    pub settled: bool,
+    pub last_round_move_se: f64,
     pub fit_mesh_runs: usize,
     pub wall_s: f64,
     pub rms: f64,
@@ -46,33 +54,49 @@ pub struct MeshCheck {
     pub shift_se: Vec<Option<f64>>,
 }
 
-/// The mesh check of `polish` on `data` (the whole record): the fit mesh's
-/// model `coarse` corrected to the check mesh at the polish's estimate.
-pub(crate) fn mesh_check(
-    data: &StageData<'_>,
-    coarse: Arc<dyn ForwardModel>,
-    polish: &StageResult,
-    h: f64,
+/// The mesh check of an estimate `theta` of the whole `record` with
+/// standard errors `se` (the polish's): the fit mesh's model corrected to
+/// the check mesh (`options.check_h`), from `theta`, round by round as the
+/// polish (at most `options.correction_rounds`, until the estimates move by
+/// less than [`crate::two_stage::ROUND_TOLERANCE`] SE).
+pub fn check_estimate(
+    record: &Q1Record,
     options: &TwoStageOptions,
+    theta: &[f64],
+    se: &[Option<f64>],
     say: Say<'_>,
 ) -> anyhow::Result<MeshCheck> {
+    let h = options
+        .check_h
+        .ok_or_else(|| anyhow::anyhow!("a mesh check needs the check mesh's element size"))?;
     let models = StageModels {
-        coarse,
+        coarse: Arc::new(options.viscoelastic_model()),
         fine: Some(Arc::new(options.viscoelastic_model_at(h))),
     };
-    let (round, _) = run_stage(data, &models, polish.theta.clone(), 1, options, say)?;
-    let ses: Vec<Option<f64>> = polish
-        .fit
-        .parameters
-        .iter()
-        .map(|e| e.standard_error)
-        .collect();
-    let mut check = compare(h, &round.theta, &polish.theta, &ses);
+    let data = StageData {
+        stage: "mesh-check",
+        name: record.name.clone(),
+        loading: record.loading(),
+        observed: record.force.clone(),
+        fixed: Vec::new(),
+    };
+    let (round, _) = run_stage(
+        &data,
+        &models,
+        theta.to_vec(),
+        options.correction_rounds,
+        options,
+        say,
+    )?;
+    let mut check = compare(h, &round.theta, theta, se);
     check.iterations = round.iterations;
-    check.fit_mesh_runs = round.fe_runs.saturating_sub(round.mesh_corrections.len());
+    check.rounds = round.mesh_corrections.len();
+    check.fit_mesh_runs = round.fe_runs.saturating_sub(check.rounds);
     check.wall_s = round.wall_s;
     check.rms = round.fit.rms;
     check.converged = round.converged;
+    check.settled = round.settled;
+    check.last_round_move_se = round.last_round_move_se;
     Ok(check)
 }
 
@@ -88,6 +112,9 @@ fn compare(h: f64, theta: &[f64], polish: &[f64], se: &[Option<f64>]) -> MeshChe
     MeshCheck {
         mesh_mm: h,
         iterations: 0,
+        rounds: 0,
+        settled: true,
+        last_round_move_se: 0.0,
         fit_mesh_runs: 0,
         wall_s: 0.0,
         rms: f64::NAN,
@@ -109,13 +136,24 @@ pub fn report(check: &MeshCheck, names: &[String], estimate_mesh: Option<f64>) -
     let mut r = String::new();
     let _ = writeln!(
         r,
-        "\n**Mesh check**: the polish refitted once more with its model corrected to a mesh of {} mm \
-         under the punch instead{} at the polish estimate ({} LM iterations{}, {} fit-mesh runs and one \
-         run of the check mesh, {:.1} s, RMS {:.3e} N). The shift is what the estimates would move \
-         by on that mesh (to first order); a shift of a standard error or more is the mesh's error \
-         in the estimate, which the standard errors do not hold.\n",
+        "\n**Mesh check**: the polish refitted with its model corrected to a mesh of {} mm under \
+         the punch instead{}, from the polish estimate, round by round as the polish ({} round{}{}; \
+         {} LM iterations{}, {} fit-mesh runs, {:.1} s, RMS {:.3e} N). The shift is how far the \
+         estimates move on that mesh, as seen through the fit mesh's sensitivities; a shift of a \
+         standard error or more is the mesh's error in the estimates, which the standard errors do \
+         not hold.\n",
         mm(check.mesh_mm),
-        estimate_mesh.map_or(String::new(), |h| format!(" of {h} mm")),
+        estimate_mesh.map_or(String::new(), |h| format!(" of {} mm", mm(h))),
+        check.rounds,
+        if check.rounds == 1 { "" } else { "s" },
+        if check.settled {
+            String::new()
+        } else {
+            format!(
+                ", not settled: the last moved an estimate by {:.1} SE",
+                check.last_round_move_se
+            )
+        },
         check.iterations,
         if check.converged { "" } else { ", not converged" },
         check.fit_mesh_runs,
@@ -161,6 +199,7 @@ mod tests {
         assert_eq!(c.shift_se[1], None);
         assert!((c.shift_se[2].unwrap() - 3.6).abs() < 1e-9);
         c.fit_mesh_runs = 12;
+        c.rounds = 2;
         let names: Vec<String> = ["C10", "g1", "tau1_s"]
             .iter()
             .map(|s| s.to_string())
@@ -176,6 +215,14 @@ mod tests {
             "{md}"
         );
         assert!(md.contains("12 fit-mesh runs"), "{md}");
+        assert!(md.contains("2 rounds;"), "{md}");
+        c.settled = false;
+        c.last_round_move_se = 0.7;
+        let md = report(&c, &names, None);
+        assert!(
+            md.contains("not settled: the last moved an estimate by 0.7 SE"),
+            "{md}"
+        );
         assert_eq!(mm(0.2 / 3.0), "0.06667");
         assert_eq!(mm(0.5), "0.5");
     }

@@ -331,7 +331,7 @@ fn a_polish_that_does_not_move_is_flagged() {
 
 /// The mesh check: a plain fit on the 1 mm mesh of a record made on the
 /// 0.5 mm mesh is biased (the test above); its check on the record's mesh
-/// (`check_h`, one corrected round from the polish) moves the estimates by
+/// (`check_h`, corrected rounds from the polish) moves the estimates by
 /// several standard errors onto the truth, as the record's mesh's own fit
 /// would, and the report gives each shift.
 #[test]
@@ -349,6 +349,11 @@ fn the_mesh_check_moves_a_biased_fit_onto_the_records_mesh() {
         .map(|s| s.expect("a standard error").abs())
         .fold(0.0, f64::max);
     assert!(largest > 4.0, "{:?}", check.shift_se);
+    // round by round as the polish: the second round settles
+    assert!(
+        check.settled && (2..=3).contains(&check.rounds),
+        "{check:?}"
+    );
     for (k, e) in polish.fit.parameters.iter().enumerate() {
         let se = e.standard_error.unwrap();
         assert!(
