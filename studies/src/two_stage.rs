@@ -39,7 +39,6 @@
 
 use crate::two_stage_mesh_check::MeshCheck;
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
 use palpate_inverse::{
     fit, CorrectedModel, DataSet, FdOptions, FidelityCorrection, FitOptions, FitReport, LmOptions,
@@ -280,11 +279,7 @@ impl TwoStageOptions {
     fn model_with(&self, h: f64, edge_radius: f64) -> Q1Punch {
         let mut m = Q1Punch::new(self.law);
         m.edge_radius = edge_radius;
-        m.grading = Some(Grading {
-            h_fine: h,
-            fine_length: 3.0,
-            growth: 1.0 + h,
-        });
+        m.set_fine_size(h);
         m
     }
 

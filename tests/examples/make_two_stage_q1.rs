@@ -88,11 +88,7 @@ fn main() {
         let mut m = model(level, dt);
         if let Some(h) = args.get(4) {
             let h: f64 = h.parse().expect("H_FINE");
-            m.grading = Some(palpate_fe::mesh::Grading {
-                h_fine: h,
-                fine_length: 3.0,
-                growth: 1.0 + h,
-            });
+            m.set_fine_size(h);
         }
         let (sim, _) = m.simulate(&TRUTH[..1], &loading, None).expect("run");
         let f = sim.forces;

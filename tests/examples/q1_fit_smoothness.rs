@@ -11,7 +11,6 @@
 //! With the 0.2 mm edge the 0.3 mm mesh jumps branch (g2 -1 %: +11 % at the
 //! ramp's end); with a 0.6 mm edge it is smooth (docs/guide.md, two-stage).
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
 use palpate_material::Law;
 
@@ -28,11 +27,7 @@ fn main() {
     }
     let mut m = Q1Punch::new(Law::NeoHookean);
     m.set_edge_radius(edge).unwrap();
-    m.grading = Some(Grading {
-        h_fine: h,
-        fine_length: 3.0,
-        growth: 1.0 + h,
-    });
+    m.set_fine_size(h);
     let mut m = m.with_prony_parameters(2);
     m.options.max_time_step = Some(1.0);
     let base = [0.00166, 0.327, 0.306, 0.206, 8.30];

@@ -17,7 +17,6 @@
 //! there), the step and the point it reaches. 11 runs, in parallel; env
 //! `RUNS_OUT=FILE` writes the points, their forces and the data as JSON.
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
 use palpate_material::Law;
 use rayon::prelude::*;
@@ -59,11 +58,7 @@ fn main() {
     }
     let mut m = Q1Punch::new(Law::NeoHookean);
     m.set_edge_radius(edge).unwrap();
-    m.grading = Some(Grading {
-        h_fine: h,
-        fine_length: 3.0,
-        growth: 1.0 + h,
-    });
+    m.set_fine_size(h);
     let mut m = m.with_prony_parameters(2);
     m.options.max_time_step = Some(1.0);
     let loading = Loading::timed(Drive::DisplacementMm, t.clone(), d.clone());

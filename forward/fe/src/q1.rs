@@ -222,14 +222,25 @@ impl Q1Punch {
 
     /// The grading in use (radial and axial).
     pub fn effective_grading(&self) -> Grading {
-        self.grading.unwrap_or_else(|| {
-            let n = self.level.max(1) as f64;
-            Grading {
-                h_fine: 0.2 / n,
-                fine_length: self.fine_zone,
-                growth: 1.0 + 0.2 / n,
-            }
-        })
+        self.grading
+            .unwrap_or_else(|| self.level_grading(0.2 / self.level.max(1) as f64))
+    }
+
+    /// The levels' grading with elements of `h` mm in the fine zone,
+    /// growing by `1 + h` beyond it (level `n` is `h = 0.2 / n`).
+    fn level_grading(&self, h: f64) -> Grading {
+        Grading {
+            h_fine: h,
+            fine_length: self.fine_zone,
+            growth: 1.0 + h,
+        }
+    }
+
+    /// Meshes as the levels do with elements of `h` mm (> 0) under the
+    /// punch: a level between the levels (`0.2 / n` is level `n`), as the
+    /// staged identification's fit and correcting meshes.
+    pub fn set_fine_size(&mut self, h: f64) {
+        self.grading = Some(self.level_grading(h));
     }
 
     /// The mesh this model uses.

@@ -196,3 +196,21 @@ fn the_stabilised_ramp_passes_the_edge_snap() {
     m.options.max_cuts = 4;
     assert!(m.simulate(&[C10], &loading, None).is_err());
 }
+
+/// A fine size of `0.2 / n` mm meshes as level `n` (what `palpate calibrate
+/// --correct-mesh` and `--mesh-check` sizes name), and any other size
+/// grades as the levels do.
+#[test]
+fn a_fine_size_of_a_level_meshes_as_that_level() {
+    let mut level3 = Q1Punch::new("neo-hookean".parse().unwrap());
+    level3.level = 3;
+    let mut sized = Q1Punch::new("neo-hookean".parse().unwrap());
+    sized.set_fine_size(0.2 / 3.0);
+    assert_eq!(sized.effective_grading(), level3.effective_grading());
+    let (a, b) = (sized.build_mesh().unwrap(), level3.build_mesh().unwrap());
+    assert_eq!(a.nodes.len(), b.nodes.len());
+    sized.set_fine_size(0.08);
+    let g = sized.effective_grading();
+    assert_eq!((g.h_fine, g.fine_length), (0.08, 3.0));
+    assert!((g.growth - 1.08).abs() < 1e-15, "{g:?}");
+}
