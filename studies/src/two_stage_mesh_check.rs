@@ -34,14 +34,15 @@ use std::sync::Arc;
 pub struct MeshCheck {
     /// Element size under the punch of the check mesh (mm).
     pub mesh_mm: f64,
-    /// The corrected round: LM iterations, fit-mesh runs, wall time (the
-    /// check mesh's run included), RMS (N), whether LM converged.
+    /// LM iterations over the corrected rounds.
     pub iterations: u64,
     /// Rounds (runs of the check mesh), whether the last moved the
     /// estimates by less than the tolerance, and its largest move in SE.
     pub rounds: usize,
     pub settled: bool,
     pub last_round_move_se: f64,
+    /// Fit-mesh runs, wall time (the check mesh's runs included), the last
+    /// round's RMS (N) and whether its LM converged.
     pub fit_mesh_runs: usize,
     pub wall_s: f64,
     pub rms: f64,
