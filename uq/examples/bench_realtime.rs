@@ -24,9 +24,10 @@ fn main() {
     println!("{}", s.model);
     match &s.kernel {
         Some(k) => println!(
-            "memory kernel: {} knots, {} time constants, loss of contact {}",
+            "memory kernel: {} knots, {} time constants, {} stop operators, loss of contact {}",
             k.knots,
             k.taus.len(),
+            k.play.len(),
             if !k.lift_off {
                 "clamps".to_string()
             } else if k.soft_contact[0] == 0.0 {

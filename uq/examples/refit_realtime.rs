@@ -27,6 +27,10 @@ fn main() {
         k.lift_off,
         k.soft_contact
     );
+    println!(
+        "cv with stop operators {:?}, stops {:?}",
+        k.training.cv_play, k.play
+    );
     for v in &s.validation {
         println!(
             "{}: {:.2} % of peak {:.4} N at (s, mm) {:?}, RMS {:.2} %",

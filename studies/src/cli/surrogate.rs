@@ -291,13 +291,22 @@ pub fn target_warning(s: &RealTimeSurrogate, target: f64) -> Option<String> {
 /// How the fitted memory meets the punch, in words.
 pub fn contact_words(k: &palpate_uq::surrogate::memory_kernel::MemoryKernel) -> String {
     let [g, a] = k.soft_contact;
-    if !k.lift_off {
+    let contact = if !k.lift_off {
         "follows the punch".into()
     } else if g == 0.0 {
         "follows the free surface".into()
     } else {
         format!(
             "follows a surface that lets go over a gap of {g:.3} mm (compliant contact, press {a:.3e} N)"
+        )
+    };
+    if k.play.is_empty() {
+        contact
+    } else {
+        let r: Vec<String> = k.play.iter().map(|r| format!("{r:.3}")).collect();
+        format!(
+            "{contact}, with stop operators (hysteresis) of {} mm",
+            r.join(", ")
         )
     }
 }
@@ -329,6 +338,19 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
                 } else {
                     write!(r, "; gap {g} D, press {a} peak {:.2} %", 100.0 * e)
                 };
+            }
+            if !k.training.cv_play.is_empty() {
+                let e: Vec<String> = k
+                    .training
+                    .cv_play
+                    .iter()
+                    .map(|e| format!("{:.2}", 100.0 * e))
+                    .collect();
+                let _ = write!(
+                    r,
+                    "; with stop operators, the same forms in order: {} %",
+                    e.join(" / ")
+                );
             }
             r.push(')');
         }

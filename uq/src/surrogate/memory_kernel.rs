@@ -64,6 +64,26 @@
 //! flat punch, whose contact is all or nothing in the linear range, and
 //! less so for a needle or a rounded edge at depth.
 //!
+//! Stop operators (`play`, session 23): a rate-independent hysteresis
+//! beside the memory,
+//!
+//! ```text
+//! F += sum_j (b_j0 chi_0(e) + b_j1 chi_1(e)) s_j(t),
+//! s_j(t) = clamp(s_j(t - dt) + e(t) - e(t - dt), -r_j, r_j),
+//! ```
+//!
+//! the stretch of an elastic-perfectly-plastic element of yield
+//! displacement `r_j` (the stop operator of Prandtl-Ishlinskii hysteresis
+//! models; Visintin 1994, *Differential Models of Hysteresis*, ch. III;
+//! Iwan 1966, J. Appl. Mech. 33:893, for the parallel elements), with
+//! thresholds [`PLAY`] times `depth_max`. A reversal of the depth changes
+//! the force by up to `2 b_j r_j` over `2 r_j` of depth, whatever the rate:
+//! what the memory alone lacks where the FE force falls faster on
+//! unloading than it rose (a needle's shaft sliding back, a contact patch
+//! letting go) and comes back earlier on reloading. Linear in `b`, so
+//! fitted with the rest; the cross-validation chooses each contact form
+//! without and with them.
+//!
 //! # Fit
 //!
 //! The force is linear in `a` and `c` once the path `e(t)` is known, so the
@@ -72,7 +92,7 @@
 //! are out of contact and left out), with second differences along the
 //! knots as a small smoothing penalty; with `lift_off` the path comes from
 //! the previous fit (three fixed-point passes from `e = d`). The solver is
-//! nalgebra's SVD (a dense problem of ~1,000 x 50; the crate is already a
+//! nalgebra's SVD (a dense problem of ~1,000 x 56; the crate is already a
 //! dependency here, faer is not).
 
 use serde::{Deserialize, Serialize};
@@ -92,6 +112,13 @@ const BISECTIONS: usize = 40;
 /// %, Q1 to 5 mm on mesh 2 8.61 to 3.38 %, and raised it on 2: N1 with
 /// friction to 10 mm 3.71 to 3.94 %, to 4 mm 1.65 to 1.95 %).
 pub const COMPLIANT: [[f64; 2]; 4] = [[0.05, 0.03], [0.1, 0.03], [0.1, 0.1], [0.2, 0.03]];
+/// Thresholds of the stop operators, over `depth_max` (module doc).
+/// Session 23, on four fresh builds (12 histories each; docs/guide.md):
+/// chosen by the cross-validation on N1 frictionless to 10 mm (worst
+/// held-out 2.52 to 1.70 %) and on Q1 with the default edge to 5 mm on
+/// mesh 1 (15.8 to 13.2 %), not chosen on the other two; 0.01-0.3,
+/// 0.1-0.3 and 0.05/0.15 did no better, five thresholds over-fit.
+pub const PLAY: [f64; 3] = [0.03, 0.1, 0.3];
 /// Folds of the cross-validation that chooses `lift_off`.
 const FOLDS: usize = 4;
 /// Stations whose FE force is below this fraction of the run's peak are
@@ -123,6 +150,11 @@ pub struct KernelTraining {
     /// the hard contact) and its score as above.
     #[serde(default)]
     pub cv_contacts: Vec<([f64; 2], f64)>,
+    /// The same scores with the stop operators ([`PLAY`]): following the
+    /// punch, then each form of `cv_contacts` in its order (empty in files
+    /// written before them).
+    #[serde(default)]
+    pub cv_play: Vec<f64>,
 }
 
 /// The fitted memory and its state (the state is not stored).
@@ -145,6 +177,13 @@ pub struct MemoryKernel {
     /// doc); `g0 = 0` is the hard contact (files written before it).
     #[serde(default)]
     pub soft_contact: [f64; 2],
+    /// Thresholds `r_j` (mm) of the stop operators (rate-independent
+    /// hysteresis; module doc); empty: none.
+    #[serde(default)]
+    pub play: Vec<f64>,
+    /// `b_jp` at `j PRESENT + p` (N/mm).
+    #[serde(default)]
+    pub play_coefficients: Vec<f64>,
     pub training: KernelTraining,
     #[serde(skip)]
     state: KernelState,
@@ -158,6 +197,8 @@ struct KernelState {
     e: f64,
     dt: f64,
     decay: Vec<(f64, f64)>,
+    stop: Vec<f64>,
+    stop_trial: Vec<f64>,
 }
 
 /// The two hats that are non-zero at `depth`: `(k, weight)` pairs (a `k`
@@ -180,12 +221,15 @@ impl MemoryKernel {
             memory: vec![0.0; taus.len() * knots * PRESENT],
             lift_off,
             soft_contact: [0.0; 2],
+            play: Vec::new(),
+            play_coefficients: Vec::new(),
             training: KernelTraining {
                 histories: 0,
                 stations: 0,
                 rms_n: 0.0,
                 cv_max_relative_error: None,
                 cv_contacts: Vec::new(),
+                cv_play: Vec::new(),
             },
             state: KernelState::default(),
         }
@@ -219,7 +263,7 @@ impl MemoryKernel {
     }
 
     fn columns(&self) -> usize {
-        self.knots + self.memory.len()
+        self.knots + self.memory.len() + self.play_coefficients.len()
     }
 
     /// Back to rest.
@@ -232,6 +276,8 @@ impl MemoryKernel {
             e: 0.0,
             dt: f64::NAN,
             decay: vec![(1.0, 1.0); self.taus.len()],
+            stop: vec![0.0; self.play.len()],
+            stop_trial: vec![0.0; self.play.len()],
         };
     }
 
@@ -293,12 +339,24 @@ impl MemoryKernel {
                 }
             }
         }
+        let first = nk + self.memory.len();
+        for (j, &r0) in self.play.iter().enumerate() {
+            let s = (st.stop[j] + (e - st.e)).clamp(-r0, r0);
+            st.stop_trial[j] = s;
+            let b = &self.play_coefficients[j * PRESENT..(j + 1) * PRESENT];
+            f += s * (b[0] * chi[0] + b[1] * chi[1]);
+            if let Some(r) = row.as_deref_mut() {
+                r[first + j * PRESENT] = s * chi[0];
+                r[first + j * PRESENT + 1] = s * chi[1];
+            }
+        }
         f
     }
 
     fn commit(&mut self, e: f64) {
         let st = &mut self.state;
         std::mem::swap(&mut st.m, &mut st.trial);
+        std::mem::swap(&mut st.stop, &mut st.stop_trial);
         st.phi.iter_mut().for_each(|v| *v = 0.0);
         for (k, w) in hats(self.depth_max, self.knots, e) {
             if k != usize::MAX {
@@ -465,7 +523,11 @@ impl MemoryKernel {
         let res = a.rows(0, n) * &c - b.rows(0, n);
         self.equilibrium
             .copy_from_slice(&c.as_slice()[..self.knots]);
-        self.memory.copy_from_slice(&c.as_slice()[self.knots..]);
+        let nm = self.memory.len();
+        self.memory
+            .copy_from_slice(&c.as_slice()[self.knots..self.knots + nm]);
+        self.play_coefficients
+            .copy_from_slice(&c.as_slice()[self.knots + nm..]);
         Ok(((res.norm_squared() / n as f64).sqrt(), n))
     }
 
@@ -478,11 +540,16 @@ impl MemoryKernel {
         taus: &[f64],
         runs: &[TrainingRun<'_>],
         contact: Option<[f64; 2]>,
+        play: bool,
         smoothing: f64,
     ) -> Result<(MemoryKernel, f64, usize), String> {
         let lift_off = contact.is_some();
         let mut k = MemoryKernel::shape(depth_max, knots, taus, lift_off);
         k.soft_contact = contact.unwrap_or([0.0; 2]);
+        if play {
+            k.play = PLAY.iter().map(|r| r * depth_max).collect();
+            k.play_coefficients = vec![0.0; k.play.len() * PRESENT];
+        }
         let mut paths: Vec<Vec<f64>> = runs.iter().map(|r| r.history.depth.clone()).collect();
         let (mut rms, mut n) = k.solve(runs, &paths, smoothing)?;
         if lift_off {
@@ -511,10 +578,11 @@ impl MemoryKernel {
     /// should reach `depth_max`): `knots` hat functions on `[0, depth_max]`,
     /// the material's time constants `taus`. How the memory meets the punch
     /// (following it, a hard loss of contact, or one of the compliant ones
-    /// of [`COMPLIANT`]) is chosen by a 4-fold cross-validation over the runs
+    /// of [`COMPLIANT`]), each without and with the stop operators
+    /// ([`PLAY`]), is chosen by a 4-fold cross-validation over the runs
     /// after the first (which stays in every fold): the smallest mean of the
-    /// held-out runs' largest errors, the simpler form on a tie. Then the
-    /// chosen form is fitted to all of them.
+    /// held-out runs' largest errors, the simpler form on a tie (without
+    /// stops first). Then the chosen form is fitted to all of them.
     pub fn fit(
         depth_max: f64,
         knots: usize,
@@ -555,8 +623,13 @@ impl MemoryKernel {
                     .map(|c| Some([c[0] * depth_max, c[1] * peak])),
             )
             .collect();
-        let mut cv = vec![0.0f64; contacts.len()];
-        for (slot, &contact) in contacts.iter().enumerate() {
+        // each contact without, then with, the stop operators
+        let forms: Vec<(Option<[f64; 2]>, bool)> = [false, true]
+            .into_iter()
+            .flat_map(|play| contacts.iter().map(move |&c| (c, play)))
+            .collect();
+        let mut cv = vec![0.0f64; forms.len()];
+        for (slot, &(contact, play)) in forms.iter().enumerate() {
             let mut scored = 0usize;
             for fold in 0..FOLDS {
                 let held = |r: usize| r > 0 && (r - 1) % FOLDS == fold;
@@ -567,7 +640,7 @@ impl MemoryKernel {
                     .map(|(_, r)| r.clone())
                     .collect();
                 let (mut k, _, _) =
-                    Self::fit_with(depth_max, knots, taus, &train, contact, smoothing)?;
+                    Self::fit_with(depth_max, knots, taus, &train, contact, play, smoothing)?;
                 for (_, run) in runs.iter().enumerate().filter(|(r, _)| held(*r)) {
                     cv[slot] += k.max_relative_error(run);
                     scored += 1;
@@ -577,9 +650,11 @@ impl MemoryKernel {
         }
         // the first smallest score: the simpler form on a tie
         let best = (0..cv.len()).fold(0, |b, j| if cv[j] < cv[b] { j } else { b });
+        let (contact, play) = forms[best];
         let (mut k, rms, n) =
-            Self::fit_with(depth_max, knots, taus, runs, contacts[best], smoothing)?;
-        let lifted = cv[1..].iter().copied().fold(f64::INFINITY, f64::min);
+            Self::fit_with(depth_max, knots, taus, runs, contact, play, smoothing)?;
+        let nc = contacts.len();
+        let lifted = cv[1..nc].iter().copied().fold(f64::INFINITY, f64::min);
         k.training = KernelTraining {
             histories: runs.len(),
             stations: n,
@@ -587,8 +662,9 @@ impl MemoryKernel {
             cv_max_relative_error: Some([cv[0], lifted]),
             cv_contacts: std::iter::once([0.0; 2])
                 .chain(COMPLIANT)
-                .zip(cv[1..].iter().copied())
+                .zip(cv[1..nc].iter().copied())
                 .collect(),
+            cv_play: cv[nc..].to_vec(),
         };
         Ok(k)
     }
@@ -623,6 +699,22 @@ impl MemoryKernel {
         }
         if let Some(t) = self.taus.iter().find(|t| **t <= 0.0) {
             return Err(format!("memory kernel: time constant {t} s"));
+        }
+        if self.play_coefficients.len() != self.play.len() * PRESENT
+            || self
+                .play
+                .iter()
+                .chain(&self.play_coefficients)
+                .any(|v| !v.is_finite())
+            || self.play.iter().any(|r| *r <= 0.0)
+        {
+            return Err(format!(
+                "memory kernel: {} stop operators with thresholds {:?} mm and {} coefficients: need thresholds > 0 and {} finite coefficients",
+                self.play.len(),
+                self.play,
+                self.play_coefficients.len(),
+                self.play.len() * PRESENT
+            ));
         }
         if self
             .soft_contact

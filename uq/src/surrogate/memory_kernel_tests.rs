@@ -259,3 +259,76 @@ fn refuses_bad_input() {
     k.memory.pop();
     assert!(k.check().unwrap_err().contains("memory coefficients"));
 }
+
+/// A stop operator alone: on a ramp its stretch follows the depth until it
+/// reaches its threshold `r`, then stays; on the way back it falls by `2 r`
+/// over `2 r` of depth: the force `b s` (read at the present depth as
+/// `b0 (1 - e/D) + b1 e/D`) is the elastic-perfectly-plastic element's,
+/// a rate-independent hysteresis loop.
+#[test]
+fn a_stop_operator_is_an_elastic_plastic_element() {
+    let (dmax, r, b) = (2.0, 0.1, 3.0);
+    let mut k = MemoryKernel::shape(dmax, 4, &[1.0], false);
+    k.play = vec![r];
+    k.play_coefficients = vec![b, b];
+    k.check().unwrap();
+    k.reset();
+    // in and out in 0.01 mm steps (no memory, no equilibrium: the force is
+    // the stop's alone)
+    let path: Vec<f64> = (0..=100)
+        .chain((0..=100).rev())
+        .map(|j| j as f64 * 0.01)
+        .collect();
+    let f: Vec<f64> = path.iter().map(|&d| k.step(d, 1e-3).0).collect();
+    let want = |i: usize| {
+        let d = path[i];
+        if i <= 100 {
+            b * d.min(r)
+        } else {
+            // from +r at 1 mm down by the depth withdrawn
+            b * (r - (1.0 - d)).max(-r)
+        }
+    };
+    for (i, &fi) in f.iter().enumerate() {
+        // the force is clamped at 0 with the surface following the punch
+        let w = want(i).max(0.0);
+        assert!(
+            (fi - w).abs() < 1e-12,
+            "sample {i}, depth {}: {fi} against {w}",
+            path[i]
+        );
+    }
+    // a loop: at 0.5 mm b r on the way in, -b r (clamped at 0) on the way out
+    assert!((f[50] - b * r).abs() < 1e-12 && f[150] == 0.0);
+    let mut bad = k.clone();
+    bad.play_coefficients.pop();
+    assert!(bad.check().unwrap_err().contains("stop operators"));
+    bad = k.clone();
+    bad.play[0] = 0.0;
+    assert!(bad.check().unwrap_err().contains("stop operators"));
+}
+
+/// Data made with stop operators on top of a representable memory: the
+/// cross-validation chooses them, and the fit reproduces unseen
+/// histories; without them the held-out error is far larger.
+#[test]
+fn the_cross_validation_finds_the_stop_operators() {
+    let (dmax, knots) = (2.0, 6);
+    let taus = [0.3, 4.0];
+    let mut truth = representable(dmax, knots, &taus, false, 1.0);
+    truth.play = PLAY.iter().map(|r| r * dmax).collect();
+    // a hysteresis of a few per cent of the peak (~2.8 N at 2 mm)
+    truth.play_coefficients = vec![0.3, 0.6, 0.2, 0.4, 0.1, 0.2];
+    truth.reset();
+    let hs = histories(dmax, 12);
+    let (mut fit, st) = fit_to(&mut truth, &hs, &taus);
+    let cv = fit.training.cv_play.clone();
+    assert_eq!(fit.play.len(), PLAY.len(), "cv with the stops {cv:?}");
+    assert!(
+        fit.training.cv_max_relative_error.unwrap()[0] > 5.0 * cv[0],
+        "following the punch without and with the stops: {:?} {cv:?}",
+        fit.training.cv_max_relative_error
+    );
+    let e = worst_held_out(&mut fit, &hs, &st);
+    assert!(e < 2e-3, "held-out error {e}; cv {cv:?}");
+}
