@@ -64,8 +64,8 @@ pub struct BuildArgs {
     pub benchmark: String,
     /// N1: the needle's Coulomb friction [default: 0.8]. The fitted memory's
     /// worst held-out error (of the peak) on N1: 1.95 % to 4 mm at 0.8; to 10
-    /// mm 2.5-2.9 % frictionless, 2.9-3.9 % at 0.8; plain QLV 3.7-13.6 %
-    /// (docs/guide.md).
+    /// mm 1.7 % frictionless (with the stop operators), 2.9-3.9 % at 0.8;
+    /// plain QLV 3.7-13.6 % (docs/guide.md).
     #[arg(long)]
     pub friction: Option<f64>,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
