@@ -27,7 +27,7 @@ fn main() {
             "memory kernel: {} knots, {} time constants, {} stop operators, loss of contact {}",
             k.knots,
             k.taus.len(),
-            k.play.len(),
+            k.stops.len(),
             if !k.lift_off {
                 "clamps".to_string()
             } else if k.soft_contact[0] == 0.0 {

@@ -29,7 +29,7 @@ fn main() {
     );
     println!(
         "cv with stop operators {:?}, stops {:?}",
-        k.training.cv_play, k.play
+        k.training.cv_stops, k.stops
     );
     for v in &s.validation {
         println!(

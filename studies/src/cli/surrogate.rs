@@ -300,10 +300,10 @@ pub fn contact_words(k: &palpate_uq::surrogate::memory_kernel::MemoryKernel) -> 
             "follows a surface that lets go over a gap of {g:.3} mm (compliant contact, press {a:.3e} N)"
         )
     };
-    if k.play.is_empty() {
+    if k.stops.is_empty() {
         contact
     } else {
-        let r: Vec<String> = k.play.iter().map(|r| format!("{r:.3}")).collect();
+        let r: Vec<String> = k.stops.iter().map(|r| format!("{r:.3}")).collect();
         format!(
             "{contact}, with stop operators (hysteresis) of {} mm",
             r.join(", ")
@@ -339,10 +339,10 @@ pub fn error_table(s: &RealTimeSurrogate) -> String {
                     write!(r, "; gap {g} D, press {a} peak {:.2} %", 100.0 * e)
                 };
             }
-            if !k.training.cv_play.is_empty() {
+            if !k.training.cv_stops.is_empty() {
                 let e: Vec<String> = k
                     .training
-                    .cv_play
+                    .cv_stops
                     .iter()
                     .map(|e| format!("{:.2}", 100.0 * e))
                     .collect();

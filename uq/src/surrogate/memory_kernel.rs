@@ -64,7 +64,7 @@
 //! flat punch, whose contact is all or nothing in the linear range, and
 //! less so for a needle or a rounded edge at depth.
 //!
-//! Stop operators (`play`, session 23): a rate-independent hysteresis
+//! Stop operators (`stops`, session 23): a rate-independent hysteresis
 //! beside the memory,
 //!
 //! ```text
@@ -76,7 +76,7 @@
 //! displacement `r_j` (the stop operator of Prandtl-Ishlinskii hysteresis
 //! models; Visintin 1994, *Differential Models of Hysteresis*, ch. III;
 //! Iwan 1966, J. Appl. Mech. 33:893, for the parallel elements), with
-//! thresholds [`PLAY`] times `depth_max`. A reversal of the depth changes
+//! thresholds [`STOPS`] times `depth_max`. A reversal of the depth changes
 //! the force by up to `2 b_j r_j` over `2 r_j` of depth, whatever the rate:
 //! what the memory alone lacks where the FE force falls faster on
 //! unloading than it rose (a needle's shaft sliding back, a contact patch
@@ -118,7 +118,7 @@ pub const COMPLIANT: [[f64; 2]; 4] = [[0.05, 0.03], [0.1, 0.03], [0.1, 0.1], [0.
 /// held-out 2.52 to 1.70 %) and on Q1 with the default edge to 5 mm on
 /// mesh 1 (15.8 to 13.2 %), not chosen on the other two; 0.01-0.3,
 /// 0.1-0.3 and 0.05/0.15 did no better, five thresholds over-fit.
-pub const PLAY: [f64; 3] = [0.03, 0.1, 0.3];
+pub const STOPS: [f64; 3] = [0.03, 0.1, 0.3];
 /// Folds of the cross-validation that chooses `lift_off`.
 const FOLDS: usize = 4;
 /// Stations whose FE force is below this fraction of the run's peak are
@@ -150,11 +150,11 @@ pub struct KernelTraining {
     /// the hard contact) and its score as above.
     #[serde(default)]
     pub cv_contacts: Vec<([f64; 2], f64)>,
-    /// The same scores with the stop operators ([`PLAY`]): following the
+    /// The same scores with the stop operators ([`STOPS`]): following the
     /// punch, then each form of `cv_contacts` in its order (empty in files
     /// written before them).
     #[serde(default)]
-    pub cv_play: Vec<f64>,
+    pub cv_stops: Vec<f64>,
 }
 
 /// The fitted memory and its state (the state is not stored).
@@ -180,10 +180,10 @@ pub struct MemoryKernel {
     /// Thresholds `r_j` (mm) of the stop operators (rate-independent
     /// hysteresis; module doc); empty: none.
     #[serde(default)]
-    pub play: Vec<f64>,
+    pub stops: Vec<f64>,
     /// `b_jp` at `j PRESENT + p` (N/mm).
     #[serde(default)]
-    pub play_coefficients: Vec<f64>,
+    pub stop_coefficients: Vec<f64>,
     pub training: KernelTraining,
     #[serde(skip)]
     state: KernelState,
@@ -221,15 +221,15 @@ impl MemoryKernel {
             memory: vec![0.0; taus.len() * knots * PRESENT],
             lift_off,
             soft_contact: [0.0; 2],
-            play: Vec::new(),
-            play_coefficients: Vec::new(),
+            stops: Vec::new(),
+            stop_coefficients: Vec::new(),
             training: KernelTraining {
                 histories: 0,
                 stations: 0,
                 rms_n: 0.0,
                 cv_max_relative_error: None,
                 cv_contacts: Vec::new(),
-                cv_play: Vec::new(),
+                cv_stops: Vec::new(),
             },
             state: KernelState::default(),
         }
@@ -263,7 +263,7 @@ impl MemoryKernel {
     }
 
     fn columns(&self) -> usize {
-        self.knots + self.memory.len() + self.play_coefficients.len()
+        self.knots + self.memory.len() + self.stop_coefficients.len()
     }
 
     /// Back to rest.
@@ -276,8 +276,8 @@ impl MemoryKernel {
             e: 0.0,
             dt: f64::NAN,
             decay: vec![(1.0, 1.0); self.taus.len()],
-            stop: vec![0.0; self.play.len()],
-            stop_trial: vec![0.0; self.play.len()],
+            stop: vec![0.0; self.stops.len()],
+            stop_trial: vec![0.0; self.stops.len()],
         };
     }
 
@@ -340,10 +340,10 @@ impl MemoryKernel {
             }
         }
         let first = nk + self.memory.len();
-        for (j, &r0) in self.play.iter().enumerate() {
+        for (j, &r0) in self.stops.iter().enumerate() {
             let s = (st.stop[j] + (e - st.e)).clamp(-r0, r0);
             st.stop_trial[j] = s;
-            let b = &self.play_coefficients[j * PRESENT..(j + 1) * PRESENT];
+            let b = &self.stop_coefficients[j * PRESENT..(j + 1) * PRESENT];
             f += s * (b[0] * chi[0] + b[1] * chi[1]);
             if let Some(r) = row.as_deref_mut() {
                 r[first + j * PRESENT] = s * chi[0];
@@ -526,7 +526,7 @@ impl MemoryKernel {
         let nm = self.memory.len();
         self.memory
             .copy_from_slice(&c.as_slice()[self.knots..self.knots + nm]);
-        self.play_coefficients
+        self.stop_coefficients
             .copy_from_slice(&c.as_slice()[self.knots + nm..]);
         Ok(((res.norm_squared() / n as f64).sqrt(), n))
     }
@@ -540,15 +540,15 @@ impl MemoryKernel {
         taus: &[f64],
         runs: &[TrainingRun<'_>],
         contact: Option<[f64; 2]>,
-        play: bool,
+        with_stops: bool,
         smoothing: f64,
     ) -> Result<(MemoryKernel, f64, usize), String> {
         let lift_off = contact.is_some();
         let mut k = MemoryKernel::shape(depth_max, knots, taus, lift_off);
         k.soft_contact = contact.unwrap_or([0.0; 2]);
-        if play {
-            k.play = PLAY.iter().map(|r| r * depth_max).collect();
-            k.play_coefficients = vec![0.0; k.play.len() * PRESENT];
+        if with_stops {
+            k.stops = STOPS.iter().map(|r| r * depth_max).collect();
+            k.stop_coefficients = vec![0.0; k.stops.len() * PRESENT];
         }
         let mut paths: Vec<Vec<f64>> = runs.iter().map(|r| r.history.depth.clone()).collect();
         let (mut rms, mut n) = k.solve(runs, &paths, smoothing)?;
@@ -579,7 +579,7 @@ impl MemoryKernel {
     /// the material's time constants `taus`. How the memory meets the punch
     /// (following it, a hard loss of contact, or one of the compliant ones
     /// of [`COMPLIANT`]), each without and with the stop operators
-    /// ([`PLAY`]), is chosen by a 4-fold cross-validation over the runs
+    /// ([`STOPS`]), is chosen by a 4-fold cross-validation over the runs
     /// after the first (which stays in every fold): the smallest mean of the
     /// held-out runs' largest errors, the simpler form on a tie (without
     /// stops first). Then the chosen form is fitted to all of them.
@@ -626,10 +626,10 @@ impl MemoryKernel {
         // each contact without, then with, the stop operators
         let forms: Vec<(Option<[f64; 2]>, bool)> = [false, true]
             .into_iter()
-            .flat_map(|play| contacts.iter().map(move |&c| (c, play)))
+            .flat_map(|with_stops| contacts.iter().map(move |&c| (c, with_stops)))
             .collect();
         let mut cv = vec![0.0f64; forms.len()];
-        for (slot, &(contact, play)) in forms.iter().enumerate() {
+        for (slot, &(contact, with_stops)) in forms.iter().enumerate() {
             let mut scored = 0usize;
             for fold in 0..FOLDS {
                 let held = |r: usize| r > 0 && (r - 1) % FOLDS == fold;
@@ -639,8 +639,9 @@ impl MemoryKernel {
                     .filter(|(r, _)| !held(*r))
                     .map(|(_, r)| r.clone())
                     .collect();
-                let (mut k, _, _) =
-                    Self::fit_with(depth_max, knots, taus, &train, contact, play, smoothing)?;
+                let (mut k, _, _) = Self::fit_with(
+                    depth_max, knots, taus, &train, contact, with_stops, smoothing,
+                )?;
                 for (_, run) in runs.iter().enumerate().filter(|(r, _)| held(*r)) {
                     cv[slot] += k.max_relative_error(run);
                     scored += 1;
@@ -650,9 +651,9 @@ impl MemoryKernel {
         }
         // the first smallest score: the simpler form on a tie
         let best = (0..cv.len()).fold(0, |b, j| if cv[j] < cv[b] { j } else { b });
-        let (contact, play) = forms[best];
+        let (contact, with_stops) = forms[best];
         let (mut k, rms, n) =
-            Self::fit_with(depth_max, knots, taus, runs, contact, play, smoothing)?;
+            Self::fit_with(depth_max, knots, taus, runs, contact, with_stops, smoothing)?;
         let nc = contacts.len();
         let lifted = cv[1..nc].iter().copied().fold(f64::INFINITY, f64::min);
         k.training = KernelTraining {
@@ -664,7 +665,7 @@ impl MemoryKernel {
                 .chain(COMPLIANT)
                 .zip(cv[1..nc].iter().copied())
                 .collect(),
-            cv_play: cv[nc..].to_vec(),
+            cv_stops: cv[nc..].to_vec(),
         };
         Ok(k)
     }
@@ -700,20 +701,20 @@ impl MemoryKernel {
         if let Some(t) = self.taus.iter().find(|t| **t <= 0.0) {
             return Err(format!("memory kernel: time constant {t} s"));
         }
-        if self.play_coefficients.len() != self.play.len() * PRESENT
+        if self.stop_coefficients.len() != self.stops.len() * PRESENT
             || self
-                .play
+                .stops
                 .iter()
-                .chain(&self.play_coefficients)
+                .chain(&self.stop_coefficients)
                 .any(|v| !v.is_finite())
-            || self.play.iter().any(|r| *r <= 0.0)
+            || self.stops.iter().any(|r| *r <= 0.0)
         {
             return Err(format!(
                 "memory kernel: {} stop operators with thresholds {:?} mm and {} coefficients: need thresholds > 0 and {} finite coefficients",
-                self.play.len(),
-                self.play,
-                self.play_coefficients.len(),
-                self.play.len() * PRESENT
+                self.stops.len(),
+                self.stops,
+                self.stop_coefficients.len(),
+                self.stops.len() * PRESENT
             ));
         }
         if self

@@ -269,8 +269,8 @@ fn refuses_bad_input() {
 fn a_stop_operator_is_an_elastic_plastic_element() {
     let (dmax, r, b) = (2.0, 0.1, 3.0);
     let mut k = MemoryKernel::shape(dmax, 4, &[1.0], false);
-    k.play = vec![r];
-    k.play_coefficients = vec![b, b];
+    k.stops = vec![r];
+    k.stop_coefficients = vec![b, b];
     k.check().unwrap();
     k.reset();
     // in and out in 0.01 mm steps (no memory, no equilibrium: the force is
@@ -301,10 +301,10 @@ fn a_stop_operator_is_an_elastic_plastic_element() {
     // a loop: at 0.5 mm b r on the way in, -b r (clamped at 0) on the way out
     assert!((f[50] - b * r).abs() < 1e-12 && f[150] == 0.0);
     let mut bad = k.clone();
-    bad.play_coefficients.pop();
+    bad.stop_coefficients.pop();
     assert!(bad.check().unwrap_err().contains("stop operators"));
     bad = k.clone();
-    bad.play[0] = 0.0;
+    bad.stops[0] = 0.0;
     assert!(bad.check().unwrap_err().contains("stop operators"));
 }
 
@@ -316,14 +316,14 @@ fn the_cross_validation_finds_the_stop_operators() {
     let (dmax, knots) = (2.0, 6);
     let taus = [0.3, 4.0];
     let mut truth = representable(dmax, knots, &taus, false, 1.0);
-    truth.play = PLAY.iter().map(|r| r * dmax).collect();
+    truth.stops = STOPS.iter().map(|r| r * dmax).collect();
     // a hysteresis of a few per cent of the peak (~2.8 N at 2 mm)
-    truth.play_coefficients = vec![0.3, 0.6, 0.2, 0.4, 0.1, 0.2];
+    truth.stop_coefficients = vec![0.3, 0.6, 0.2, 0.4, 0.1, 0.2];
     truth.reset();
     let hs = histories(dmax, 12);
     let (mut fit, st) = fit_to(&mut truth, &hs, &taus);
-    let cv = fit.training.cv_play.clone();
-    assert_eq!(fit.play.len(), PLAY.len(), "cv with the stops {cv:?}");
+    let cv = fit.training.cv_stops.clone();
+    assert_eq!(fit.stops.len(), STOPS.len(), "cv with the stops {cv:?}");
     assert!(
         fit.training.cv_max_relative_error.unwrap()[0] > 5.0 * cv[0],
         "following the punch without and with the stops: {:?} {cv:?}",
