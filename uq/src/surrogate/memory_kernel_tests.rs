@@ -317,7 +317,8 @@ fn the_cross_validation_finds_the_stop_operators() {
     let taus = [0.3, 4.0];
     let mut truth = representable(dmax, knots, &taus, false, 1.0);
     truth.stops = STOPS.iter().map(|r| r * dmax).collect();
-    // a hysteresis of a few per cent of the peak (~2.8 N at 2 mm)
+    // the stops carry up to sum b_j1 r_j = 0.24 N at 2 mm, where the
+    // equilibrium force is 1.8 N
     truth.stop_coefficients = vec![0.3, 0.6, 0.2, 0.4, 0.1, 0.2];
     truth.reset();
     let hs = histories(dmax, 12);
