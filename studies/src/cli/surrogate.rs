@@ -48,8 +48,10 @@ pub enum Sub {
 /// Runs the benchmark's FE model for the material given (--law, --param,
 /// --prony): one elastic ramp to --depth-max; --train histories (a ramp and
 /// hold, then random ones) to which the surrogate's memory is fitted (a
-/// relaxation read through the present depth; 0: plain QLV on the force
-/// curve with the material's terms); then --holdout other random histories
+/// relaxation read through the present depth, with the contact form and
+/// optional stop operators (a rate-independent hysteresis) chosen by
+/// cross-validation; 0: plain QLV on the force curve with the material's
+/// terms); then --holdout other random histories
 /// of --segments ramps, holds and unloadings, whose FE forces are compared
 /// with the surrogate's (and plain QLV's) in a printed error table (max
 /// error as a percentage of the history's peak force).
