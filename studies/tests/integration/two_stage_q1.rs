@@ -141,7 +141,11 @@ fn stages_are_parsed_and_checked() {
 /// hold); a correcting mesh no finer than the fit mesh is refused by field.
 #[test]
 fn the_study_manifest_is_valid() {
-    let deep = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("two-stage-q1-5mm.toml");
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let edge1 = dir.join("two-stage-q1-5mm-edge1.toml");
+    let m = palpate_studies::manifest::Manifest::read(&edge1).unwrap();
+    m.validate(&edge1).unwrap();
+    let deep = dir.join("two-stage-q1-5mm.toml");
     let m = palpate_studies::manifest::Manifest::read(&deep).unwrap();
     m.validate(&deep).unwrap();
     let coarse = std::fs::read_to_string(&deep)
