@@ -127,7 +127,7 @@ fn main() {
     if let Some(rho) = edge() {
         sub = format!("{sub}-edge{rho}");
     }
-    let edge_mm = model(1, 1.0).edge_radius;
+    let edge_mm = edge().unwrap_or(palpate_fe::q1::DEFAULT_EDGE_RADIUS);
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(&sub);
     std::fs::create_dir_all(&dir).expect("create the record's folder");
     let level = level();
