@@ -54,7 +54,8 @@ pub enum Sub {
 /// terms); then --holdout other random histories
 /// of --segments ramps, holds and unloadings, whose FE forces are compared
 /// with the surrogate's (and plain QLV's) in a printed error table (max
-/// error as a percentage of the history's peak force).
+/// error at the segment ends and 16 points inside each ramp, 12 inside each
+/// hold, as a percentage of the history's peak force).
 ///
 /// Example: palpate surrogate build --benchmark Q1 --law neo-hookean --param C10=0.0016
 ///   --prony g1=0.3,tau1=0.5,g2=0.2,tau2=10 --depth-max 1 --out q1-rt.json
@@ -65,9 +66,9 @@ pub struct BuildArgs {
     #[arg(long)]
     pub benchmark: String,
     /// N1: the needle's Coulomb friction [default: 0.8]. The fitted memory's
-    /// worst held-out error (of the peak) on N1: 1.95 % to 4 mm at 0.8; to 10
-    /// mm 1.7 % frictionless (with the stop operators), 2.9-3.9 % at 0.8;
-    /// plain QLV 3.7-13.6 % (docs/guide.md).
+    /// worst held-out error (of the peak) on N1: 0.97 % to 4 mm frictionless, 2.2-2.3 % to
+    /// 3-4 mm at 0.8; to 10 mm 2.2 % frictionless, 2.9 % at 0.8; plain QLV 1.3-13.5 %
+    /// (docs/guide.md).
     #[arg(long)]
     pub friction: Option<f64>,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
