@@ -230,7 +230,7 @@ fn build(a: BuildArgs) -> anyhow::Result<()> {
         && a.edge_radius.is_none_or(|r| r < 0.5)
     {
         eprintln!(
-            "note: on mesh {} the Q1 force past 2 mm is stiff (+8 % at 5 mm against mesh 3) and drops by up to 4 % where the surface snaps round the punch's edge; the surrogate follows this mesh's FE (--mesh 2: within 3.7 %, about 9 x the FE time; docs/guide.md)",
+            "note: on mesh {} the Q1 force past 2 mm is stiff (+8 % at 5 mm against mesh 3) and drops by up to 4 % where the surface snaps round the punch's edge; the surrogate follows this mesh's FE (--mesh 2: within 4.2 %, about 9 x the FE time; docs/guide.md)",
             a.mesh
         );
     }
