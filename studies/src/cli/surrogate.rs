@@ -67,7 +67,7 @@ pub struct BuildArgs {
     pub benchmark: String,
     /// N1: the needle's Coulomb friction [default: 0.8]. The fitted memory's
     /// worst held-out error (of the peak) on N1: 0.97 % to 4 mm frictionless, 2.2-2.3 % to
-    /// 3-4 mm at 0.8; to 10 mm 2.2 % frictionless, 2.9 % at 0.8; plain QLV 1.3-13.5 %
+    /// 3-4 mm at 0.8; to 10 mm 2.2 % frictionless, 2.9 % at 0.8; plain QLV 1.2-13.5 %
     /// (docs/guide.md).
     #[arg(long)]
     pub friction: Option<f64>,

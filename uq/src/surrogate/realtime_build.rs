@@ -20,6 +20,10 @@ use super::realtime::{HistoryError, MonotoneCubic, RealTimeSurrogate, StoredRun}
 /// 164 s).
 pub const HELD_OUT_STATIONS: (usize, usize) = (16, 12);
 
+/// FE stations inside each ramp and each hold of a training history, where
+/// the memory is fitted (and the cross-validation scores its forms).
+pub const TRAINING_STATIONS: (usize, usize) = (8, 6);
+
 /// What a build runs: the elastic and viscoelastic forms of one model (the
 /// same FE model without and with its Prony series), their parameters, the
 /// trained depth range and the held-out histories.
@@ -112,7 +116,7 @@ impl RealTimeSurrogate {
                 } else {
                     random_history(1000 + k as u64, req.depth_max, req.segments, 1e-3)
                 };
-                (format!("training {k}"), h, (8, 6))
+                (format!("training {k}"), h, TRAINING_STATIONS)
             })
             .collect();
         jobs.extend((1..=req.validation_histories as u64).map(|seed| {
@@ -550,7 +554,7 @@ mod tests {
     fn a_build_leaves_out_histories_the_model_cannot_run() {
         // the first station of training history k (k >= 1) and of held-out seed k
         let first = |h: History, inner: usize| h.stations(inner, inner).1[0];
-        let train = |k: u64| first(random_history(1000 + k, 1.0, 6, 1e-3), 8);
+        let train = |k: u64| first(random_history(1000 + k, 1.0, 6, 1e-3), TRAINING_STATIONS.0);
         let held = |k: u64| first(random_history(k, 1.0, 6, 1e-3), HELD_OUT_STATIONS.0);
         let elastic = tissue(false, Vec::new());
         let failing = tissue(true, vec![train(3), train(7), held(2)]);
