@@ -7,7 +7,7 @@
 # A cited path is a backticked word that starts with a top-level entry of the
 # repository (a directory followed by '/', or a file at the root) and has no
 # space, glob or placeholder in it, e.g. `forward/fe/src/system.rs`,
-# `studies/treloar.toml`, `docs/theory.md`. A trailing `:LINE`, `:LINE-LINE`
+# `studies/treloar.toml`, `docs/theory.md`. A trailing `:LINE`, `:LINE-LINE`,
 # `#anchor` or `::item` is dropped. Run from anywhere inside the repository.
 set -euo pipefail
 cd "$(git rev-parse --show-toplevel)"
@@ -18,7 +18,8 @@ report=$(while IFS= read -r doc; do
   grep -no '`[^`]*`' "$doc" | while IFS= read -r hit; do
     line=${hit%%:*}
     path=${hit#*:}; path=${path//\`/}
-    path=${path%%#*}; path=${path%%::*}; path=$(sed -E 's/:[0-9]+(-[0-9]+)?$//' <<<"$path")
+    path=${path%%#*}; path=${path%%::*}
+    [[ $path =~ ^(.*):[0-9]+(-[0-9]+)?$ ]] && path=${BASH_REMATCH[1]}
     [[ $path =~ ^($tops)(/|$) ]] || continue
     [[ $path =~ [[:space:]\*\?\<\>\{\}\$] ]] && continue
     [[ -e $path ]] || echo "$doc:$line: \`$path\` does not exist"
