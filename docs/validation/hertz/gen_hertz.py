@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Write CalculiX decks for the Hertz check (issue 3): a rigid sphere of
+"""Write CalculiX decks for the Hertz check (docs/validation/hertz): a rigid sphere of
 radius R = 2.5 mm pressed frictionlessly on the axis of the N1 cylinder
 (r in [0, 35], z in [0, 80], top z = 80, bottom fixed, axis u_r = 0),
 neo-Hookean C10 = 1101.295 Pa with K = kfac * mu (or a linear-elastic
