@@ -2,7 +2,7 @@
 //! and which stress a file gives, in which unit, turned into the stretch (or
 //! amount of shear) and the nominal stress in MPa that the models predict.
 //!
-//! Conventions (docs/guide.md, "Data files of homogeneous tests"):
+//! Conventions (docs/guide/installing-and-data.md, "Homogeneous tests"):
 //!
 //! * deformation: `stretch` (lambda), `strain` (engineering, lambda = 1 + e)
 //!   or `true_strain` (logarithmic, lambda = exp(e)); general biaxial

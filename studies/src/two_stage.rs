@@ -94,7 +94,7 @@ pub struct TwoStageOptions {
     /// each anchor; a rounding the fit mesh resolves (a few of its cells)
     /// keeps its force smooth in the parameters: at 5 mm the 0.3 mm mesh
     /// with the 0.2 mm edge jumps branch (+11 % at the ramp's end for g2
-    /// -1 %), with a 0.6 mm edge it is smooth and 3 x faster (docs/guide.md).
+    /// -1 %), with a 0.6 mm edge it is smooth and 3 x faster (docs/guide/two-stage.md).
     pub fit_edge_radius: Option<f64>,
     /// Stages in order (`elastic`, `relaxation`); the polish follows.
     pub stages: Vec<String>,
@@ -627,7 +627,7 @@ pub(crate) fn run_stage(
 
 /// Past this depth (mm) a fit mesh coarser than [`DEEP_FIT_MESH`] is stiff
 /// under the punch's rounded edge (18 % at 5 mm for 0.3 mm cells, 7 % for
-/// 0.15 mm; docs/guide.md).
+/// 0.15 mm; docs/guide/two-stage.md).
 pub const DEEP_RECORD: f64 = 2.0;
 /// The element size under the punch below which deep fits are left alone.
 pub const DEEP_FIT_MESH: f64 = 0.15;

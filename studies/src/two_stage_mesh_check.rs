@@ -23,7 +23,7 @@
 //! noise. It is read through the fit mesh's sensitivities: where their
 //! shape differs from the check mesh's (a fit mesh with its own punch edge,
 //! at depth), the fixed point is not the check mesh's own optimum (5 mm
-//! record, tau1: docs/guide.md, two-stage, session 22).
+//! record, tau1: docs/validation/two-stage.md).
 
 use crate::two_stage::{run_stage, Q1Record, Say, StageData, StageModels, TwoStageOptions};
 use serde::Serialize;

@@ -80,7 +80,7 @@ pub struct Args {
     /// --benchmark Q1 (a ramp-and-hold record, columns time_s,displacement_mm,force_N):
     /// the stages of the inverse FE identification, `elastic,relaxation`
     /// (the law on the ramp with an elastic model, then the Prony terms with
-    /// the law held), followed by a joint polish (docs/guide.md).
+    /// the law held), followed by a joint polish (docs/guide/two-stage.md).
     #[arg(long, value_name = "LIST")]
     pub stages: Option<String>,
     /// --benchmark Q1: Prony terms (default 2).

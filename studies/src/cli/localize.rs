@@ -73,14 +73,12 @@ pub struct Args {
     pub sampler: String,
     /// The surrogate's scan: lean (default: the centre model with the
     /// excess shifted by the end lean measured on 16 short FE scans near
-    /// the end, one shift per nodule position and depth; its 94 % x
-    /// intervals cover at the nominal rate on 50 FE records, ~7 min to
-    /// build at RD 6 on 2 cores), centre (depth only, one nodule at the
-    /// block's centre, translation invariance assumed: shallow nodules
-    /// within ~45 mm of an end read ~0.16 mm towards it; ~2.5 min) or along
+    /// the end, one shift per nodule position and depth), centre (depth
+    /// only, one nodule at the block's centre, translation invariance
+    /// assumed: shallow nodules near an end read towards it) or along
     /// (depth and position of the nodule, 20 FE scans instead of 8: removes
-    /// most of that bias, but its surrogate error is larger;
-    /// docs/validation/r2-localisation.md).
+    /// most of that bias, but its surrogate error is larger). Coverage,
+    /// bias and build times of the three: docs/validation/r2-localisation.md.
     #[arg(long, default_value = "lean", value_parser = ["lean", "centre", "along"])]
     pub scan: String,
 }

@@ -23,7 +23,7 @@ use std::path::{Path, PathBuf};
 ///   * one run at a time: a second run into the same folder is refused with
 ///     the pid of the one writing it.
 ///
-/// See studies/*.toml for examples and docs/guide.md for every field.
+/// See studies/*.toml for examples and docs/guide/studies-and-clusters.md for every field.
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {

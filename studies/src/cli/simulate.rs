@@ -80,10 +80,10 @@ pub struct Args {
     /// N1, N3 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
-    /// N1 and Q1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4]. N3: hex8 (8-node, constant pressure, on the graded box) or hex27 (27-node, linear discontinuous pressure, on the quarter O-grid with cells of 1.6/N mm: about 1 % at 10 mm in under a minute at level 1, friction 0.8) [default: hex8].
+    /// N1 and Q1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4]. N3: hex8 (8-node, constant pressure, on the graded box) or hex27 (27-node, linear discontinuous pressure, on the quarter O-grid with cells of 1.6/N mm: the accurate choice with friction; accuracy and cost: docs/validation/fe.md "N3") [default: hex8].
     #[arg(long, value_name = "quad4|quad9")]
     pub element: Option<String>,
-    /// Q1: radius of the punch's rounded edge in mm, > 0 and below the punch radius 2 [default: 0.2]. The default runs the 5 mm ramp (its force within a few per cent past 2 mm of depth: docs/validation/fe.md "Q1"); a larger edge is a rounded punch, no longer the flat one: with 1 mm its force at 0.1 mm is 0.57 of Sneddon's for the flat punch (0.94 with the default).
+    /// Q1: radius of the punch's rounded edge in mm, > 0 and below the punch radius 2 [default: 0.2]. The default runs the 5 mm ramp; a larger edge is a rounded punch, no longer the flat one (its force and accuracy against depth: docs/validation/fe.md "Q1").
     #[arg(long, value_name = "MM", allow_hyphen_values = true)]
     pub edge_radius: Option<f64>,
     /// Final tool displacement in mm (default: 10 for N1, 2 for C1, 5 for Q1).
