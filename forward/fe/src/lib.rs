@@ -35,7 +35,6 @@
 )]
 
 pub mod body;
-pub mod c1;
 pub mod contact;
 pub mod contact_split;
 pub mod contribution;
@@ -49,16 +48,10 @@ pub mod line_search;
 pub mod material;
 pub mod mesh;
 pub mod model;
+pub mod models;
 pub mod motion;
-pub mod n1;
-pub mod n3;
 pub mod predictor;
-pub mod q1;
-pub mod q1_viscous;
 pub mod quadrature;
-pub mod r2;
-pub mod r2_gap;
-pub mod r2_scan;
 pub mod self_contact;
 pub mod shape;
 pub mod sparse;
@@ -68,6 +61,8 @@ pub mod system;
 pub mod tool;
 pub mod viscoelastic;
 pub mod vtu;
+
+pub use models::{c1, n1, n3, q1, r2, r2_gap, r2_scan};
 
 pub use c1::{C1Fe, Platens};
 pub use contact::ContactPoints;
@@ -79,7 +74,7 @@ pub use model::{Bulk, Simulation};
 pub use n1::{Base, MeshDensity, N1Element, N1Needle};
 pub use n3::{n3_core_cells, n3_grading, n3_quadratic_grading, N3Element, N3Mesh, N3Needle};
 pub use q1::Q1Punch;
-pub use q1_viscous::Q1Viscous;
+pub use q1::viscous::Q1Viscous;
 pub use r2::{r2_element_size, Nodule, R2Rolling};
 pub use r2_gap::R2Gap;
 pub use stepper::{LoadPath, Progress};

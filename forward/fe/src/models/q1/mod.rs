@@ -16,6 +16,8 @@
 //! (`0.2 / level` mm) in a 3 x 3 mm zone that holds the punch edge, growing
 //! by `1 + 0.2 / level` beyond ([`Q1Punch::grading`]).
 
+pub mod viscous;
+
 use palpate_core::{
     Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole, ParamSpace, ParamSpec,
 };
@@ -528,7 +530,7 @@ impl ForwardModel for Q1Punch {
 
 /// Effects of the elastic Q1 model: `viscoelasticity` (a one-term Prony
 /// series with its weight and time constant as parameters,
-/// [`crate::q1_viscous::Q1Viscous`]).
+/// [`crate::q1::viscous::Q1Viscous`]).
 impl palpate_core::Enrichable for Q1Punch {
     fn effects(&self) -> Vec<palpate_core::Effect> {
         if self.prony.is_none() {
@@ -540,7 +542,7 @@ impl palpate_core::Enrichable for Q1Punch {
     fn enrich(&self, effect: palpate_core::Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
             palpate_core::Effect::Viscoelasticity if self.prony.is_none() => {
-                Ok(Box::new(crate::q1_viscous::Q1Viscous::new(self.clone())))
+                Ok(Box::new(crate::q1::viscous::Q1Viscous::new(self.clone())))
             }
             _ => Err(ForwardError::InvalidConfig {
                 field: "effect".into(),
