@@ -69,8 +69,8 @@ use palpate_analytic::{
 };
 use palpate_core::ForwardModel;
 use palpate_fe::{
-    C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch,
-    R2Rolling, Support,
+    C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch, R2Rolling,
+    Support,
 };
 use palpate_material::Law;
 use serde::Deserialize;

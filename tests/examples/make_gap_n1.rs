@@ -8,7 +8,7 @@
 //! minute). The records are committed; rerun only to change them.
 
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::{Support, MeshDensity, N1Needle};
+use palpate_fe::{MeshDensity, N1Needle, Support};
 use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
