@@ -260,6 +260,11 @@ impl<S: Setup> FeModel<S> {
         &self.setup
     }
 
+    /// The law of the specimen.
+    pub fn law(&self) -> &Law {
+        self.setup.law()
+    }
+
     /// Replaces the law; the parameter space follows.
     pub fn set_law(&mut self, law: Law) {
         std::ops::DerefMut::deref_mut(self).set_law(law);

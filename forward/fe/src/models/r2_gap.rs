@@ -44,7 +44,7 @@ use palpate_core::{
     ParamSpace, ParamSpec,
 };
 
-use crate::model::{friction_param, law_space, Setup, Support};
+use crate::model::{friction_param, law_space, Support};
 use crate::r2::{Nodule, R2Rolling};
 
 /// Clearance (mm) between an added nodule and the top or bottom face,
