@@ -5,7 +5,7 @@
 
 use crate::models::{ModelError, DEFAULT_MESH, MAX_MESH_LEVEL};
 use palpate_analytic::Mode;
-use palpate_fe::{Bulk, MeshDensity, N1Element, Prony, ToolShape};
+use palpate_fe::{Bulk, MeshDensity, PlaneCell, Prony, ToolShape};
 use serde::Deserialize;
 
 /// A `prony = "g1=..,tau1=.."` field; errors name it.
@@ -51,10 +51,10 @@ pub fn parse_mesh(kind: &'static str, s: Option<&str>) -> Result<usize, ModelErr
     }
 }
 
-pub(crate) fn parse_element(kind: &'static str, s: Option<&str>) -> Result<N1Element, ModelError> {
+pub(crate) fn parse_element(kind: &'static str, s: Option<&str>) -> Result<PlaneCell, ModelError> {
     match s.unwrap_or("quad4") {
-        "quad4" => Ok(N1Element::Quad4),
-        "quad9" => Ok(N1Element::Quad9),
+        "quad4" => Ok(PlaneCell::Quad4),
+        "quad9" => Ok(PlaneCell::Quad9),
         other => Err(ModelError::new(
             kind,
             "element",

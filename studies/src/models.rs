@@ -69,8 +69,8 @@ use palpate_analytic::{
 };
 use palpate_core::ForwardModel;
 use palpate_fe::{
-    Base, C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch,
-    R2Rolling,
+    C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch, R2Rolling,
+    Support,
 };
 use palpate_material::Law;
 use serde::Deserialize;
@@ -543,8 +543,8 @@ impl ModelSpec {
                 };
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
                 m.base = match s.base.as_deref().unwrap_or("bonded") {
-                    "bonded" => Base::Bonded,
-                    "sliding" => Base::Sliding,
+                    "bonded" => Support::Bonded,
+                    "sliding" => Support::Sliding,
                     other => {
                         return Err(ModelError::new(
                             K,

@@ -1,7 +1,7 @@
 //! Unit tests of [`crate::models`] (the spec and its factory).
 
 use crate::models::*;
-use palpate_fe::N1Element;
+use palpate_fe::PlaneCell;
 
 #[test]
 fn a_spec_reads_from_its_own_toml_table() {
@@ -71,7 +71,7 @@ fn q1_reads_its_mesh_element_and_prony() {
     .unwrap();
     assert_eq!(s.kind(), "q1");
     assert!(matches!(s.validate(),
-        Ok(Model::Q1(m)) if m.level == 1 && m.element == N1Element::Quad9 && m.prony.is_some()));
+        Ok(Model::Q1(m)) if m.level == 1 && m.element == PlaneCell::Quad9 && m.prony.is_some()));
     assert!(s.test().unwrap_err().to_string().contains("Q1 records"));
     let s: ModelSpec = toml::from_str("[q1]\nlaw = \"neo-hookean\"\nelement = \"tri3\"\n").unwrap();
     assert!(s

@@ -8,7 +8,7 @@
 //! minute). The records are committed; rerun only to change them.
 
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::{Base, MeshDensity, N1Needle};
+use palpate_fe::{MeshDensity, N1Needle, Support};
 use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
@@ -19,7 +19,7 @@ struct Case {
     name: &'static str,
     c10: f64,
     friction: f64,
-    base: Base,
+    base: Support,
     noise_fraction: f64,
     seed: u64,
     effects: &'static [&'static str],
@@ -32,7 +32,7 @@ fn main() {
             name: "n1-friction",
             c10: 1.2e-3,
             friction: 0.5,
-            base: Base::Bonded,
+            base: Support::Bonded,
             noise_fraction: 0.01,
             seed: 11,
             effects: &["friction"],
@@ -42,7 +42,7 @@ fn main() {
             name: "n1-none",
             c10: 0.9e-3,
             friction: 0.0,
-            base: Base::Bonded,
+            base: Support::Bonded,
             noise_fraction: 0.01,
             seed: 12,
             effects: &[],
@@ -52,7 +52,7 @@ fn main() {
             name: "n1-sliding",
             c10: 1.0e-3,
             friction: 0.0,
-            base: Base::Sliding,
+            base: Support::Sliding,
             noise_fraction: 0.005,
             seed: 13,
             effects: &["boundary_condition"],

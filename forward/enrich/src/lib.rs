@@ -52,6 +52,6 @@ pub use asymmetry::TensionCompressionAsymmetry;
 pub use convert::law_space;
 pub use material_form::{richer_law, MaterialForm, RicherLaw};
 pub use tool_compliance::ToolCompliance;
-pub use viscoelastic::{qlv_convolve, Viscoelastic};
+pub use viscoelastic::{prony_params, qlv_convolve, Viscoelastic};
 pub use wrap::{wrap, wrapper_effects, DEFAULT_PRONY_TERMS, WRAPPER_EFFECTS};
 pub use zero_offset::ZeroOffset;

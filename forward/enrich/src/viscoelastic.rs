@@ -44,30 +44,8 @@ impl Viscoelastic {
 
     /// Same, sharing the base model.
     pub fn from_arc(base: Arc<dyn ForwardModel>, terms: usize) -> Self {
-        let mut own = Vec::with_capacity(2 * terms);
-        for i in 1..=terms {
-            own.push(
-                ParamSpec::new(format!("g{i}"), "1", 0.0, 1.0, 0.1)
-                    .with_role(ParamRole::RelaxationWeight { term: i }),
-            );
-            own.push(
-                ParamSpec::new(
-                    format!("tau{i}_s"),
-                    "s",
-                    0.0,
-                    f64::INFINITY,
-                    Self::default_tau(i),
-                )
-                .with_role(ParamRole::TimeConstant { term: i }),
-            );
-        }
-        let space = base.space().extended(&own);
+        let space = base.space().extended(&prony_params(terms));
         Viscoelastic { base, terms, space }
-    }
-
-    /// Starting relaxation time of term `i` (1-based): one decade apart, 1 s, 10 s, ...
-    fn default_tau(i: usize) -> f64 {
-        10f64.powi(i as i32 - 1)
     }
 
     /// Number of Prony terms.
@@ -117,6 +95,30 @@ impl Viscoelastic {
         }
         out
     }
+}
+
+/// The parameters of `terms` Prony terms, `g1, tau1_s, g2, tau2_s, ...`:
+/// g_i in [0, 1] starting at 0.1, tau_i > 0 (s) starting one decade apart
+/// (1 s, 10 s, ...). The same list for every model that takes Prony terms
+/// as parameters ([`Viscoelastic`] here, the FE models' own series).
+pub fn prony_params(terms: usize) -> Vec<ParamSpec> {
+    let mut own = Vec::with_capacity(2 * terms);
+    for i in 1..=terms {
+        own.push(
+            ParamSpec::new(format!("g{i}"), "1", 0.0, 1.0, 0.1)
+                .with_role(ParamRole::RelaxationWeight { term: i }),
+        );
+        own.push(
+            ParamSpec::new(format!("tau{i}_s"), "s", 0.0, f64::INFINITY, default_tau(i))
+                .with_role(ParamRole::TimeConstant { term: i }),
+        );
+    }
+    own
+}
+
+/// Starting relaxation time of term `i` (1-based): one decade apart, 1 s, 10 s, ...
+fn default_tau(i: usize) -> f64 {
+    10f64.powi(i as i32 - 1)
 }
 
 /// Exact convolution for an elastic response `fe` that is piecewise linear
@@ -289,7 +291,7 @@ impl Enrichable for Viscoelastic {
         let mut v = base_theta.to_vec();
         for i in 1..=self.terms {
             v.push(0.0);
-            v.push(Self::default_tau(i));
+            v.push(default_tau(i));
         }
         v
     }

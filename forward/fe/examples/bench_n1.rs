@@ -1,4 +1,4 @@
-//! Benchmark (issue 3): N1 (BENCHMARKS.md) neo-Hookean `ecoflex-nh`,
+//! Benchmark: N1 (BENCHMARKS.md) neo-Hookean `ecoflex-nh`,
 //! friction 0.8, bonded base, exact incompressibility, needle to 10 mm with
 //! the force every 0.25 mm, on 1 and 2 threads, against CalculiX on the
 //! reference deck `../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp`.
@@ -25,7 +25,7 @@ use std::time::Instant;
 
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
-use palpate_fe::{MeshDensity, N1Element, N1Needle, RunStats};
+use palpate_fe::{MeshDensity, N1Needle, PlaneCell, RunStats};
 
 const C10: f64 = 1101.295e-6;
 const AT: [f64; 3] = [2.0, 5.0, 10.0];
@@ -117,7 +117,7 @@ fn run(case: Case, threads: usize) -> Run {
         MeshChoice::Graded(_, g) => m.grading = Some(g),
         MeshChoice::Quadratic(_, g) => {
             m.grading = Some(g);
-            m.element = N1Element::Quad9;
+            m.element = PlaneCell::Quad9;
         }
     }
     if let Some(s) = case.max_step {

@@ -1,6 +1,6 @@
 //! Prints N1 and C1 forces for the regression record.
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens};
+use palpate_fe::{Bulk, C1Fe, MeshDensity, N1Needle, Platens, Support};
 
 fn main() {
     let nh: palpate_material::Law = "neo-hookean".parse().unwrap();
@@ -9,16 +9,16 @@ fn main() {
     let load = Loading::quasi_static(Drive::DisplacementMm, d);
     let mut cases: Vec<(String, Box<dyn ForwardModel>, Vec<f64>)> = Vec::new();
     for (fr, bulk, base, law, p) in [
-        (0.8, Bulk::Exact, Base::Bonded, nh, vec![0.001101295]),
-        (0.0, Bulk::Exact, Base::Bonded, nh, vec![0.001101295]),
+        (0.8, Bulk::Exact, Support::Bonded, nh, vec![0.001101295]),
+        (0.0, Bulk::Exact, Support::Bonded, nh, vec![0.001101295]),
         (
             0.8,
             Bulk::Ratio(1000.0),
-            Base::Bonded,
+            Support::Bonded,
             rp,
             vec![0.0011, 0.0002],
         ),
-        (0.3, Bulk::Exact, Base::Sliding, nh, vec![0.001101295]),
+        (0.3, Bulk::Exact, Support::Sliding, nh, vec![0.001101295]),
     ] {
         let mut m = N1Needle::new(law);
         m.friction = fr;

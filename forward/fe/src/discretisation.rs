@@ -10,7 +10,7 @@
 //! ```
 //!
 //! Two meshes cannot observe `p`; the models take it from their documented
-//! convergence studies ([`ConvergenceOrder`], e.g. [`crate::N1Needle::convergence_order`]).
+//! convergence studies ([`ConvergenceOrder`], e.g. [`crate::N1Setup::convergence_order`]).
 //! [`observed_order`] is the three-mesh order those studies report.
 //!
 //! Used by `palpate simulate` only: a model's `predict` stays one solve.

@@ -1,18 +1,25 @@
-//! What the FE forward models share: the volumetric treatment, the
-//! parameter space of a law, the per-thread evaluator that keeps its solver
-//! (mesh, pattern, symbolic factorisation, scratch) between calls, and the
+//! What the FE forward models share: the [`Setup`] a model describes (its
+//! system, what its parameters set, what it observes) and the one
+//! [`FeModel`] that makes any setup a [`ForwardModel`]; the layer's
+//! vocabulary of a model ([`Bulk`], [`PlaneCell`], [`Support`]); the
+//! parameter space of a law; the per-thread evaluator that keeps its solver
+//! (mesh, pattern, symbolic factorisation, scratch) between calls; and the
 //! conversion of solver failures into [`ForwardError`].
 
 use palpate_core::{
-    check_output_slots, Drive, Evaluator, ForwardError, Loading, ParamRole, ParamSpace, ParamSpec,
+    check_output_slots, enrichable::not_applicable, Drive, Effect, Enrichable, Evaluator,
+    ForwardError, ForwardModel, Loading, Observable, Output, ParamRole, ParamSpace, ParamSpec,
 };
 use palpate_material::{Law, Volumetric};
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use crate::body::RegionMaterial;
+use crate::discretisation::Coarser;
+use crate::kernel::PressureSpace;
 use crate::material::LawMaterial;
 use crate::material::PointMaterial;
+use crate::mesh::{CellType, Grading};
 use crate::stepper::{self, LoadPath, Progress, RunFailure};
 use crate::system::{RunStats, SolverOptions, System};
 use crate::viscoelastic::{Prony, Viscoelastic};
@@ -70,12 +77,90 @@ pub struct Simulation {
     pub stats: RunStats,
 }
 
-/// Something that builds a system for given extra (non-material)
-/// parameters and applies those parameters before a run.
-pub(crate) trait Setup: Send + Sync {
+/// The cell of a 2D (axisymmetric or plane) mesh made from a grading.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PlaneCell {
+    /// 4-node quadrilateral, constant pressure (Q1/P0).
+    Quad4,
+    /// 9-node quadrilateral, discontinuous linear pressure (Q2/P1), on the
+    /// grading's cells made quadratic (twice the nodes per direction).
+    Quad9,
+}
+
+impl PlaneCell {
+    /// The mesh cell type and the pressure space of the mixed element.
+    pub fn element(self) -> (CellType, PressureSpace) {
+        match self {
+            PlaneCell::Quad4 => (CellType::Quad4, PressureSpace::P0),
+            PlaneCell::Quad9 => (CellType::Quad9, PressureSpace::P1),
+        }
+    }
+}
+
+/// How the specimen's base (bottom face) is supported.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Support {
+    /// Fixed in all directions.
+    Bonded,
+    /// Free to slide along the base (the normal component fixed only).
+    Sliding,
+}
+
+/// The Coulomb coefficient of a tool as a parameter (bounds 0..2,
+/// plausible 0..0.8: a lubricated to a dry tool on soft tissue), starting
+/// at `initial`: the `friction` effect of the models with a tool.
+pub fn friction_param(initial: f64) -> ParamSpec {
+    ParamSpec::new("friction", "1", 0.0, 2.0, initial)
+        .with_role(ParamRole::Friction)
+        .with_plausible(0.0, 0.8)
+}
+
+/// The coarser companion of a graded mesh for the error estimate: the fine
+/// size and `growth - 1` doubled, the fine zone kept (level L -> L/2).
+pub fn doubled(g: Grading) -> Grading {
+    Grading {
+        h_fine: 2.0 * g.h_fine,
+        fine_length: g.fine_length,
+        growth: 1.0 + 2.0 * (g.growth - 1.0),
+    }
+}
+
+/// A graded mesh in words for messages: `0.4 mm elements under the
+/// {tool}, growth 1.4`.
+pub fn graded_mesh_words(g: Grading, tool: &str) -> String {
+    format!(
+        "{} mm elements under the {tool}, growth {}",
+        round6(g.h_fine),
+        round6(g.growth)
+    )
+}
+
+/// `x` to six decimals, for messages (0.4 rather than 0.4000000000000001).
+fn round6(x: f64) -> f64 {
+    (x * 1e6).round() / 1e6
+}
+
+/// An FE experiment as data: what it builds (mesh, bodies, supports,
+/// tool), what its parameters set before a run, how its loading drives the
+/// stepper and what it observes. [`FeModel`] makes any setup a
+/// [`ForwardModel`] (and [`Enrichable`]); the reference problems N1, N3,
+/// C1, Q1 and R2 are setups ([`crate::models`]).
+pub trait Setup: Clone + std::fmt::Debug + PartialEq + Send + Sync + 'static {
+    /// Typed handles to the contributions [`Setup::build`] adds
+    /// ([`crate::system::Parts`]), for [`Setup::prepare`] and
+    /// [`Setup::observe`].
+    type Parts: Send + Sync;
+    /// The law of the specimen; its parameters come first.
     fn law(&self) -> &Law;
+    /// Replaces the law ([`FeModel::set_law`]: the parameter space follows).
+    fn set_law(&mut self, law: Law);
     fn bulk(&self) -> Bulk;
     fn options(&self) -> SolverOptions;
+    /// The parameter space: the law's, then those [`Setup::prepare`] and
+    /// [`Setup::prony_for`] read after them (`extra`).
+    fn param_space(&self) -> ParamSpace;
     /// A Prony series on the material's isochoric stress (viscoelastic
     /// runs); `None` (the default): elastic.
     fn prony(&self) -> Option<&Prony> {
@@ -87,13 +172,15 @@ pub(crate) trait Setup: Send + Sync {
     fn prony_for(&self, _extra: &[f64]) -> Result<Option<Prony>, FeError> {
         Ok(self.prony().cloned())
     }
-    fn build(&self) -> Result<System, FeError>;
+    /// The system, and the handles of its contributions.
+    fn build(&self) -> Result<(System, Self::Parts), FeError>;
     /// Sets what depends on the parameters before a run: the materials,
     /// contact penalties (scaled by the shear modulus `mu`) and the
     /// parameters that follow the law's (e.g. friction).
     fn prepare(
         &self,
         sys: &mut System,
+        parts: &Self::Parts,
         material: RegionMaterial,
         extra: &[f64],
     ) -> Result<(), FeError>;
@@ -121,15 +208,186 @@ pub(crate) trait Setup: Send + Sync {
             preload: 0,
         })
     }
-    /// The outputs of a converged state: as many as the model's
-    /// [`palpate_core::ForwardModel::outputs`], in that order (the
-    /// evaluator checks); the first is the force a one-output consumer sees.
-    fn observe(&self, sys: &System) -> Vec<f64>;
+    /// The outputs of a converged state: as many as [`Setup::outputs`], in
+    /// that order (the evaluator checks); the first is the force a
+    /// one-output consumer sees.
+    fn observe(&self, sys: &System, parts: &Self::Parts) -> Vec<f64>;
+    /// The model's name, with every setting that changes its predictions
+    /// (provenance records it).
+    fn name(&self) -> String;
+    /// The outputs [`Setup::observe`] returns. Default: the force.
+    fn outputs(&self) -> Vec<Output> {
+        vec![Output::from(Observable::ForceN)]
+    }
+    /// A check of a loading before [`FeModel::simulate`] builds anything
+    /// (e.g. a depth the specimen cannot take). Default: none.
+    fn check_loading(&self, _loading: &Loading) -> Result<(), ForwardError> {
+        Ok(())
+    }
+    /// The effects of the gap diagnosis the model offers; `None` (the
+    /// default): the model is not [`Enrichable`].
+    fn effects(&self) -> Option<Vec<Effect>> {
+        None
+    }
+    /// The model with `effect` ([`Enrichable::enrich`]).
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        Err(not_applicable(effect, &self.name()))
+    }
+}
+
+/// The forward model of a [`Setup`]: one FE run per prediction, each
+/// thread's evaluator keeping its system between calls. It dereferences
+/// to its setup, whose public fields are the model's settings; the
+/// parameter space is derived from the setup ([`Setup::param_space`]) and
+/// follows every change made through it.
+#[derive(Clone)]
+pub struct FeModel<S> {
+    setup: S,
+    space: OnceLock<ParamSpace>,
+}
+
+impl<S: Setup> FeModel<S> {
+    /// The model of `setup`.
+    pub fn from_setup(setup: S) -> Self {
+        FeModel {
+            setup,
+            space: OnceLock::new(),
+        }
+    }
+
+    /// The setup.
+    pub fn setup(&self) -> &S {
+        &self.setup
+    }
+
+    /// The law of the specimen.
+    pub fn law(&self) -> &Law {
+        self.setup.law()
+    }
+
+    /// Replaces the law; the parameter space follows.
+    pub fn set_law(&mut self, law: Law) {
+        std::ops::DerefMut::deref_mut(self).set_law(law);
+    }
+
+    /// The model with another law.
+    pub fn with_law(mut self, law: Law) -> Self {
+        self.set_law(law);
+        self
+    }
+
+    /// Runs one history with a progress observer; returns the system too
+    /// (fields for VTK output).
+    pub fn simulate(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+        progress: Option<&mut dyn FnMut(&Progress)>,
+    ) -> Result<(Simulation, System), ForwardError> {
+        self.setup.check_loading(loading)?;
+        let (mut sys, parts) = self.setup.build().map_err(to_forward)?;
+        let sim = simulate_with(
+            &self.setup,
+            self.space(),
+            &mut sys,
+            &parts,
+            theta,
+            loading,
+            progress,
+            false,
+        )?;
+        Ok((sim, sys))
+    }
+
+    /// The model with its setup changed by `change`, as the coarser
+    /// companion of the error estimate with element-size ratio `ratio` and
+    /// the mesh in words.
+    pub(crate) fn companion(
+        &self,
+        ratio: f64,
+        mesh: String,
+        change: impl FnOnce(&mut S),
+    ) -> Coarser<Self> {
+        let mut setup = self.setup.clone();
+        change(&mut setup);
+        Coarser {
+            model: FeModel::from_setup(setup),
+            ratio,
+            mesh,
+        }
+    }
+}
+
+impl<S> std::ops::Deref for FeModel<S> {
+    type Target = S;
+    fn deref(&self) -> &S {
+        &self.setup
+    }
+}
+
+/// A change through the setup may change the parameter space: it is derived
+/// again when next asked for.
+impl<S> std::ops::DerefMut for FeModel<S> {
+    fn deref_mut(&mut self) -> &mut S {
+        self.space = OnceLock::new();
+        &mut self.setup
+    }
+}
+
+impl<S: PartialEq> PartialEq for FeModel<S> {
+    fn eq(&self, other: &Self) -> bool {
+        self.setup == other.setup
+    }
+}
+
+impl<S: std::fmt::Debug> std::fmt::Debug for FeModel<S> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        self.setup.fmt(f)
+    }
+}
+
+impl<S: Setup> ForwardModel for FeModel<S> {
+    fn name(&self) -> String {
+        self.setup.name()
+    }
+    fn space(&self) -> &ParamSpace {
+        self.space.get_or_init(|| self.setup.param_space())
+    }
+    fn observable(&self) -> Observable {
+        Observable::ForceN
+    }
+    fn outputs(&self) -> Vec<Output> {
+        self.setup.outputs()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(FeEvaluator {
+            setup: &self.setup,
+            space: self.space(),
+            outputs: self.outputs().len(),
+            system: None,
+        })
+    }
+    /// A nonlinear FE solve per prediction (seconds or more).
+    fn expensive(&self) -> bool {
+        true
+    }
+    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        self.setup.effects().map(|_| self as &dyn Enrichable)
+    }
+}
+
+impl<S: Setup> Enrichable for FeModel<S> {
+    fn effects(&self) -> Vec<Effect> {
+        self.setup.effects().unwrap_or_default()
+    }
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+        self.setup.enrich(effect)
+    }
 }
 
 /// A loading as the stepper runs it: the path, and the number of its first
 /// stations that are a preload (run, not reported as samples).
-pub(crate) struct Path {
+pub struct Path {
     pub path: LoadPath,
     pub preload: usize,
 }
@@ -175,26 +433,15 @@ fn failure(mut f: RunFailure, all_outputs: bool, preload: usize) -> ForwardError
     }
 }
 
-/// Runs one loading history on `sys` (built by `setup`); a
-/// [`ForwardError::NotConverged`] keeps the first output of the converged
-/// samples.
-pub(crate) fn simulate(
-    setup: &dyn Setup,
+/// Runs one loading history on `sys` (built by `setup`, with the handles
+/// `parts`); a failure keeps the first output of the converged samples, or
+/// with `all_outputs` every output (samples x outputs, row-major).
+#[allow(clippy::too_many_arguments)]
+fn simulate_with<S: Setup>(
+    setup: &S,
     space: &ParamSpace,
     sys: &mut System,
-    theta: &[f64],
-    loading: &Loading,
-    progress: Option<&mut dyn FnMut(&Progress)>,
-) -> Result<Simulation, ForwardError> {
-    simulate_with(setup, space, sys, theta, loading, progress, false)
-}
-
-/// [`simulate`]; with `all_outputs`, a failure keeps every output of the
-/// converged samples (samples x outputs, row-major).
-fn simulate_with(
-    setup: &dyn Setup,
-    space: &ParamSpace,
-    sys: &mut System,
+    parts: &S::Parts,
     theta: &[f64],
     loading: &Loading,
     progress: Option<&mut dyn FnMut(&Progress)>,
@@ -227,10 +474,10 @@ fn simulate_with(
         volumetric: setup.bulk().volumetric(mu),
     };
     setup
-        .prepare(sys, material, &theta[n_law..])
+        .prepare(sys, parts, material, &theta[n_law..])
         .map_err(to_forward)?;
     let Path { path, preload } = setup.path(loading, &opts)?;
-    let mut observe = |s: &System| setup.observe(s);
+    let mut observe = |s: &System| setup.observe(s, parts);
     let mut outputs = stepper::run(sys, &path, &opts, &mut observe, progress)
         .map_err(|f| failure(f, all_outputs, preload))?;
     outputs.drain(..preload.min(outputs.len()));
@@ -245,16 +492,16 @@ fn simulate_with(
 /// and kept (pattern, symbolic LU, scratch) for every later call. Every
 /// output [`Setup::observe`] returns is read at each sample;
 /// `predict_into` gives the first, `predict_outputs_into` all of them.
-pub(crate) struct FeEvaluator<'a> {
-    pub setup: &'a dyn Setup,
-    pub space: &'a ParamSpace,
-    /// The number of outputs the model declares
-    /// ([`palpate_core::ForwardModel::outputs`]), which `observe` returns.
-    pub outputs: usize,
-    pub system: Option<System>,
+struct FeEvaluator<'a, S: Setup> {
+    setup: &'a S,
+    space: &'a ParamSpace,
+    /// The number of outputs the model declares ([`Setup::outputs`]), which
+    /// `observe` returns.
+    outputs: usize,
+    system: Option<(System, S::Parts)>,
 }
 
-impl FeEvaluator<'_> {
+impl<S: Setup> FeEvaluator<'_, S> {
     /// The simulation of `loading`, on the system built at first use.
     fn run(
         &mut self,
@@ -265,7 +512,7 @@ impl FeEvaluator<'_> {
         if self.system.is_none() {
             self.system = Some(self.setup.build().map_err(to_forward)?);
         }
-        let sys = self
+        let (sys, parts) = self
             .system
             .as_mut()
             .ok_or_else(|| ForwardError::InvalidConfig {
@@ -276,6 +523,7 @@ impl FeEvaluator<'_> {
             self.setup,
             self.space,
             sys,
+            parts,
             theta,
             loading,
             None,
@@ -284,7 +532,7 @@ impl FeEvaluator<'_> {
     }
 }
 
-impl Evaluator for FeEvaluator<'_> {
+impl<S: Setup> Evaluator for FeEvaluator<'_, S> {
     fn predict_into(
         &mut self,
         theta: &[f64],
@@ -332,21 +580,28 @@ impl Evaluator for FeEvaluator<'_> {
 mod tests {
     use super::*;
     use crate::{C1Fe, Platens};
-    use palpate_core::{ForwardModel, Observable, Output};
     use palpate_enrich::ZeroOffset;
 
     /// Bonded C1 observing both platens: the reaction of the driven top
     /// platen (C1's force) and the sum of the internal forces along y on the
     /// bottom face, which equilibrium makes equal to it. `declared` is the
     /// number of outputs it claims (2, or wrong on purpose).
+    #[derive(Debug, Clone, PartialEq)]
     struct BothPlatens {
-        c1: C1Fe,
+        c1: crate::C1Setup,
         declared: usize,
     }
 
     impl Setup for BothPlatens {
+        type Parts = <crate::C1Setup as Setup>::Parts;
         fn law(&self) -> &Law {
             self.c1.law()
+        }
+        fn set_law(&mut self, law: Law) {
+            self.c1.set_law(law)
+        }
+        fn param_space(&self) -> ParamSpace {
+            self.c1.param_space()
         }
         fn bulk(&self) -> Bulk {
             self.c1.bulk()
@@ -354,18 +609,19 @@ mod tests {
         fn options(&self) -> SolverOptions {
             Setup::options(&self.c1)
         }
-        fn build(&self) -> Result<System, FeError> {
+        fn build(&self) -> Result<(System, Self::Parts), FeError> {
             self.c1.build()
         }
         fn prepare(
             &self,
             sys: &mut System,
+            parts: &Self::Parts,
             material: RegionMaterial,
             extra: &[f64],
         ) -> Result<(), FeError> {
-            self.c1.prepare(sys, material, extra)
+            self.c1.prepare(sys, parts, material, extra)
         }
-        fn observe(&self, sys: &System) -> Vec<f64> {
+        fn observe(&self, sys: &System, _parts: &Self::Parts) -> Vec<f64> {
             let fint = sys.internal_forces();
             let bottom = sys.mesh.node_set("bottom").expect("C1 has a bottom");
             let d = sys.dofs.dim;
@@ -374,17 +630,8 @@ mod tests {
                 bottom.iter().map(|&n| fint[n * d + 1]).sum(),
             ]
         }
-    }
-
-    impl ForwardModel for BothPlatens {
         fn name(&self) -> String {
             "C1 observing both platens".into()
-        }
-        fn space(&self) -> &ParamSpace {
-            self.c1.space()
-        }
-        fn observable(&self) -> Observable {
-            Observable::ForceN
         }
         fn outputs(&self) -> Vec<Output> {
             let mut v = vec![
@@ -397,17 +644,13 @@ mod tests {
             );
             v
         }
-        fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-            Box::new(FeEvaluator {
-                setup: self,
-                space: self.c1.space(),
-                outputs: self.outputs().len(),
-                system: None,
-            })
-        }
-        fn expensive(&self) -> bool {
-            true
-        }
+    }
+
+    fn both(declared: usize) -> FeModel<BothPlatens> {
+        FeModel::from_setup(BothPlatens {
+            c1: c1().setup().clone(),
+            declared,
+        })
     }
 
     fn c1() -> C1Fe {
@@ -422,10 +665,7 @@ mod tests {
     /// the first column is the one-output prediction, bit for bit.
     #[test]
     fn fe_evaluator_writes_every_output_per_sample() {
-        let m = BothPlatens {
-            c1: c1(),
-            declared: 2,
-        };
+        let m = both(2);
         let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.5, 1.0, 1.5]);
         let columns = m.predict_outputs(&NH, &loading).unwrap();
         assert_eq!(columns.len(), 2);
@@ -462,13 +702,38 @@ mod tests {
         assert_eq!(off, columns);
     }
 
+    /// The parameter space follows every change of the setup: a new law, a
+    /// new nodule law, friction made a parameter; the name records Q1's
+    /// pure-penalty switch only when it is on.
+    #[test]
+    fn the_space_follows_the_setup() {
+        let rp: Law = "reduced-polynomial:2".parse().unwrap();
+        let mut n1 = crate::N1Needle::new(Law::NeoHookean);
+        assert_eq!(n1.space().len(), 1);
+        n1.set_law(rp);
+        assert_eq!(n1.space().names(), ["C10", "C20"]);
+        let friction = n1.enrich(Effect::Friction).unwrap();
+        assert_eq!(friction.space().names(), ["C10", "C20", "friction"]);
+
+        let ab: Law = "arruda-boyce".parse().unwrap();
+        let mut r2 = crate::R2Rolling::new(ab, ab, 3.0);
+        assert_eq!(r2.space().len(), 4);
+        r2.set_nodule_law(Law::NeoHookean);
+        assert_eq!(r2.space().names(), ["mu", "lambda_m", "nodule_C10"]);
+
+        let mut q1 = crate::Q1Punch::new(Law::NeoHookean);
+        let plain = q1.name();
+        assert!(!plain.contains("penalty"), "{plain}");
+        q1.pure_penalty = true;
+        assert_eq!(q1.name(), format!("{plain}, pure-penalty contact"));
+        let q1 = q1.with_prony_parameters(2);
+        assert_eq!(q1.space().names(), ["C10", "g1", "tau1_s", "g2", "tau2_s"]);
+    }
+
     /// A model whose `outputs` and `observe` disagree is told so.
     #[test]
     fn declared_and_observed_outputs_must_agree() {
-        let m = BothPlatens {
-            c1: c1(),
-            declared: 3,
-        };
+        let m = both(3);
         let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.5]);
         let err = m.predict_outputs(&NH, &loading).unwrap_err();
         assert!(

@@ -293,7 +293,7 @@ impl SparseLu {
             CholeskySymbolicParams {
                 // faer's AUTO picks the simplicial factorisation for R2's
                 // 2D tangent (11,144 unknowns), 2.2x slower there than the
-                // supernodal one (58 -> 26 ms a factorisation; session 9);
+                // supernodal one (58 -> 26 ms a factorisation);
                 // 3D tangents (N3) were supernodal already
                 supernodal_flop_ratio_threshold: SupernodalThreshold::FORCE_SUPERNODAL,
                 ..Default::default()

@@ -147,6 +147,49 @@ pub(crate) struct Target {
     pub dt: f64,
 }
 
+/// The contributions of a system being built, each added with a typed
+/// handle that reaches it in the built [`System`] ([`System::from_parts`]):
+/// a model keeps the handles instead of positions.
+#[derive(Default)]
+pub struct Parts {
+    list: Vec<Box<dyn Contribution>>,
+}
+
+impl Parts {
+    pub fn new() -> Self {
+        Parts::default()
+    }
+
+    /// Adds `contribution` after those already added.
+    pub fn add<T: Contribution + 'static>(&mut self, contribution: T) -> Part<T> {
+        self.list.push(Box::new(contribution));
+        Part {
+            index: self.list.len() - 1,
+            kind: std::marker::PhantomData,
+        }
+    }
+}
+
+/// A typed handle to a contribution of a [`System`] built from [`Parts`].
+pub struct Part<T> {
+    index: usize,
+    kind: std::marker::PhantomData<fn() -> T>,
+}
+
+impl<T> Clone for Part<T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Part<T> {}
+
+impl<T> std::fmt::Debug for Part<T> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Part({}: {})", self.index, std::any::type_name::<T>())
+    }
+}
+
 /// The global system.
 pub struct System {
     pub mesh: Mesh,
@@ -256,6 +299,29 @@ impl System {
             fail_after: None,
             prox: None,
         })
+    }
+
+    /// [`System::new`] with the contributions of `parts`, whose handles
+    /// ([`Part`]) reach them afterwards ([`System::get`], [`System::get_mut`]).
+    pub fn from_parts(
+        mesh: Mesh,
+        dim: usize,
+        parts: Parts,
+        bcs: &[crate::dofs::Dirichlet],
+        channels: usize,
+    ) -> Result<System, FeError> {
+        System::new(mesh, dim, parts.list, bcs, channels)
+    }
+
+    /// The contribution behind `part`, or an error naming what is there
+    /// (a handle of another system).
+    pub fn get_mut<T: Contribution + 'static>(&mut self, part: Part<T>) -> Result<&mut T, FeError> {
+        self.part_mut(part.index)
+    }
+
+    /// The contribution behind `part`.
+    pub fn get<T: Contribution + 'static>(&self, part: Part<T>) -> Option<&T> {
+        self.part(part.index)
     }
 
     /// Contribution `index` as its concrete type, or an error naming it.

@@ -915,3 +915,62 @@ fn self_contact_tangent_equals_finite_differences() {
     sys.assemble(&target, true).unwrap();
     assert_eq!(sys.part::<SelfContact>(0).unwrap().active(), 0);
 }
+
+/// The handles [`Parts::add`] returns reach their contributions in the
+/// built system whatever the order they were added in; a handle of another
+/// system that points at a contribution of another type is an error naming
+/// what is there.
+#[test]
+fn typed_handles_reach_their_contributions() {
+    let mesh = Mesh::graded_rectangle(4.0, 2.0, Grading::uniform(4.0, 4), Grading::uniform(2.0, 2))
+        .unwrap();
+    let kin = Kinematics::Axisymmetric;
+    let body = || {
+        SolidBody::new(
+            "body",
+            &mesh,
+            &["body"],
+            kernel_for(CellType::Quad4, kin, PressureSpace::P0).unwrap(),
+            true,
+        )
+        .unwrap()
+    };
+    let contact = RigidContact::new(
+        "tool",
+        Box::new(Profile2d(ToolShape::n1_needle())),
+        ToolMotion::translating([0.0, 2.0, 0.0], vec![(0, [0.0, -1.0, 0.0])]),
+        &mesh,
+        "top",
+        kin,
+        ContactOptions {
+            friction: 0.0,
+            penalty_normal: 20.0,
+            penalty_tangent: 20.0,
+            penetration_tol: 1e-6,
+            points: ContactPoints::EdgeGauss,
+        },
+        1,
+    )
+    .unwrap();
+    let mut parts = Parts::new();
+    let tool = parts.add(contact);
+    let solid = parts.add(body());
+    let bcs = [Dirichlet::fixed("axis", 0), Dirichlet::fixed("bottom", 1)];
+    let mut sys = System::from_parts(mesh.clone(), 2, parts, &bcs, 1).unwrap();
+    assert_eq!(
+        sys.get(tool).map(|c| c.name()).as_deref(),
+        Some("tool `tool`")
+    );
+    assert_eq!(
+        sys.get(solid).map(|c| c.name()).as_deref(),
+        Some("body `body`")
+    );
+    sys.get_mut(tool).unwrap().smoothing = 0.01;
+    assert_eq!(sys.get(tool).unwrap().smoothing, 0.01);
+    // the first part of another system is a body; here it is the tool
+    let mut other = Parts::new();
+    let foreign = other.add(body());
+    assert!(sys.get(foreign).is_none());
+    let err = sys.get_mut(foreign).err().unwrap().to_string();
+    assert!(err.contains("is tool `tool`"), "{err}");
+}

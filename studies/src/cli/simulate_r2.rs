@@ -53,9 +53,9 @@ fn segments() -> usize {
 /// Runs the R2 benchmark for the checked `model`.
 pub fn run(args: &Args, model: R2Rolling) -> anyhow::Result<()> {
     let p = R2Rolling::BENCHMARK_PARAMS;
-    let mut theta = law_params(&model.law, &args.params, &p[..2], "--param")?;
+    let mut theta = law_params(model.law(), &args.params, &p[..2], "--param")?;
     theta.extend(law_params(
-        &model.nodule_law,
+        model.nodule_law(),
         &args.nodule_params,
         &p[2..],
         "--nodule-param",

@@ -78,7 +78,7 @@ tool = "sphere:5"
         Model::N1Needle(n) => {
             assert_eq!(n.friction, 0.0);
             assert_eq!(n.mesh.level, 1);
-            assert_eq!(n.base, palpate_fe::Base::Sliding);
+            assert_eq!(n.base, palpate_fe::Support::Sliding);
             assert_eq!(n.tool, palpate_fe::ToolShape::Sphere { radius: 5.0 });
         }
         other => panic!("{other:?}"),

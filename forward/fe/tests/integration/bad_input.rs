@@ -1,4 +1,4 @@
-//! Issue 10, bad input: a mesh file with a missing node, an inverted
+//! Bad input: a mesh file with a missing node, an inverted
 //! element, an unknown region name, a tool starting inside the body and a
 //! loading channel that no boundary condition uses each give a clear error
 //! naming the file and line or the field, never a panic. Also a dimension

@@ -1,6 +1,6 @@
 //! Hertz: a rigid sphere of radius R = 2.5 mm pressed frictionlessly into
 //! the N1 cylinder (70 mm x 80 mm, bonded base) of incompressible
-//! neo-Hookean `ecoflex-nh` (issue 3). For an incompressible half-space
+//! neo-Hookean `ecoflex-nh`. For an incompressible half-space
 //! (Hertz 1882; Johnson, *Contact Mechanics*, 1985, eq. 4.22)
 //!
 //! ```text
@@ -23,7 +23,7 @@
 //! measured by enlarging it) and finite deformation (-1.7 %, growing like
 //! a / R), and an independent CalculiX model of the same problem
 //! (docs/validation/hertz/) is 4.0 % below Hertz: ours is 0.2-0.4 % above
-//! it, within its own uncertainty. The 3 % target of issue 3 holds against
+//! it, within its own uncertainty. The 3 % criterion holds against
 //! Hertz to 0.1 R on a near-half-space (the N1 cylinder enlarged 10x, the
 //! body Hertz's formula assumes), against Sneddon to 0.1 R on the N1
 //! cylinder, and against Hertz to 0.06 R on the N1 cylinder.
@@ -178,7 +178,7 @@ fn sphere_force_matches_calculix() {
     eprintln!("{msg}");
     assert!(rel.iter().all(|r| r.abs() < CCX_TOLERANCE), "{msg}");
     // the independent solver is itself more than 3 % below Hertz at 0.1 R:
-    // the 3 % target of issue 3 is not reachable on this cylinder
+    // a 3 % agreement with Hertz is not reachable on this cylinder
     let d = 0.1 * R;
     assert!(at(&ccx, d) / hertz(d) - 1.0 < -0.03, "{msg}");
 }
@@ -189,7 +189,7 @@ fn sphere_force_matches_calculix() {
 /// finite-deformation part of the deviation.
 ///
 /// Hertz's formula is a half-space result: on this near-half-space the FE
-/// force is within 3 % of it at every depth up to 0.1 R (issue 3's
+/// force is within 3 % of it at every depth up to 0.1 R (the test's
 /// criterion; -2.8 % at 0.1 R), while on the N1-sized cylinder the finite
 /// body takes another 0.8-1 % off.
 #[test]

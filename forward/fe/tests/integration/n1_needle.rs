@@ -260,8 +260,8 @@ fn viscoelastic_needle_relaxes_to_g_inf_times_the_elastic_force() {
     }
 }
 
-/// The real-time surrogate's held-out history 1 to 5 mm (session 15's
-/// stall): the viscoelastic needle with friction 0.8, pressed to 4.93 mm
+/// The real-time surrogate's held-out history 1 to 5 mm, on which Newton
+/// stalls without stabilisation: the viscoelastic needle with friction 0.8, pressed to 4.93 mm
 /// and withdrawn, then pressed and withdrawn again. Without the proximal
 /// stabilisation of failing increments its Newton stalls on the way down
 /// near 3.83 mm after 12 step cuts; with N1's default it runs to the end

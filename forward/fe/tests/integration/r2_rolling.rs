@@ -1,4 +1,4 @@
-//! R2 rolling model (forward/fe/src/r2.rs) on a cheap model: a block
+//! R2 rolling model (forward/fe/src/models/r2.rs) on a cheap model: a block
 //! shortened to 60 mm (same height, thickness, wheel and laws as
 //! BENCHMARKS.md R2), 2 mm elements (level 1), one nodule at x = 30 mm,
 //! depth 10 mm (the shallowest of R2, so its peak is the clearest), RD 3,
@@ -108,7 +108,7 @@ fn frictionless_press_at_x_equals_rolled_force_at_x() {
 /// one reach the same equilibria: the rolled forces agree to the Newton
 /// tolerance, like the two paths of (a). The slope search must also not
 /// cost more iterations here (it took 205 against 213 on R2's x 52 -> 62
-/// mm, docs/validation/fe.md R2 speed, session 9).
+/// mm, docs/validation/fe.md R2 speed).
 #[test]
 fn slope_and_residual_line_searches_reach_the_same_forces() {
     let m = one_nodule();

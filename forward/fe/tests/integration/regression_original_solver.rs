@@ -9,7 +9,7 @@
 #![allow(clippy::excessive_precision)]
 
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_fe::{Base, Bulk, C1Fe, MeshDensity, N1Needle, Platens};
+use palpate_fe::{Bulk, C1Fe, MeshDensity, N1Needle, Platens, Support};
 
 fn check(name: &str, got: &[f64], want: &[f64]) {
     assert_eq!(got.len(), want.len(), "{name}");
@@ -36,7 +36,7 @@ fn n1_forces_equal_the_original_solver() {
     let mut m = N1Needle::new("reduced-polynomial:2".parse().unwrap());
     m.mesh = MeshDensity::COARSE;
     m.bulk = Bulk::Ratio(1000.0);
-    m.base = Base::Bonded;
+    m.base = Support::Bonded;
     check(
         "n1 rp2 f0.8 K1000",
         &m.predict(&[0.0011, 0.0002], &load).unwrap(),

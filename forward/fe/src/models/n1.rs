@@ -4,7 +4,7 @@
 //! friction 0.8. The force is the needle reaction for the whole body,
 //! positive in compression.
 //!
-//! The mesh is graded toward the indentation point ([`N1Needle::mesh`]); the
+//! The mesh is graded toward the indentation point ([`N1Setup::mesh`]); the
 //! contact surface is the whole top face. Effects:
 //!
 //! * `friction` — the friction coefficient becomes a parameter (bounds 0..2).
@@ -19,26 +19,25 @@
 //! * `zero_offset` — contact starts at a recorded displacement d0
 //!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
 
-use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole,
-    ParamSpace, ParamSpec,
-};
+use palpate_core::{enrichable::not_applicable, Effect, ForwardError, ForwardModel, ParamSpace};
 use palpate_enrich::{richer_law, MaterialForm, ZeroOffset};
 use palpate_material::Law;
 use std::sync::Arc;
 
 use crate::body::{RegionMaterial, SolidBody};
 use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::contribution::Contribution;
 use crate::discretisation::{Coarser, ConvergenceOrder};
 use crate::dofs::Dirichlet;
-use crate::kernel::{kernel_for, PressureSpace};
+use crate::kernel::kernel_for;
 use crate::kinematics::Kinematics;
-use crate::mesh::{CellType, Grading, Mesh};
-use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
+use crate::mesh::{Grading, Mesh};
+use crate::model::{
+    doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup, Support,
+};
 use crate::motion::ToolMotion;
-use crate::stepper::Progress;
 use crate::surface::Profile2d;
-use crate::system::{SolverOptions, System};
+use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
 use crate::FeError;
@@ -55,7 +54,7 @@ impl MeshDensity {
     pub const MEDIUM: MeshDensity = MeshDensity { level: 2 };
     pub const FINE: MeshDensity = MeshDensity { level: 3 };
 
-    /// The N1 speed-benchmark mesh (issue 3; set it as [`N1Needle::grading`]):
+    /// The N1 speed-benchmark mesh (set it as [`N1Setup::grading`]):
     /// level 2's 0.2 mm elements in a 3 x 3 mm zone under the needle instead
     /// of 5 x 5, growing by 1.1 beyond it (2332 elements instead of 3286).
     /// The cheapest grading found that is as accurate as level 2 for the
@@ -89,34 +88,21 @@ impl MeshDensity {
     }
 }
 
-/// The element of the N1 mesh.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum N1Element {
-    /// 4-node quadrilateral, constant pressure (Q1/P0).
-    Quad4,
-    /// 9-node quadrilateral, discontinuous linear pressure (Q2/P1).
-    Quad9,
-}
+/// The N1 model: [`N1Setup`] as a forward model.
+pub type N1Needle = FeModel<N1Setup>;
 
-/// Base (bottom face) condition.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Base {
-    /// Fixed in all directions (BENCHMARKS.md).
-    Bonded,
-    /// Free to slide radially (u_z = 0 only).
-    Sliding,
-}
-
-/// The N1 model.
+/// The N1 experiment ([`N1Needle`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct N1Needle {
-    pub law: Law,
+pub struct N1Setup {
+    law: Law,
+    /// The law's parameter space when it is not [`law_space`]`(law)`: the
+    /// richer law of the `material_form` enrichment, whose added modulus
+    /// is >= 0.
+    law_bounds: Option<ParamSpace>,
     pub bulk: Bulk,
     pub friction: f64,
     pub tool: ToolShape,
-    pub base: Base,
+    pub base: Support,
     pub mesh: MeshDensity,
     /// When set, this grading (radial from the axis and axial from the top)
     /// replaces the one of `mesh` and `fine_zone`, e.g. for a contact zone
@@ -143,7 +129,7 @@ pub struct N1Needle {
     /// The element: 4-node Q1/P0 (default, the validated one) or 9-node
     /// Q2/P1 on the same grading made quadratic (each cell of the grading
     /// becomes one 9-node cell: twice the nodes per direction).
-    pub element: N1Element,
+    pub element: PlaneCell,
     /// A Prony series on the law's isochoric stress
     /// ([`crate::viscoelastic::Viscoelastic`], as C1 and Q1); `None`:
     /// elastic. A viscoelastic run needs timed loading and steps by at most
@@ -151,8 +137,15 @@ pub struct N1Needle {
     /// when unset).
     pub prony: Option<Prony>,
     pub options: SolverOptions,
+    /// Friction is the parameter after the law's (the `friction` effect).
     friction_is_parameter: bool,
-    space: ParamSpace,
+}
+
+/// The contributions of the N1 system.
+#[derive(Debug, Clone, Copy)]
+pub struct N1Parts {
+    body: Part<SolidBody>,
+    contact: Part<RigidContact>,
 }
 
 impl N1Needle {
@@ -160,13 +153,13 @@ impl N1Needle {
     /// incompressibility, medium mesh, contact at the edge Gauss points with
     /// the multipliers updated once per increment.
     pub fn new(law: Law) -> Self {
-        N1Needle {
-            space: law_space(&law),
+        FeModel::from_setup(N1Setup {
             law,
+            law_bounds: None,
             bulk: Bulk::Exact,
             friction: 0.8,
             tool: ToolShape::n1_needle(),
-            base: Base::Bonded,
+            base: Support::Bonded,
             mesh: MeshDensity::MEDIUM,
             grading: None,
             radius: 35.0,
@@ -175,7 +168,7 @@ impl N1Needle {
             penalty: 100.0,
             penetration_tol: 2e-3,
             contact_points: ContactPoints::EdgeGauss,
-            element: N1Element::Quad4,
+            element: PlaneCell::Quad4,
             prony: None,
             options: SolverOptions {
                 max_step: 0.25,
@@ -187,28 +180,13 @@ impl N1Needle {
                 // A viscoelastic frictional history (friction 0.8, the
                 // real-time surrogate's held-out history 1 to 5 mm) stalled
                 // at 3.83 mm after 12 step cuts; proximal steps carry it
-                // through (session 17). Only failing increments use them, so
+                // through. Only failing increments use them, so
                 // every run that converged before is unchanged.
                 stabilisation: 0.1,
                 ..SolverOptions::default()
             },
             friction_is_parameter: false,
-        }
-    }
-
-    /// The mesh this model uses.
-    pub fn build_mesh(&self) -> Result<Mesh, FeError> {
-        let g = self.effective_grading();
-        let m = Mesh::graded_rectangle(self.radius, self.height, g, g)?;
-        match self.element {
-            N1Element::Quad4 => Ok(m),
-            N1Element::Quad9 => m.to_quadratic(),
-        }
-    }
-
-    fn effective_grading(&self) -> Grading {
-        self.grading
-            .unwrap_or_else(|| self.mesh.grading(self.fine_zone))
+        })
     }
 
     /// The coarser companion of the discretisation error estimate: the same
@@ -217,23 +195,27 @@ impl N1Needle {
     /// level 1) and level 1, which has no coarser level, gets 0.8 mm
     /// elements growing by 1.4.
     pub fn coarser(&self) -> Coarser<N1Needle> {
+        let coarse = doubled(self.effective_grading());
+        self.companion(2.0, graded_mesh_words(coarse, "tool"), |s| {
+            s.grading = Some(coarse)
+        })
+    }
+}
+
+impl N1Setup {
+    /// The mesh this model uses.
+    pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
-        let coarse = Grading {
-            h_fine: 2.0 * g.h_fine,
-            fine_length: g.fine_length,
-            growth: 1.0 + 2.0 * (g.growth - 1.0),
-        };
-        let mut model = self.clone();
-        model.grading = Some(coarse);
-        Coarser {
-            model,
-            ratio: 2.0,
-            mesh: format!(
-                "{} mm elements under the tool, growth {}",
-                round6(coarse.h_fine),
-                round6(coarse.growth)
-            ),
+        let m = Mesh::graded_rectangle(self.radius, self.height, g, g)?;
+        match self.element {
+            PlaneCell::Quad4 => Ok(m),
+            PlaneCell::Quad9 => m.to_quadratic(),
         }
+    }
+
+    fn effective_grading(&self) -> Grading {
+        self.grading
+            .unwrap_or_else(|| self.mesh.grading(self.fine_zone))
     }
 
     /// The order of convergence of the force with the element size. Q1/P0,
@@ -244,7 +226,7 @@ impl N1Needle {
     /// estimate errs on the large side.
     pub fn convergence_order(&self) -> ConvergenceOrder {
         let (order, mut source) = match self.element {
-            N1Element::Quad4 => (
+            PlaneCell::Quad4 => (
                 1.22,
                 "docs/validation/fe.md N1 speed (levels 2, 3, 5, friction 0.8, at 10 mm)"
                     .to_string(),
@@ -253,7 +235,7 @@ impl N1Needle {
             // 0.125 mm increments: observed order 0.9 at 5 mm, larger at
             // 10 mm (the finest two agree to 0.006 %), non-monotone at
             // 2 mm; the smallest is taken.
-            N1Element::Quad9 => (
+            PlaneCell::Quad9 => (
                 0.9,
                 "docs/validation/fe.md N1 speed, Q2/P1 convergence (h 1, 0.5, 0.25 mm, at 5 mm)"
                     .to_string(),
@@ -264,29 +246,27 @@ impl N1Needle {
         }
         ConvergenceOrder { order, source }
     }
-
-    /// Runs one history with a progress observer; returns the system too
-    /// (fields for VTK output).
-    pub fn simulate(
-        &self,
-        theta: &[f64],
-        loading: &Loading,
-        progress: Option<&mut dyn FnMut(&Progress)>,
-    ) -> Result<(Simulation, System), ForwardError> {
-        let mut sys = self.build().map_err(to_forward)?;
-        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
-        Ok((sim, sys))
-    }
 }
 
-/// `x` to six decimals, for messages (0.4 rather than 0.4000000000000001).
-fn round6(x: f64) -> f64 {
-    (x * 1e6).round() / 1e6
-}
-
-impl Setup for N1Needle {
+impl Setup for N1Setup {
+    type Parts = N1Parts;
     fn law(&self) -> &Law {
         &self.law
+    }
+    fn set_law(&mut self, law: Law) {
+        self.law = law;
+        self.law_bounds = None;
+    }
+    fn param_space(&self) -> ParamSpace {
+        let law = self
+            .law_bounds
+            .clone()
+            .unwrap_or_else(|| law_space(&self.law));
+        if self.friction_is_parameter {
+            law.extended(&[friction_param(self.friction)])
+        } else {
+            law
+        }
     }
     fn bulk(&self) -> Bulk {
         self.bulk
@@ -297,7 +277,7 @@ impl Setup for N1Needle {
     fn prony(&self) -> Option<&Prony> {
         self.prony.as_ref()
     }
-    fn build(&self) -> Result<System, FeError> {
+    fn build(&self) -> Result<(System, N1Parts), FeError> {
         if !(self.friction >= 0.0 && self.friction.is_finite()) {
             return Err(FeError::InvalidConfig {
                 field: "friction".into(),
@@ -310,14 +290,14 @@ impl Setup for N1Needle {
             "body",
             &mesh,
             &["body"],
-            match self.element {
-                N1Element::Quad4 => kernel_for(CellType::Quad4, kin, PressureSpace::P0)?,
-                N1Element::Quad9 => kernel_for(CellType::Quad9, kin, PressureSpace::P1)?,
+            {
+                let (cell, pressure) = self.element.element();
+                kernel_for(cell, kin, pressure)?
             },
             self.bulk.exact(),
         )?;
         let mut bcs = vec![Dirichlet::fixed("axis", 0), Dirichlet::fixed("bottom", 1)];
-        if self.base == Base::Bonded {
+        if self.base == Support::Bonded {
             bcs.push(Dirichlet::fixed("bottom", 0));
         }
         // Penalties scale with the initial shear modulus, set per run.
@@ -339,20 +319,25 @@ impl Setup for N1Needle {
             options,
             1,
         )?;
-        System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 1)
+        let mut parts = Parts::new();
+        let handles = N1Parts {
+            body: parts.add(body),
+            contact: parts.add(contact),
+        };
+        Ok((System::from_parts(mesh, 2, parts, &bcs, 1)?, handles))
     }
     fn prepare(
         &self,
         sys: &mut System,
+        parts: &N1Parts,
         material: RegionMaterial,
         extra: &[f64],
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
         let h = self.effective_grading().h_fine;
         sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
-        sys.part_mut::<SolidBody>(0)?
-            .set_material("body", material)?;
-        let cs = sys.part_mut::<RigidContact>(1)?;
+        sys.get_mut(parts.body)?.set_material("body", material)?;
+        let cs = sys.get_mut(parts.contact)?;
         cs.options.penalty_normal = self.penalty * mu / h;
         cs.options.penalty_tangent = self.penalty * mu / h;
         cs.options.friction = if self.friction_is_parameter {
@@ -362,18 +347,16 @@ impl Setup for N1Needle {
         };
         Ok(())
     }
-    fn observe(&self, sys: &System) -> Vec<f64> {
-        vec![sys.contributions[1]
-            .tool_force([0.0, -1.0, 0.0])
+    fn observe(&self, sys: &System, parts: &N1Parts) -> Vec<f64> {
+        vec![sys
+            .get(parts.contact)
+            .and_then(|c| c.tool_force([0.0, -1.0, 0.0]))
             .unwrap_or(0.0)]
     }
-}
-
-impl ForwardModel for N1Needle {
     fn name(&self) -> String {
         let base = match self.base {
-            Base::Bonded => "",
-            Base::Sliding => ", sliding base",
+            Support::Bonded => "",
+            Support::Sliding => ", sliding base",
         };
         let mut name = format!(
             "N1 FE needle indentation, {}, friction {}{base}",
@@ -384,36 +367,12 @@ impl ForwardModel for N1Needle {
         }
         name
     }
-    fn space(&self) -> &ParamSpace {
-        &self.space
-    }
-    fn observable(&self) -> Observable {
-        Observable::ForceN
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(FeEvaluator {
-            setup: self,
-            space: &self.space,
-            outputs: self.outputs().len(),
-            system: None,
-        })
-    }
-    /// A nonlinear FE solve per prediction (seconds).
-    fn expensive(&self) -> bool {
-        true
-    }
-    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
-        Some(self)
-    }
-}
-
-impl Enrichable for N1Needle {
-    fn effects(&self) -> Vec<Effect> {
+    fn effects(&self) -> Option<Vec<Effect>> {
         let mut v = Vec::new();
         if !self.friction_is_parameter {
             v.push(Effect::Friction);
         }
-        if self.base == Base::Bonded {
+        if self.base == Support::Bonded {
             v.push(Effect::BoundaryCondition);
         }
         // (one enrichment at a time: the richer law of a model whose friction
@@ -425,29 +384,19 @@ impl Enrichable for N1Needle {
         if self.modelling_space_applies() {
             v.push(Effect::ModellingSpace);
         }
-        v
+        Some(v)
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
             Effect::Friction if !self.friction_is_parameter => {
                 let mut m = self.clone();
                 m.friction_is_parameter = true;
-                // plausible range: a lubricated to a dry needle in soft tissue
-                m.space = self.space.extended(&[ParamSpec::new(
-                    "friction",
-                    "1",
-                    0.0,
-                    2.0,
-                    self.friction,
-                )
-                .with_role(ParamRole::Friction)
-                .with_plausible(0.0, 0.8)]);
-                Ok(Box::new(m))
+                Ok(Box::new(FeModel::from_setup(m)))
             }
-            Effect::BoundaryCondition if self.base == Base::Bonded => {
+            Effect::BoundaryCondition if self.base == Support::Bonded => {
                 let mut m = self.clone();
-                m.base = Base::Sliding;
-                Ok(Box::new(m))
+                m.base = Support::Sliding;
+                Ok(Box::new(FeModel::from_setup(m)))
             }
             Effect::MaterialForm
                 if !self.friction_is_parameter && richer_law(&self.law).is_some() =>
@@ -456,30 +405,29 @@ impl Enrichable for N1Needle {
                 let mut inner = self.clone();
                 inner.law = richer.law;
                 let space = richer.space.clone();
-                inner.space = space.clone();
+                inner.law_bounds = Some(space.clone());
                 Ok(Box::new(MaterialForm::new(
-                    Box::new(inner),
+                    Box::new(FeModel::from_setup(inner)),
                     richer.embed_law_params.clone(),
                     self.law.to_string(),
                     space,
                 )))
             }
-            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(self.clone())))),
+            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(
+                FeModel::from_setup(self.clone()),
+            )))),
             Effect::ModellingSpace if self.modelling_space_applies() => Ok(Box::new(self.in_3d())),
-            _ => Err(ForwardError::InvalidConfig {
-                field: "effect".into(),
-                reason: format!("`{effect}` does not apply to {}", self.name()),
-            }),
+            _ => Err(not_applicable(effect, &self.name())),
         }
     }
 }
 
-impl N1Needle {
+impl N1Setup {
     /// Whether `modelling_space` is offered: the axisymmetric model with a
     /// bonded base, its friction fixed, elastic (N3 has neither a sliding
     /// base nor viscoelasticity).
     fn modelling_space_applies(&self) -> bool {
-        self.base == Base::Bonded && !self.friction_is_parameter && self.prony.is_none()
+        self.base == Support::Bonded && !self.friction_is_parameter && self.prony.is_none()
     }
 
     /// The `modelling_space` enrichment: the same needle, law, bulk

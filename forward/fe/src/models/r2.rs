@@ -31,18 +31,16 @@
 //!
 //! Parameters: the tissue law's, then the nodule law's (named `nodule_...`).
 //! The geometry (nodule positions and depths, RD) is part of the model, so
-//! a change of geometry is a new model ([`crate::r2::R2Rolling::with_nodules`]).
+//! a change of geometry is a new model ([`R2Rolling::with_nodules`]).
 
-use palpate_core::{
-    Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output, ParamSpace,
-    ParamSpec,
-};
+use palpate_core::{Drive, ForwardError, Loading, Observable, Output, ParamSpace, ParamSpec};
 use palpate_material::Law;
 use rayon::prelude::*;
 use std::sync::Arc;
 
 use crate::body::{RegionMaterial, SolidBody};
 use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::contribution::Contribution;
 use crate::discretisation::{Coarser, ConvergenceOrder};
 use crate::dofs::Dirichlet;
 use crate::kernel::{kernel_for, PressureSpace};
@@ -50,12 +48,12 @@ use crate::kinematics::Kinematics;
 use crate::line_search::LineSearch;
 use crate::material::LawMaterial;
 use crate::mesh::{CellType, InclusionBlock, Mesh};
-use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Path, Setup, Simulation};
+use crate::model::{law_space, Bulk, FeModel, Path, Setup, Support};
 use crate::motion::ToolMotion;
 use crate::predictor::FollowTool;
 use crate::stepper::{LoadPath, Progress};
 use crate::surface::Wheel2d;
-use crate::system::{SolverOptions, System};
+use crate::system::{Part, Parts, SolverOptions, System};
 use crate::FeError;
 
 /// A nodule: centre position along the block and depth of its centre below
@@ -119,13 +117,16 @@ pub fn r2_element_size(level: usize) -> f64 {
     2.0 / level.max(1) as f64
 }
 
-/// The R2 model.
+/// The R2 model: [`R2Setup`] as a forward model.
+pub type R2Rolling = FeModel<R2Setup>;
+
+/// The R2 experiment ([`R2Rolling`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct R2Rolling {
+pub struct R2Setup {
     /// The tissue (block) law; its parameters come first in `theta`.
-    pub law: Law,
+    law: Law,
     /// The nodules' law; its parameters follow the tissue's.
-    pub nodule_law: Law,
+    nodule_law: Law,
     pub bulk: Bulk,
     /// Rolling depth (mm) of the rolled pass.
     pub rd: f64,
@@ -144,7 +145,7 @@ pub struct R2Rolling {
     /// Bottom support: bonded (both components fixed, BENCHMARKS.md R2) or
     /// sliding (vertical component fixed, horizontal free except at the
     /// bottom node nearest mid-block, which removes the rigid translation).
-    pub base: crate::Base,
+    pub base: Support,
     /// Mesh level ([`r2_element_size`]).
     pub level: usize,
     /// When set, replaces the element size of `level` (mm).
@@ -172,7 +173,13 @@ pub struct R2Rolling {
     /// (docs/validation/fe.md, R2 friction).
     pub tangent_penalty: f64,
     pub options: SolverOptions,
-    space: ParamSpace,
+}
+
+/// The contributions of the R2 system.
+#[derive(Debug, Clone, Copy)]
+pub struct R2Parts {
+    body: Part<SolidBody>,
+    contact: Part<RigidContact>,
 }
 
 impl R2Rolling {
@@ -180,17 +187,7 @@ impl R2Rolling {
     /// are Arruda-Boyce for both): three nodules, RD `rd`, frictionless,
     /// exact incompressibility, mesh level 1.
     pub fn new(law: Law, nodule_law: Law, rd: f64) -> Self {
-        let nodule_specs: Vec<ParamSpec> = law_space(&nodule_law)
-            .params
-            .iter()
-            .map(|p| {
-                let mut q = p.clone();
-                q.name = format!("nodule_{}", p.name);
-                q
-            })
-            .collect();
-        R2Rolling {
-            space: law_space(&law).extended(&nodule_specs),
+        FeModel::from_setup(R2Setup {
             law,
             nodule_law,
             bulk: Bulk::Exact,
@@ -204,7 +201,7 @@ impl R2Rolling {
             press_x: 10.0,
             roll_to: 140.0,
             friction: 0.0,
-            base: crate::Base::Bonded,
+            base: Support::Bonded,
             level: 1,
             element_size: None,
             penalty: 1000.0,
@@ -221,8 +218,8 @@ impl R2Rolling {
                 // iteration (the supernodal LDL^T costs less than the chord
                 // steps it saves); `options()` goes back to the residual
                 // search, the 0.3 mm cap and chord steps with friction.
-                // Short pass x 52 -> 62 mm (docs/validation/fe.md, session
-                // 9): 276 -> 205 iterations, 18.7 -> 9.3 s wall.
+                // Short pass x 52 -> 62 mm (docs/validation/fe.md):
+                // 276 -> 205 iterations, 18.7 -> 9.3 s wall.
                 max_update: None,
                 line_search: LineSearch::Slope,
                 reuse_factorisation: false,
@@ -233,7 +230,7 @@ impl R2Rolling {
                 symmetric: true,
                 ..SolverOptions::default()
             },
-        }
+        })
     }
 
     /// BENCHMARKS.md's materials: `rtv6166-ab` (mu 4.98 kPa, lambda_m 1.05)
@@ -243,12 +240,21 @@ impl R2Rolling {
 
     /// The same model with other nodules.
     pub fn with_nodules(&self, nodules: Vec<Nodule>) -> Self {
-        R2Rolling {
-            nodules,
-            ..self.clone()
-        }
+        let mut m = self.clone();
+        m.nodules = nodules;
+        m
     }
 
+    /// The coarser companion of the error estimate: elements twice as large.
+    pub fn coarser(&self) -> Coarser<R2Rolling> {
+        let h = 2.0 * self.h();
+        self.companion(2.0, format!("{h} mm elements"), |s| {
+            s.element_size = Some(h)
+        })
+    }
+}
+
+impl R2Setup {
     /// The element size in use (mm).
     pub fn h(&self) -> f64 {
         self.element_size
@@ -287,17 +293,6 @@ impl R2Rolling {
             .collect()
     }
 
-    /// The coarser companion of the error estimate: elements twice as large.
-    pub fn coarser(&self) -> Coarser<R2Rolling> {
-        let mut model = self.clone();
-        model.element_size = Some(2.0 * self.h());
-        Coarser {
-            model,
-            ratio: 2.0,
-            mesh: format!("{} mm elements", 2.0 * self.h()),
-        }
-    }
-
     /// The order of convergence of the force with the element size
     /// (docs/validation/fe.md, R2).
     pub fn convergence_order(&self) -> ConvergenceOrder {
@@ -306,26 +301,15 @@ impl R2Rolling {
             source: "docs/validation/fe.md R2 (h = 4, 2, 1 mm presses at RD 3: 0.93-8 by position, the smallest taken)".into(),
         }
     }
+}
 
-    /// Runs one history with a progress observer; returns the system too
-    /// (fields for VTK output).
-    pub fn simulate(
-        &self,
-        theta: &[f64],
-        loading: &Loading,
-        progress: Option<&mut dyn FnMut(&Progress)>,
-    ) -> Result<(Simulation, System), ForwardError> {
-        let mut sys = self.build().map_err(to_forward)?;
-        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
-        Ok((sim, sys))
-    }
-
+impl R2Rolling {
     /// The rolled pass through `positions` (increasing, within
     /// `press_x..=roll_to`), split into up to `segments` contiguous pieces
     /// solved in parallel (rayon tasks: safe to call from a rayon worker),
     /// each pressed to `rd` at its first
     /// position and rolled from there. Exact for a frictionless wheel with
-    /// [`R2Rolling::pure_penalty`] contact, whose state is a function of the
+    /// [`R2Setup::pure_penalty`] contact, whose state is a function of the
     /// wheel position alone (the press at x equals the rolled state at x,
     /// tests/integration/r2_rolling.rs); with friction (path-dependent) or augmented
     /// contact one segment is used whatever `segments` says.
@@ -412,6 +396,18 @@ impl R2Rolling {
             }
         }
         Ok((out, last))
+    }
+}
+
+impl R2Setup {
+    /// The nodules' law.
+    pub fn nodule_law(&self) -> &Law {
+        &self.nodule_law
+    }
+
+    /// Replaces the nodules' law (the parameter space follows).
+    pub fn set_nodule_law(&mut self, law: Law) {
+        self.nodule_law = law;
     }
 
     /// The weight of the wheel-following prediction per node
@@ -522,15 +518,32 @@ pub fn check_model(m: &R2Rolling) -> Result<(), (String, String)> {
 }
 
 /// Distance from a nodule's circle (mm) over which the wheel-following
-/// prediction fades in ([`R2Rolling::follow_weights`]).
+/// prediction fades in ([`R2Setup::follow_weights`]).
 const FOLLOW_FADE: f64 = 5.0;
 
 /// The order stated for the R2 force (docs/validation/fe.md, R2).
 const R2_ORDER: f64 = 1.0;
 
-impl Setup for R2Rolling {
+impl Setup for R2Setup {
+    type Parts = R2Parts;
     fn law(&self) -> &Law {
         &self.law
+    }
+    fn set_law(&mut self, law: Law) {
+        self.law = law;
+    }
+    /// The tissue law's parameters, then the nodule law's (`nodule_...`).
+    fn param_space(&self) -> ParamSpace {
+        let nodule: Vec<ParamSpec> = law_space(&self.nodule_law)
+            .params
+            .iter()
+            .map(|p| {
+                let mut q = p.clone();
+                q.name = format!("nodule_{}", p.name);
+                q
+            })
+            .collect();
+        law_space(&self.law).extended(&nodule)
     }
     fn bulk(&self) -> Bulk {
         self.bulk
@@ -542,7 +555,7 @@ impl Setup for R2Rolling {
         // Coulomb friction makes the contact tangent unsymmetric and the
         // problem non-potential: LU, the residual search, a capped update
         // and chord steps (the settings the frictional passes were
-        // measured with, session 7)
+        // measured with)
         SolverOptions {
             symmetric: false,
             line_search: LineSearch::Residual,
@@ -551,7 +564,7 @@ impl Setup for R2Rolling {
             ..self.options
         }
     }
-    fn build(&self) -> Result<System, FeError> {
+    fn build(&self) -> Result<(System, R2Parts), FeError> {
         self.check()?;
         let mut mesh = self.build_mesh()?;
         let kin = Kinematics::PlaneStress {
@@ -569,10 +582,10 @@ impl Setup for R2Rolling {
             false,
         )?;
         let bcs = match self.base {
-            crate::Base::Bonded => {
+            Support::Bonded => {
                 vec![Dirichlet::fixed("bottom", 0), Dirichlet::fixed("bottom", 1)]
             }
-            crate::Base::Sliding => {
+            Support::Sliding => {
                 let mid = self.length / 2.0;
                 let anchor = mesh
                     .node_sets
@@ -624,24 +637,30 @@ impl Setup for R2Rolling {
         )?;
         contact.pure_penalty = self.pure_penalty;
         contact.smoothing = self.contact_smoothing;
-        let mut sys = System::new(mesh, 2, vec![Box::new(body), Box::new(contact)], &bcs, 2)?;
+        let mut parts = Parts::new();
+        let handles = R2Parts {
+            body: parts.add(body),
+            contact: parts.add(contact),
+        };
+        let mut sys = System::from_parts(mesh, 2, parts, &bcs, 2)?;
         if let Some(order) = self.predictor {
             let mut p = FollowTool::new(1, [1.0, 0.0, 0.0], order);
             p.weights = Some(self.follow_weights(&sys.mesh));
             sys.predictor = Some(Box::new(p));
         }
-        Ok(sys)
+        Ok((sys, handles))
     }
     fn prepare(
         &self,
         sys: &mut System,
+        parts: &R2Parts,
         material: RegionMaterial,
         extra: &[f64],
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
         let h = self.h();
         sys.force_floor = 1e-6 * mu * self.thickness * h;
-        let body = sys.part_mut::<SolidBody>(0)?;
+        let body = sys.get_mut(parts.body)?;
         body.set_material("tissue", material)?;
         if !self.nodules.is_empty() {
             let n = self.nodule_law.params().len();
@@ -659,7 +678,7 @@ impl Setup for R2Rolling {
                 },
             )?;
         }
-        let cs = sys.part_mut::<RigidContact>(1)?;
+        let cs = sys.get_mut(parts.contact)?;
         cs.options.penalty_normal = self.penalty * mu / h;
         cs.options.penalty_tangent = self.tangent_penalty * self.penalty * mu / h;
         cs.options.friction = self.friction;
@@ -697,16 +716,14 @@ impl Setup for R2Rolling {
             ))),
         }
     }
-    fn observe(&self, sys: &System) -> Vec<f64> {
-        let c = &sys.contributions[1];
-        vec![
-            c.tool_force([0.0, -1.0, 0.0]).unwrap_or(0.0),
-            c.tool_force([1.0, 0.0, 0.0]).unwrap_or(0.0),
-        ]
+    fn observe(&self, sys: &System, parts: &R2Parts) -> Vec<f64> {
+        let force = |axis| {
+            sys.get(parts.contact)
+                .and_then(|c| c.tool_force(axis))
+                .unwrap_or(0.0)
+        };
+        vec![force([0.0, -1.0, 0.0]), force([1.0, 0.0, 0.0])]
     }
-}
-
-impl ForwardModel for R2Rolling {
     fn name(&self) -> String {
         let nodules: Vec<String> = self
             .nodules
@@ -714,8 +731,8 @@ impl ForwardModel for R2Rolling {
             .map(|n| format!("{}:{}", n.x, n.depth))
             .collect();
         let base = match self.base {
-            crate::Base::Bonded => "",
-            crate::Base::Sliding => ", sliding base",
+            Support::Bonded => "",
+            Support::Sliding => ", sliding base",
         };
         format!(
             "R2 FE rolling indentation (plane stress), RD {} mm, nodules {}, {} / {}, friction {}{base}",
@@ -730,28 +747,10 @@ impl ForwardModel for R2Rolling {
             self.friction
         )
     }
-    fn space(&self) -> &ParamSpace {
-        &self.space
-    }
-    fn observable(&self) -> Observable {
-        Observable::ForceN
-    }
     fn outputs(&self) -> Vec<Output> {
         vec![
             Output::new("force_N", Observable::ForceN),
             Output::new("force_x_N", Observable::ForceN),
         ]
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(FeEvaluator {
-            setup: self,
-            space: &self.space,
-            outputs: self.outputs().len(),
-            system: None,
-        })
-    }
-    /// A nonlinear FE solve per prediction (seconds).
-    fn expensive(&self) -> bool {
-        true
     }
 }

@@ -2,7 +2,7 @@
 //! (BENCHMARKS.md Q1), axisymmetric stand-in — a cylinder of radius 50 mm and
 //! height 60 mm, bottom fixed, a rigid flat-ended cylindrical punch of radius
 //! 2 mm pressed on the axis without friction. The punch edge is rounded with
-//! 0.2 mm ([`Q1Punch::edge_radius`]; `ToolShape::FlatPunch` needs
+//! 0.2 mm ([`Q1Setup::edge_radius`]; `ToolShape::FlatPunch` needs
 //! `0 < edge_radius < radius`, and a sharp corner would put the contact
 //! boundary on a kink of the tool). The force is the punch reaction for the
 //! whole body, positive in compression.
@@ -14,27 +14,27 @@
 //!
 //! The mesh is graded from the axis and from the top: uniformly fine
 //! (`0.2 / level` mm) in a 3 x 3 mm zone that holds the punch edge, growing
-//! by `1 + 0.2 / level` beyond ([`Q1Punch::grading`]).
+//! by `1 + 0.2 / level` beyond ([`Q1Setup::grading`]).
 
-use palpate_core::{
-    Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole, ParamSpace, ParamSpec,
-};
+pub mod viscous;
+
+use palpate_core::{Effect, ForwardError, ForwardModel, ParamSpace};
+use palpate_enrich::prony_params;
 use palpate_material::Law;
 
 use crate::body::{RegionMaterial, SolidBody};
 use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::contribution::Contribution;
 use crate::discretisation::{Coarser, ConvergenceOrder};
 use crate::dofs::Dirichlet;
-use crate::kernel::{kernel_for, PressureSpace};
+use crate::kernel::kernel_for;
 use crate::kinematics::Kinematics;
-use crate::mesh::{CellType, Grading, Mesh};
-use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
+use crate::mesh::{Grading, Mesh};
+use crate::model::{doubled, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup};
 use crate::motion::ToolMotion;
-use crate::n1::N1Element;
 use crate::self_contact::SelfContact;
-use crate::stepper::Progress;
 use crate::surface::Profile2d;
-use crate::system::{SolverOptions, System};
+use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
 use crate::FeError;
@@ -44,10 +44,13 @@ use crate::FeError;
 /// 8Gad 0.943 at 0.1 mm; docs/validation/fe.md "Q1").
 pub const DEFAULT_EDGE_RADIUS: f64 = 0.2;
 
-/// The Q1 model.
+/// The Q1 model: [`Q1Setup`] as a forward model.
+pub type Q1Punch = FeModel<Q1Setup>;
+
+/// The Q1 experiment ([`Q1Punch`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct Q1Punch {
-    pub law: Law,
+pub struct Q1Setup {
+    law: Law,
     pub bulk: Bulk,
     /// Punch radius and the radius of its rounded edge (mm).
     pub punch_radius: f64,
@@ -65,7 +68,7 @@ pub struct Q1Punch {
     pub grading: Option<Grading>,
     /// 4-node Q1/P0 (default) or 9-node Q2/P1 on the same grading made
     /// quadratic.
-    pub element: N1Element,
+    pub element: PlaneCell,
     /// Contact penalty factor: `eps_N = penalty * mu0 / h_fine` (default
     /// 400: a pure penalty with the split quadrature, whose force at 0.1 mm
     /// is within 0.15 % of the stiff-penalty limit, 0.5 % at 100; augmented
@@ -99,13 +102,24 @@ pub struct Q1Punch {
     /// the surface edges, so that the contact force has no kinks where the
     /// face meets the rounding (with fixed Gauss points,
     /// [`ContactPoints::EdgeGauss`], Newton stalled near 2 mm;
-    /// docs/validation/fe.md "Q1", session 16). Q2/P1 cells (curved
-    /// edges) use the fixed Gauss points.
+    /// docs/validation/fe.md "Q1"). Q2/P1 cells (curved edges) use the
+    /// fixed Gauss points.
     pub contact_points: ContactPoints,
+    /// The punch contact by a pure penalty ([`RigidContact::pure_penalty`])
+    /// at the fixed Gauss points too (default `false`: augmented there; the
+    /// split quadrature is a pure penalty either way).
+    pub pure_penalty: bool,
     pub options: SolverOptions,
-    space: ParamSpace,
     /// Number of Prony terms taken from the parameters (0: `prony` fixed).
     prony_parameters: usize,
+}
+
+/// The contributions of the Q1 system.
+#[derive(Debug, Clone, Copy)]
+pub struct Q1Parts {
+    body: Part<SolidBody>,
+    contact: Part<RigidContact>,
+    self_contact: Option<Part<SelfContact>>,
 }
 
 impl Q1Punch {
@@ -113,8 +127,7 @@ impl Q1Punch {
     /// cylinder 50 x 60 mm, exact incompressibility, mesh level 2 (0.1 mm
     /// elements under the punch), Q1/P0, elastic.
     pub fn new(law: Law) -> Self {
-        Q1Punch {
-            space: law_space(&law),
+        FeModel::from_setup(Q1Setup {
             law,
             bulk: Bulk::Exact,
             punch_radius: 2.0,
@@ -124,7 +137,7 @@ impl Q1Punch {
             level: 2,
             fine_zone: 3.0,
             grading: None,
-            element: N1Element::Quad4,
+            element: PlaneCell::Quad4,
             penalty: 400.0,
             prony: None,
             self_contact: false,
@@ -132,6 +145,7 @@ impl Q1Punch {
             contact_points: ContactPoints::EdgeSplit,
             edge_refinement: 1,
             edge_band: 0.6,
+            pure_penalty: false,
             options: SolverOptions {
                 max_step: 0.1,
                 first_step: 0.02,
@@ -139,19 +153,18 @@ impl Q1Punch {
                 // Newton stagnates where a contact point sits on the
                 // junction of the punch's face and rounding: the normal,
                 // hence the contact force, has a kink there (the curvature
-                // jumps from 0 to 1/rho; docs/validation/fe.md "Q1", session
-                // 14). 5e-4 of the force scale accepts more such increments
+                // jumps from 0 to 1/rho; docs/validation/fe.md "Q1"). 5e-4 of the force scale accepts more such increments
                 // (counted as loose) than the default 1e-4: the surrogate
                 // build's ramp to 0.8 mm, which stopped at 0.767 mm, runs
                 // through. The stop near 2 mm does not move (1.975 -> 1.977).
                 stagnation_tolerance: 5e-4,
                 // a surface edge draped over the rounding snaps round it
-                // (docs/validation/fe.md "Q1", session 16)
+                // (docs/validation/fe.md "Q1")
                 stabilisation: 0.1,
                 ..SolverOptions::default()
             },
             prony_parameters: 0,
-        }
+        })
     }
 
     /// Sets the radius of the punch's rounded edge (mm), or says why `rho`
@@ -182,24 +195,6 @@ impl Q1Punch {
     /// shortest relaxation time, moves with the parameters and would make
     /// the time discretisation, hence the objective, jump with them).
     pub fn with_prony_parameters(mut self, terms: usize) -> Self {
-        let mut own = Vec::with_capacity(2 * terms);
-        for i in 1..=terms {
-            own.push(
-                ParamSpec::new(format!("g{i}"), "1", 0.0, 1.0, 0.1)
-                    .with_role(ParamRole::RelaxationWeight { term: i }),
-            );
-            own.push(
-                ParamSpec::new(
-                    format!("tau{i}_s"),
-                    "s",
-                    0.0,
-                    f64::INFINITY,
-                    10f64.powi(i as i32 - 1),
-                )
-                .with_role(ParamRole::TimeConstant { term: i }),
-            );
-        }
-        self.space = law_space(&self.law).extended(&own);
         self.prony_parameters = terms;
         if terms > 0 {
             self.prony = None;
@@ -207,6 +202,17 @@ impl Q1Punch {
         self
     }
 
+    /// The coarser companion of the discretisation error estimate: the same
+    /// family with the fine size and `growth - 1` doubled (level L -> L/2).
+    pub fn coarser(&self) -> Coarser<Q1Punch> {
+        let coarse = doubled(self.effective_grading());
+        self.companion(2.0, graded_mesh_words(coarse, "punch"), |s| {
+            s.grading = Some(coarse)
+        })
+    }
+}
+
+impl Q1Setup {
     /// Number of Prony terms taken from the parameters.
     pub fn prony_parameters(&self) -> usize {
         self.prony_parameters
@@ -275,30 +281,8 @@ impl Q1Punch {
             m = Mesh::tensor(&rs, &zs);
         }
         match self.element {
-            N1Element::Quad4 => Ok(m),
-            N1Element::Quad9 => m.to_quadratic(),
-        }
-    }
-
-    /// The coarser companion of the discretisation error estimate: the same
-    /// family with the fine size and `growth - 1` doubled (level L -> L/2).
-    pub fn coarser(&self) -> Coarser<Q1Punch> {
-        let g = self.effective_grading();
-        let coarse = Grading {
-            h_fine: 2.0 * g.h_fine,
-            fine_length: g.fine_length,
-            growth: 1.0 + 2.0 * (g.growth - 1.0),
-        };
-        let mut model = self.clone();
-        model.grading = Some(coarse);
-        Coarser {
-            model,
-            ratio: 2.0,
-            mesh: format!(
-                "{} mm elements under the punch, growth {}",
-                (coarse.h_fine * 1e6).round() / 1e6,
-                (coarse.growth * 1e6).round() / 1e6
-            ),
+            PlaneCell::Quad4 => Ok(m),
+            PlaneCell::Quad9 => m.to_quadratic(),
         }
     }
 
@@ -311,27 +295,15 @@ impl Q1Punch {
     /// extrapolation of the finest meshes (1.06 %).
     pub fn convergence_order(&self) -> ConvergenceOrder {
         match self.element {
-            N1Element::Quad4 => ConvergenceOrder {
+            PlaneCell::Quad4 => ConvergenceOrder {
                 order: Q1_ORDER_QUAD4,
                 source: "docs/validation/fe.md Q1 (Q1/P0, edge 0.2 mm, at 0.1 mm)".into(),
             },
-            N1Element::Quad9 => ConvergenceOrder {
+            PlaneCell::Quad9 => ConvergenceOrder {
                 order: Q1_ORDER_QUAD4,
                 source: "docs/validation/fe.md Q1, measured for Q1/P0 (not for Q2/P1)".into(),
             },
         }
-    }
-
-    /// Runs one history with a progress observer; returns the system too.
-    pub fn simulate(
-        &self,
-        theta: &[f64],
-        loading: &Loading,
-        progress: Option<&mut dyn FnMut(&Progress)>,
-    ) -> Result<(Simulation, System), ForwardError> {
-        let mut sys = self.build().map_err(to_forward)?;
-        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
-        Ok((sim, sys))
     }
 
     fn check(&self) -> Result<(), FeError> {
@@ -362,12 +334,19 @@ impl Q1Punch {
     }
 }
 
-/// The order stated for Q1/P0 ([`Q1Punch::convergence_order`]).
+/// The order stated for Q1/P0 ([`Q1Setup::convergence_order`]).
 const Q1_ORDER_QUAD4: f64 = 0.5;
 
-impl Setup for Q1Punch {
+impl Setup for Q1Setup {
+    type Parts = Q1Parts;
     fn law(&self) -> &Law {
         &self.law
+    }
+    fn set_law(&mut self, law: Law) {
+        self.law = law;
+    }
+    fn param_space(&self) -> ParamSpace {
+        law_space(&self.law).extended(&prony_params(self.prony_parameters))
     }
     fn bulk(&self) -> Bulk {
         self.bulk
@@ -389,7 +368,7 @@ impl Setup for Q1Punch {
             .collect();
         Prony::new(terms).map(Some)
     }
-    fn build(&self) -> Result<System, FeError> {
+    fn build(&self) -> Result<(System, Q1Parts), FeError> {
         self.check()?;
         let mesh = self.build_mesh()?;
         let kin = Kinematics::Axisymmetric;
@@ -397,9 +376,9 @@ impl Setup for Q1Punch {
             "body",
             &mesh,
             &["body"],
-            match self.element {
-                N1Element::Quad4 => kernel_for(CellType::Quad4, kin, PressureSpace::P0)?,
-                N1Element::Quad9 => kernel_for(CellType::Quad9, kin, PressureSpace::P1)?,
+            {
+                let (cell, pressure) = self.element.element();
+                kernel_for(cell, kin, pressure)?
             },
             self.bulk.exact(),
         )?;
@@ -416,7 +395,7 @@ impl Setup for Q1Punch {
             // the split quadrature is for straight (2-node) edges: Q2/P1
             // cells keep the fixed Gauss points
             points: match (self.element, self.contact_points) {
-                (N1Element::Quad9, ContactPoints::EdgeSplit) => ContactPoints::EdgeGauss,
+                (PlaneCell::Quad9, ContactPoints::EdgeSplit) => ContactPoints::EdgeGauss,
                 (_, p) => p,
             },
         };
@@ -432,14 +411,18 @@ impl Setup for Q1Punch {
             options,
             1,
         )?;
-        let mut parts: Vec<Box<dyn crate::contribution::Contribution>> =
-            vec![Box::new(body), Box::new(contact)];
+        let mut parts = Parts::new();
+        let mut handles = Q1Parts {
+            body: parts.add(body),
+            contact: parts.add(contact),
+            self_contact: None,
+        };
         if self.self_contact {
             // the top surface from half the punch radius to 2 mm beyond its
             // edge, pairs within 1 mm (reference) of each other
             let (lo, hi) = (0.5 * self.punch_radius, self.punch_radius + 2.0);
             let top = self.height;
-            parts.push(Box::new(SelfContact::new(
+            handles.self_contact = Some(parts.add(SelfContact::new(
                 "top",
                 &mesh,
                 "top",
@@ -448,48 +431,40 @@ impl Setup for Q1Punch {
                 1.0,
             )?));
         }
-        System::new(mesh, 2, parts, &bcs, 1)
+        Ok((System::from_parts(mesh, 2, parts, &bcs, 1)?, handles))
     }
     fn prepare(
         &self,
         sys: &mut System,
+        parts: &Q1Parts,
         material: RegionMaterial,
         _extra: &[f64],
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
         let h = self.effective_grading().h_fine;
         sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
-        sys.part_mut::<SolidBody>(0)?
-            .set_material("body", material)?;
-        let cs = sys.part_mut::<RigidContact>(1)?;
+        sys.get_mut(parts.body)?.set_material("body", material)?;
+        let cs = sys.get_mut(parts.contact)?;
         cs.options.penalty_normal = self.penalty * mu / h;
         cs.options.penalty_tangent = self.penalty * mu / h;
         cs.options.friction = 0.0;
         cs.smoothing = self.contact_smoothing * h;
-        if std::env::var("XPURE").as_deref() == Ok("1") {
+        if self.pure_penalty {
             cs.pure_penalty = true;
         }
-        if let Some(f) = std::env::var("XPEN")
-            .ok()
-            .and_then(|v| v.parse::<f64>().ok())
-        {
-            cs.options.penalty_normal *= f;
-        }
-        if self.self_contact {
-            let sc = sys.part_mut::<SelfContact>(2)?;
+        if let Some(part) = parts.self_contact {
+            let sc = sys.get_mut(part)?;
             sc.penalty = self.penalty * mu / h;
             sc.depth = h;
         }
         Ok(())
     }
-    fn observe(&self, sys: &System) -> Vec<f64> {
-        vec![sys.contributions[1]
-            .tool_force([0.0, -1.0, 0.0])
+    fn observe(&self, sys: &System, parts: &Q1Parts) -> Vec<f64> {
+        vec![sys
+            .get(parts.contact)
+            .and_then(|c| c.tool_force([0.0, -1.0, 0.0]))
             .unwrap_or(0.0)]
     }
-}
-
-impl ForwardModel for Q1Punch {
     fn name(&self) -> String {
         let mut name = format!(
             "Q1 FE flat punch (radius {} mm, edge {} mm), {}",
@@ -501,47 +476,26 @@ impl ForwardModel for Q1Punch {
         if self.prony_parameters > 0 {
             name += &format!(", {} Prony terms as parameters", self.prony_parameters);
         }
+        if self.pure_penalty {
+            name += ", pure-penalty contact";
+        }
         name
     }
-    fn space(&self) -> &ParamSpace {
-        &self.space
-    }
-    fn observable(&self) -> Observable {
-        Observable::ForceN
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(FeEvaluator {
-            setup: self,
-            space: &self.space,
-            outputs: self.outputs().len(),
-            system: None,
-        })
-    }
-    /// A nonlinear FE solve per prediction.
-    fn expensive(&self) -> bool {
-        true
-    }
-    fn as_enrichable(&self) -> Option<&dyn palpate_core::Enrichable> {
-        Some(self)
-    }
-}
-
-/// Effects of the elastic Q1 model: `viscoelasticity` (a one-term Prony
-/// series with its weight and time constant as parameters,
-/// [`crate::q1_viscous::Q1Viscous`]).
-impl palpate_core::Enrichable for Q1Punch {
-    fn effects(&self) -> Vec<palpate_core::Effect> {
-        if self.prony.is_none() {
-            vec![palpate_core::Effect::Viscoelasticity]
+    /// The effect of the elastic Q1 model: `viscoelasticity` (a one-term
+    /// Prony series with its weight and time constant as parameters,
+    /// [`viscous::Q1Viscous`]).
+    fn effects(&self) -> Option<Vec<Effect>> {
+        Some(if self.prony.is_none() {
+            vec![Effect::Viscoelasticity]
         } else {
             Vec::new()
-        }
+        })
     }
-    fn enrich(&self, effect: palpate_core::Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
+    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
-            palpate_core::Effect::Viscoelasticity if self.prony.is_none() => {
-                Ok(Box::new(crate::q1_viscous::Q1Viscous::new(self.clone())))
-            }
+            Effect::Viscoelasticity if self.prony.is_none() => Ok(Box::new(
+                viscous::Q1Viscous::new(FeModel::from_setup(self.clone())),
+            )),
             _ => Err(ForwardError::InvalidConfig {
                 field: "effect".into(),
                 reason: format!("`{effect}` does not apply to {}", self.name()),

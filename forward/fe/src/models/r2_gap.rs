@@ -1,6 +1,6 @@
 //! `R2Gap`: the R2 rolling model ([`R2Rolling`]) as a base model of the
 //! sim-to-real gap diagnosis (GAP.md), with the effects `inclusion`,
-//! `friction` and `boundary_condition` (issue 14, item 5).
+//! `friction` and `boundary_condition`.
 //!
 //! The observable is the vertical wheel force of the rolled pass
 //! (`Drive::PositionMm`: the wheel pressed to RD at the first position,
@@ -36,7 +36,7 @@
 //!   so the prediction is always the rolled pass (never presses at the
 //!   positions).
 //! * `boundary_condition` (offered when the base is bonded): the bottom
-//!   sliding instead of bonded ([`crate::Base::Sliding`]), a discrete
+//!   sliding instead of bonded ([`Support::Sliding`]), a discrete
 //!   switch with no parameter.
 
 use palpate_core::{
@@ -44,9 +44,8 @@ use palpate_core::{
     ParamSpace, ParamSpec,
 };
 
-use crate::model::law_space;
+use crate::model::{friction_param, law_space, Support};
 use crate::r2::{Nodule, R2Rolling};
-use crate::Base;
 
 /// Clearance (mm) between an added nodule and the top or bottom face,
 /// beyond its radius: the mesh generator's minimum (1 mm) plus a margin for
@@ -75,9 +74,10 @@ impl R2Gap {
     /// the tissue's (contrast is unused without nodules).
     pub fn new(rolling: R2Rolling, contrast: f64) -> Self {
         let mut rolling = rolling;
-        rolling.nodule_law = rolling.law;
+        let law = *rolling.law();
+        rolling.set_nodule_law(law);
         R2Gap {
-            space: law_space(&rolling.law),
+            space: law_space(&law),
             rolling,
             contrast,
             friction_is_parameter: false,
@@ -87,7 +87,7 @@ impl R2Gap {
 
     /// Number of tissue parameters.
     fn p_law(&self) -> usize {
-        self.rolling.law.params().len()
+        self.rolling.law().params().len()
     }
 
     /// Bounds of an added nodule's depth (mm).
@@ -115,7 +115,7 @@ impl R2Gap {
                 depth: theta[k + 2],
             });
         }
-        let specs = law_space(&m.law);
+        let specs = law_space(m.law());
         let nodule: Vec<f64> = theta[..p]
             .iter()
             .zip(&specs.params)
@@ -185,7 +185,7 @@ impl ForwardModel for R2Gap {
 impl Enrichable for R2Gap {
     /// One enrichment at a time: an enriched model offers none.
     fn effects(&self) -> Vec<Effect> {
-        if self.friction_is_parameter || self.inclusion || self.rolling.base != Base::Bonded {
+        if self.friction_is_parameter || self.inclusion || self.rolling.base != Support::Bonded {
             return Vec::new();
         }
         let mut v = Vec::new();
@@ -224,18 +224,11 @@ impl R2Gap {
             }
             Effect::Friction => {
                 m.friction_is_parameter = true;
-                // plausible range: a lubricated to a dry wheel on silicone
-                m.space = self.space.extended(&[ParamSpec::new(
-                    "friction",
-                    "1",
-                    0.0,
-                    2.0,
-                    self.rolling.friction,
-                )
-                .with_role(ParamRole::Friction)
-                .with_plausible(0.0, 0.8)]);
+                m.space = self
+                    .space
+                    .extended(&[friction_param(self.rolling.friction)]);
             }
-            _ => m.rolling.base = Base::Sliding,
+            _ => m.rolling.base = Support::Sliding,
         }
         Ok(m)
     }

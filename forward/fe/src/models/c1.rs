@@ -7,7 +7,7 @@
 //! and `u_z = 0` at the bottom, plus `u_r = 0` on both when bonded. The force
 //! is the top platen reaction for the whole cylinder, positive in compression.
 
-use palpate_core::{Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace};
+use palpate_core::ParamSpace;
 use palpate_material::Law;
 
 use crate::body::{RegionMaterial, SolidBody};
@@ -16,9 +16,8 @@ use crate::dofs::Dirichlet;
 use crate::kernel::{kernel_for, PressureSpace};
 use crate::kinematics::Kinematics;
 use crate::mesh::{CellType, Grading, Mesh};
-use crate::model::{law_space, simulate, Bulk, FeEvaluator, Setup, Simulation};
-use crate::stepper::Progress;
-use crate::system::{SolverOptions, System};
+use crate::model::{law_space, Bulk, FeModel, Setup};
+use crate::system::{Part, Parts, SolverOptions, System};
 use crate::viscoelastic::Prony;
 use crate::FeError;
 
@@ -30,10 +29,13 @@ pub enum Platens {
     Bonded,
 }
 
-/// The C1 model.
+/// The C1 model: [`C1Setup`] as a forward model.
+pub type C1Fe = FeModel<C1Setup>;
+
+/// The C1 experiment ([`C1Fe`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct C1Fe {
-    pub law: Law,
+pub struct C1Setup {
+    law: Law,
     pub bulk: Bulk,
     pub platens: Platens,
     /// Cylinder diameter and height (mm).
@@ -48,14 +50,19 @@ pub struct C1Fe {
     /// `options.max_time_step` (a tenth of the shortest relaxation time
     /// when unset).
     pub prony: Option<Prony>,
-    space: ParamSpace,
+}
+
+/// The contributions of the C1 system: the body (the platens are
+/// displacement conditions).
+#[derive(Debug, Clone, Copy)]
+pub struct C1Parts {
+    body: Part<SolidBody>,
 }
 
 impl C1Fe {
     /// BENCHMARKS.md C1 geometry, 19 x 9 elements, exact incompressibility.
     pub fn new(law: Law, platens: Platens) -> Self {
-        C1Fe {
-            space: law_space(&law),
+        FeModel::from_setup(C1Setup {
             law,
             bulk: Bulk::Exact,
             platens,
@@ -68,7 +75,7 @@ impl C1Fe {
                 ..SolverOptions::default()
             },
             prony: None,
-        }
+        })
     }
 
     /// The coarser companion of the discretisation error estimate: half the
@@ -85,15 +92,15 @@ impl C1Fe {
             });
         }
         let ratio = ((nr * nz) as f64 / (coarse.0 * coarse.1) as f64).sqrt();
-        let mut model = self.clone();
-        model.elements = coarse;
-        Ok(Coarser {
-            model,
-            ratio,
-            mesh: format!("{}x{}", coarse.0, coarse.1),
-        })
+        Ok(
+            self.companion(ratio, format!("{}x{}", coarse.0, coarse.1), |s| {
+                s.elements = coarse
+            }),
+        )
     }
+}
 
+impl C1Setup {
     /// The order of convergence of the force with the element size.
     /// Bonded: 0.58, observed near the bonded edge on meshes 2 / 4 / 8
     /// (38 x 18, 76 x 36, 152 x 72), reduced polynomial N = 2, at 2 mm:
@@ -114,23 +121,18 @@ impl C1Fe {
             },
         }
     }
-
-    /// Runs one history with a progress observer; keeps the system for the caller.
-    pub fn simulate(
-        &self,
-        theta: &[f64],
-        loading: &Loading,
-        progress: Option<&mut dyn FnMut(&Progress)>,
-    ) -> Result<(Simulation, System), ForwardError> {
-        let mut sys = self.build().map_err(crate::model::to_forward)?;
-        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
-        Ok((sim, sys))
-    }
 }
 
-impl Setup for C1Fe {
+impl Setup for C1Setup {
+    type Parts = C1Parts;
     fn law(&self) -> &Law {
         &self.law
+    }
+    fn set_law(&mut self, law: Law) {
+        self.law = law;
+    }
+    fn param_space(&self) -> ParamSpace {
+        law_space(&self.law)
     }
     fn bulk(&self) -> Bulk {
         self.bulk
@@ -141,7 +143,7 @@ impl Setup for C1Fe {
     fn prony(&self) -> Option<&Prony> {
         self.prony.as_ref()
     }
-    fn build(&self) -> Result<System, FeError> {
+    fn build(&self) -> Result<(System, C1Parts), FeError> {
         let r = 0.5 * self.diameter;
         let (nr, nz) = self.elements;
         if nr == 0 || nz == 0 {
@@ -171,24 +173,26 @@ impl Setup for C1Fe {
         if self.platens == Platens::Bonded {
             bcs.push(Dirichlet::fixed("top", 0));
         }
-        System::new(mesh, 2, vec![Box::new(body)], &bcs, 1)
+        let mut parts = Parts::new();
+        let handles = C1Parts {
+            body: parts.add(body),
+        };
+        Ok((System::from_parts(mesh, 2, parts, &bcs, 1)?, handles))
     }
     fn prepare(
         &self,
         sys: &mut System,
+        parts: &C1Parts,
         material: RegionMaterial,
         _extra: &[f64],
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
         sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
-        sys.part_mut::<SolidBody>(0)?.set_material("body", material)
+        sys.get_mut(parts.body)?.set_material("body", material)
     }
-    fn observe(&self, sys: &System) -> Vec<f64> {
+    fn observe(&self, sys: &System, _parts: &C1Parts) -> Vec<f64> {
         vec![sys.channel_reaction(0)]
     }
-}
-
-impl ForwardModel for C1Fe {
     fn name(&self) -> String {
         let mut name = format!(
             "C1 FE compression ({:?} platens), {}",
@@ -199,23 +203,5 @@ impl ForwardModel for C1Fe {
             name += &format!(", Prony {p}");
         }
         name
-    }
-    fn space(&self) -> &ParamSpace {
-        &self.space
-    }
-    fn observable(&self) -> Observable {
-        Observable::ForceN
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(FeEvaluator {
-            setup: self,
-            space: &self.space,
-            outputs: self.outputs().len(),
-            system: None,
-        })
-    }
-    /// A nonlinear FE solve per prediction.
-    fn expensive(&self) -> bool {
-        true
     }
 }

@@ -26,7 +26,7 @@ use palpate_core::{
     ParamSpace, ParamSpec,
 };
 
-use crate::q1::Q1Punch;
+use super::Q1Punch;
 use crate::viscoelastic::Prony;
 
 /// The Q1 punch with a parametrised one-term Prony series.

@@ -14,8 +14,7 @@
 //! facets. Effects: `friction` (a parameter, 0..2) and `zero_offset`.
 
 use palpate_core::{
-    Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamRole,
-    ParamSpace, ParamSpec,
+    enrichable::not_applicable, Effect, ForwardError, ForwardModel, Loading, ParamSpace,
 };
 use palpate_enrich::ZeroOffset;
 use palpate_material::Law;
@@ -23,16 +22,16 @@ use std::sync::Arc;
 
 use crate::body::{RegionMaterial, SolidBody};
 use crate::contact::{ContactOptions, ContactPoints, RigidContact};
+use crate::contribution::Contribution;
 use crate::discretisation::{Coarser, ConvergenceOrder};
 use crate::dofs::Dirichlet;
 use crate::kernel::{kernel_for, PressureSpace};
 use crate::kinematics::Kinematics;
 use crate::mesh::{CellType, Grading, Mesh};
-use crate::model::{law_space, simulate, to_forward, Bulk, FeEvaluator, Setup, Simulation};
+use crate::model::{doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, Setup};
 use crate::motion::ToolMotion;
-use crate::stepper::Progress;
 use crate::surface::Revolution3d;
-use crate::system::{SolverOptions, System};
+use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::FeError;
 
@@ -101,10 +100,13 @@ pub fn n3_core_cells(h_fine: f64) -> usize {
     ((2.4 / h_fine).round() as usize).max(2)
 }
 
-/// The N3 model.
+/// The N3 model: [`N3Setup`] as a forward model.
+pub type N3Needle = FeModel<N3Setup>;
+
+/// The N3 experiment ([`N3Needle`]).
 #[derive(Debug, Clone, PartialEq)]
-pub struct N3Needle {
-    pub law: Law,
+pub struct N3Setup {
+    law: Law,
     pub bulk: Bulk,
     pub friction: f64,
     pub tool: ToolShape,
@@ -138,8 +140,15 @@ pub struct N3Needle {
     /// sharp penalty law.
     pub contact_smoothing: f64,
     pub options: SolverOptions,
+    /// Friction is the parameter after the law's (the `friction` effect).
     friction_is_parameter: bool,
-    space: ParamSpace,
+}
+
+/// The contributions of the N3 system.
+#[derive(Debug, Clone, Copy)]
+pub struct N3Parts {
+    body: Part<SolidBody>,
+    contact: Part<RigidContact>,
 }
 
 impl N3Needle {
@@ -150,8 +159,7 @@ impl N3Needle {
     /// symmetric part (`options.gmres`; the LU's fill in 3D is many times
     /// larger).
     pub fn new(law: Law) -> Self {
-        N3Needle {
-            space: law_space(&law),
+        FeModel::from_setup(N3Setup {
             law,
             bulk: Bulk::Exact,
             friction: 0.8,
@@ -175,9 +183,23 @@ impl N3Needle {
                 ..SolverOptions::default()
             },
             friction_is_parameter: false,
-        }
+        })
     }
 
+    /// The coarser companion of the error estimate: elements twice as large
+    /// (fine size and `growth - 1` doubled, fine zone kept), so level 2 gives
+    /// level 1.
+    pub fn coarser(&self) -> Coarser<N3Needle> {
+        let coarse = doubled(self.effective_grading());
+        let core = (self.effective_core_cells() / 2).max(2);
+        self.companion(2.0, graded_mesh_words(coarse, "tool"), |s| {
+            s.grading = Some(coarse);
+            s.core_cells = Some(core);
+        })
+    }
+}
+
+impl N3Setup {
     fn effective_grading(&self) -> Grading {
         self.grading.unwrap_or_else(|| match self.element {
             N3Element::Hex8 => n3_grading(self.level),
@@ -240,7 +262,7 @@ impl N3Needle {
     }
 
     /// The estimated peak memory of a run (bytes) from the number of
-    /// equations ([`N3Needle::mesh_size`]), without building anything.
+    /// equations ([`N3Setup::mesh_size`]), without building anything.
     /// O-grid (LDL^T and GMRES): `0.6 GiB x (equations / 30,500)^1.25`,
     /// through the measured peaks of O-grid levels 1, 1.5 and 2 (4,110,
     /// 13,248 and 30,479 equations: 0.05, 0.2 and 0.6 GiB) with a slightly
@@ -297,30 +319,6 @@ impl N3Needle {
         }
     }
 
-    /// The coarser companion of the error estimate: elements twice as large
-    /// (fine size and `growth - 1` doubled, fine zone kept), so level 2 gives
-    /// level 1.
-    pub fn coarser(&self) -> Coarser<N3Needle> {
-        let g = self.effective_grading();
-        let coarse = Grading {
-            h_fine: 2.0 * g.h_fine,
-            fine_length: g.fine_length,
-            growth: 1.0 + 2.0 * (g.growth - 1.0),
-        };
-        let mut model = self.clone();
-        model.grading = Some(coarse);
-        model.core_cells = Some((self.effective_core_cells() / 2).max(2));
-        Coarser {
-            model,
-            ratio: 2.0,
-            mesh: format!(
-                "{} mm elements under the tool, growth {}",
-                (coarse.h_fine * 1e6).round() / 1e6,
-                (coarse.growth * 1e6).round() / 1e6
-            ),
-        }
-    }
-
     /// The order of convergence of the force with the element size.
     /// Q1/P0: taken as N1's Q1/P0 order (1.22 at 10 mm), the same element
     /// family and contact in 3D; on N3 itself (h = 1.2, 0.8, 0.6 mm, NH,
@@ -347,14 +345,9 @@ impl N3Needle {
         }
     }
 
-    /// Runs one history with a progress observer; returns the system too.
-    /// A depth of half the block height or more is refused.
-    pub fn simulate(
-        &self,
-        theta: &[f64],
-        loading: &Loading,
-        progress: Option<&mut dyn FnMut(&Progress)>,
-    ) -> Result<(Simulation, System), ForwardError> {
+    /// A depth of half the block height or more is refused
+    /// ([`N3Needle::simulate`]).
+    fn check_depth(&self, loading: &Loading) -> Result<(), ForwardError> {
         let max = loading.drive.iter().cloned().fold(0.0, f64::max);
         if max >= 0.5 * self.size[2] {
             return Err(ForwardError::InvalidLoading(format!(
@@ -362,9 +355,7 @@ impl N3Needle {
                 self.size[2]
             )));
         }
-        let mut sys = self.build().map_err(to_forward)?;
-        let sim = simulate(self, &self.space, &mut sys, theta, loading, progress)?;
-        Ok((sim, sys))
+        Ok(())
     }
 }
 
@@ -383,9 +374,21 @@ fn available_memory() -> Option<f64> {
     Some(kib * 1024.0)
 }
 
-impl Setup for N3Needle {
+impl Setup for N3Setup {
+    type Parts = N3Parts;
     fn law(&self) -> &Law {
         &self.law
+    }
+    fn set_law(&mut self, law: Law) {
+        self.law = law;
+    }
+    fn param_space(&self) -> ParamSpace {
+        let law = law_space(&self.law);
+        if self.friction_is_parameter {
+            law.extended(&[friction_param(self.friction)])
+        } else {
+            law
+        }
     }
     fn bulk(&self) -> Bulk {
         self.bulk
@@ -393,7 +396,7 @@ impl Setup for N3Needle {
     fn options(&self) -> SolverOptions {
         self.options
     }
-    fn build(&self) -> Result<System, FeError> {
+    fn build(&self) -> Result<(System, N3Parts), FeError> {
         if !(self.friction >= 0.0 && self.friction.is_finite()) {
             return Err(FeError::InvalidConfig {
                 field: "friction".into(),
@@ -455,20 +458,25 @@ impl Setup for N3Needle {
             options,
             1,
         )?;
-        System::new(mesh, 3, vec![Box::new(body), Box::new(contact)], &bcs, 1)
+        let mut parts = Parts::new();
+        let handles = N3Parts {
+            body: parts.add(body),
+            contact: parts.add(contact),
+        };
+        Ok((System::from_parts(mesh, 3, parts, &bcs, 1)?, handles))
     }
     fn prepare(
         &self,
         sys: &mut System,
+        parts: &N3Parts,
         material: RegionMaterial,
         extra: &[f64],
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
         let h = self.node_spacing();
         sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
-        sys.part_mut::<SolidBody>(0)?
-            .set_material("body", material)?;
-        let cs = sys.part_mut::<RigidContact>(1)?;
+        sys.get_mut(parts.body)?.set_material("body", material)?;
+        let cs = sys.get_mut(parts.contact)?;
         cs.smoothing = self.contact_smoothing * h;
         cs.options.penalty_normal = self.penalty * mu / h;
         cs.options.penalty_tangent = self.penalty * mu / h;
@@ -479,76 +487,42 @@ impl Setup for N3Needle {
         };
         Ok(())
     }
-    fn observe(&self, sys: &System) -> Vec<f64> {
+    fn observe(&self, sys: &System, parts: &N3Parts) -> Vec<f64> {
         vec![
-            4.0 * sys.contributions[1]
-                .tool_force([0.0, 0.0, -1.0])
+            4.0 * sys
+                .get(parts.contact)
+                .and_then(|c| c.tool_force([0.0, 0.0, -1.0]))
                 .unwrap_or(0.0),
         ]
     }
-}
-
-impl ForwardModel for N3Needle {
+    fn check_loading(&self, loading: &Loading) -> Result<(), ForwardError> {
+        self.check_depth(loading)
+    }
     fn name(&self) -> String {
         format!(
             "N3 FE needle indentation (3D quarter block), {}, friction {}",
             self.law, self.friction
         )
     }
-    fn space(&self) -> &ParamSpace {
-        &self.space
-    }
-    fn observable(&self) -> Observable {
-        Observable::ForceN
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(FeEvaluator {
-            setup: self,
-            space: &self.space,
-            outputs: self.outputs().len(),
-            system: None,
-        })
-    }
-    /// A nonlinear 3D FE solve per prediction (tens of seconds or more).
-    fn expensive(&self) -> bool {
-        true
-    }
-    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
-        Some(self)
-    }
-}
-
-impl Enrichable for N3Needle {
-    fn effects(&self) -> Vec<Effect> {
+    fn effects(&self) -> Option<Vec<Effect>> {
         let mut v = Vec::new();
         if !self.friction_is_parameter {
             v.push(Effect::Friction);
         }
         v.push(Effect::ZeroOffset);
-        v
+        Some(v)
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
             Effect::Friction if !self.friction_is_parameter => {
                 let mut m = self.clone();
                 m.friction_is_parameter = true;
-                // plausible range: a lubricated to a dry needle in soft tissue
-                m.space = self.space.extended(&[ParamSpec::new(
-                    "friction",
-                    "1",
-                    0.0,
-                    2.0,
-                    self.friction,
-                )
-                .with_role(ParamRole::Friction)
-                .with_plausible(0.0, 0.8)]);
-                Ok(Box::new(m))
+                Ok(Box::new(FeModel::from_setup(m)))
             }
-            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(self.clone())))),
-            _ => Err(ForwardError::InvalidConfig {
-                field: "effect".into(),
-                reason: format!("`{effect}` does not apply to {}", self.name()),
-            }),
+            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(
+                FeModel::from_setup(self.clone()),
+            )))),
+            _ => Err(not_applicable(effect, &self.name())),
         }
     }
 }
