@@ -4,15 +4,6 @@
 //!
 //! Helpers shared by those tests live here.
 
-use std::path::PathBuf;
-
-/// Path of a file in the shared folder beside the workspace (`../shared`).
-pub fn shared(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared")
-        .join(rel)
-}
-
 /// The R2 development experiment of the gap diagnosis (issue 14, item 5):
 /// a shorter, thinner block than BENCHMARKS.md R2 so that one rolled pass
 /// costs seconds, not minutes — 80 mm long, 20 mm high, 50 mm thick,

@@ -19,7 +19,7 @@
 //! the increment size and the contact penalty factor, to separate their
 //! errors from the mesh's.
 //!
-//! `cargo run --release -p palpate-fe --example convergence_n1 -- [level | h/zone/growth ...] [--max-step=S] [--penalty=P] [--augment=TOL]`
+//! `cargo run --release -p palpate-tools --bin convergence_n1 -- [level | h/zone/growth ...] [--max-step=S] [--penalty=P] [--augment=TOL]`
 
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
@@ -65,8 +65,7 @@ impl Case {
     }
 }
 
-#[path = "common/cpu.rs"]
-mod cpu;
+use palpate_tools::cpu;
 
 fn cpu_seconds() -> f64 {
     cpu::cpu_seconds(false)

@@ -1,6 +1,6 @@
 //! Q1 mesh study (docs/validation/fe.md, "Q1"): the elastic flat-punch force
 //! at a small depth against Sneddon's 8 G a d on one grading.
-//! `cargo run --release -p palpate-fe --example convergence_q1 -- H_FINE GROWTH EDGE [DEPTH]`
+//! `cargo run --release -p palpate-tools --bin convergence_q1 -- H_FINE GROWTH EDGE [DEPTH]`
 //! (env `AUG=20` for an inner augmentation loop, `PEN=` the penalty factor,
 //! `GAUSS=1` contact at fixed Gauss points of the edges, `REFINE=` edge
 //! refinement).

@@ -8,15 +8,14 @@
 //! error of h = 2 and h = 1 with the order stated by the model, and CPU
 //! seconds. `--csv OUT` writes the rows (docs/validation/r2/fe_presses.csv).
 //!
-//! `cargo run --release -p palpate-fe --example convergence_r2 -- [--rd 3,6]
+//! `cargo run --release -p palpate-tools --bin convergence_r2 -- [--rd 3,6]
 //!  [--x 10,37.5,56.25,75,93.75,112.5] [--h 4,2,1] [--csv OUT]`
 
 use palpate_core::{Drive, Loading};
 use palpate_fe::R2Rolling;
 use palpate_material::Law;
 
-#[path = "common/cpu.rs"]
-mod cpu;
+use palpate_tools::cpu;
 use cpu::cpu_seconds;
 
 fn list(v: &str) -> Vec<f64> {

@@ -17,7 +17,7 @@
 //!   every effect it offers (`-- r2 r2-inclusion` for a subset;
 //!   `-- r2probe [H [STEP]]` times one pass per effect).
 //!
-//! `cargo run --release -p palpate-tests --example gap_fe_effects [-- q1|n3|r2|probe|r2probe]`
+//! `cargo run --release -p palpate-tools --bin gap_fe_effects [-- q1|n3|r2|probe|r2probe]`
 
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
@@ -242,7 +242,7 @@ fn main() {
         return;
     }
     if run("r2") {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-r2");
+        let dir = palpate_tools::repo("tests/data/gap-r2");
         let names: Vec<String> = match std::env::args().nth(2) {
             Some(list) => list.split(',').map(String::from).collect(),
             None => R2_RECORDS.map(String::from).to_vec(),
@@ -257,7 +257,7 @@ fn main() {
         }
     }
     if which.as_deref() == Some("probe") {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-q1");
+        let dir = palpate_tools::repo("tests/data/gap-q1");
         let (loading, _) = read(&dir.join("q1-relaxation.csv"));
         let mut base = Q1Punch::new(Law::NeoHookean);
         base.level = std::env::args().nth(3).map_or(1, |a| a.parse().unwrap());
@@ -284,7 +284,7 @@ fn main() {
         return;
     }
     if run("q1") {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-q1");
+        let dir = palpate_tools::repo("tests/data/gap-q1");
         let names: Vec<String> = match std::env::args().nth(2) {
             Some(list) => list.split(',').map(String::from).collect(),
             None => ["q1-relaxation", "q1-weak-relaxation", "q1-none"]
@@ -310,7 +310,7 @@ fn main() {
         }
     }
     if run("n3") {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n3");
+        let dir = palpate_tools::repo("tests/data/gap-n3");
         let names: Vec<String> = match std::env::args().nth(2) {
             Some(list) => list.split(',').map(String::from).collect(),
             None => vec![

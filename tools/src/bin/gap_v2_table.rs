@@ -4,7 +4,7 @@
 //! noise before and after the best effect, immaterial and undetectable
 //! effects, and the time per record.
 //!
-//! `cargo run --release -p palpate-tests --example gap_v2_table`
+//! `cargo run --release -p palpate-tools --bin gap_v2_table`
 
 use palpate_analytic::C1Compression;
 use palpate_core::{Drive, Loading, Table};
@@ -14,11 +14,10 @@ use std::path::Path;
 use std::time::Instant;
 
 fn main() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut files: Vec<(String, std::path::PathBuf, String)> = Vec::new();
     for (dir, truth) in [
-        (root.join("data/gap-v2"), "truth.json"),
-        (root.join("../../shared/data/gap-dev/c1"), "truth.json"),
+        (palpate_tools::repo("tests/data/gap-v2"), "truth.json"),
+        (palpate_tools::repo("studies/data/gap-dev/c1"), "truth.json"),
     ] {
         let Ok(text) = std::fs::read_to_string(dir.join(truth)) else {
             continue;

@@ -1,6 +1,6 @@
 //! R2 localisation: accuracy, coverage and speed (issue 11), release only.
 //!
-//! `cargo run --release -p palpate-studies --example localize_r2 -- --rd 6
+//! `cargo run --release -p palpate-tools --bin localize_r2 -- --rd 6
 //!  [--records 50] [--h-record 1.5] [--step-record 1] [--noise 0.01]
 //!  [--cache DIR] [--plot OUT.svg] [--record r2|r2-1] [--record-only]
 //!  [--predict-r2-at X,X,..]`

@@ -4,7 +4,7 @@
 //! model of the diagnosis does not share its discretisation), plus Gaussian
 //! noise of a stated fraction of the largest force, from a fixed seed.
 //!
-//! `cargo run --release -p palpate-tests --example make_gap_n1` (about a
+//! `cargo run --release -p palpate-tools --bin make_gap_n1` (about a
 //! minute). The records are committed; rerun only to change them.
 
 use palpate_core::{Drive, ForwardModel, Loading};
@@ -61,7 +61,7 @@ fn main() {
             expected: "none",
         },
     ];
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n1");
+    let dir = palpate_tools::repo("tests/data/gap-n1");
     std::fs::create_dir_all(&dir).expect("create data/gap-n1");
     let depths: Vec<f64> = (0..=24).map(|i| 0.25 * i as f64).collect();
     let loading = Loading::quasi_static(Drive::DisplacementMm, depths.clone());

@@ -20,7 +20,7 @@
 //! SDs — at 1 SD or more the planted effect, below 0.4 SD (the diagnosis's
 //! materiality threshold) `none`, between `borderline`.
 //!
-//! `cargo run --release -p palpate-tests --example make_gap_n3` (one 3D run,
+//! `cargo run --release -p palpate-tools --bin make_gap_n3` (one 3D run,
 //! about a minute of CPU). The records are committed; rerun only to change
 //! them.
 
@@ -44,7 +44,7 @@ type Case<'a> = (
 );
 
 fn main() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-n3");
+    let dir = palpate_tools::repo("tests/data/gap-n3");
     std::fs::create_dir_all(&dir).expect("create data/gap-n3");
     let depths: Vec<f64> = (0..=24).map(|i| 0.25 * i as f64).collect();
     let loading = Loading::quasi_static(Drive::DisplacementMm, depths.clone());

@@ -12,7 +12,7 @@
 //! hold increment); plus Gaussian noise of a stated fraction of the largest
 //! force, from a fixed seed.
 //!
-//! `cargo run --release -p palpate-tests --example make_gap_q1`. The records
+//! `cargo run --release -p palpate-tools --bin make_gap_q1`. The records
 //! are committed; rerun only to change them.
 
 use palpate_core::{Drive, ForwardModel, Loading};
@@ -70,7 +70,7 @@ fn main() {
             expected: "none",
         },
     ];
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-q1");
+    let dir = palpate_tools::repo("tests/data/gap-q1");
     std::fs::create_dir_all(&dir).expect("create data/gap-q1");
     let (time, depth) = q1_history();
     let loading = Loading::timed(Drive::DisplacementMm, time.clone(), depth.clone());

@@ -17,7 +17,7 @@
 //! materiality threshold) it is `none`, "too weak to see"; the cases are
 //! chosen to avoid the band between.
 //!
-//! `cargo run --release -p palpate-tests --example make_gap_r2 [-- NAME,...]`
+//! `cargo run --release -p palpate-tools --bin make_gap_r2 [-- NAME,...]`
 //! (a subset replaces only its entries of `truth.json`, so one process per
 //! record can run them in parallel). The records are committed; rerun only
 //! to change them.
@@ -74,7 +74,7 @@ fn main() {
     let only: Option<Vec<String>> = std::env::args()
         .nth(1)
         .map(|a| a.split(',').map(String::from).collect());
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-r2");
+    let dir = palpate_tools::repo("tests/data/gap-r2");
     std::fs::create_dir_all(&dir).expect("create data/gap-r2");
     let loading = r2_dev::loading(1.0);
     let fine = R2Gap::new(r2_dev::rolling(1.0), 1.0);

@@ -22,7 +22,7 @@
 //!   does not share its discretisation), noise 4 % of the peak force: the
 //!   frictionless base fits within the noise with C10 well above the truth.
 //!
-//! `cargo run --release -p palpate-tests --example make_gap_v2` (about a
+//! `cargo run --release -p palpate-tools --bin make_gap_v2` (about a
 //! minute, most of it the N1 record). The records are committed; rerun only
 //! to change them.
 
@@ -192,7 +192,7 @@ fn n1_record() -> Record {
 }
 
 fn main() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/gap-v2");
+    let dir = palpate_tools::repo("tests/data/gap-v2");
     std::fs::create_dir_all(&dir).expect("create data/gap-v2");
     let mut records = c1_records();
     if !std::env::args().any(|a| a == "--c1-only") {

@@ -30,7 +30,7 @@
 //!
 //! `truth.json` holds every value drawn. Seeds are fixed; the records are
 //! committed, rerun only to change them:
-//! `cargo run --release -p palpate-tests --example make_mesa2011` (the fine
+//! `cargo run --release -p palpate-tools --bin make_mesa2011` (the fine
 //! N3 run: about 5 min of CPU and 1.6 GiB).
 
 use palpate_analytic::C1Compression;
@@ -49,7 +49,7 @@ const RP2: [f64; 2] = [686.428e-6, 1929.606e-6];
 const C30: f64 = 100e-6;
 
 fn main() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/mesa2011");
+    let dir = palpate_tools::repo("tests/data/mesa2011");
     std::fs::create_dir_all(&dir).expect("create data/mesa2011");
     let mut truth = String::from("{\n");
 

@@ -19,7 +19,7 @@
 //! * `truth.json`: the parameters, the noise and the noise-free forces.
 //!
 //! The record is committed; rerun only to change it:
-//! `cargo run --release -p palpate-tests --example make_two_stage_q1`.
+//! `cargo run --release -p palpate-tools --bin make_two_stage_q1`.
 //! With env `Q1_RECORD_DEPTH=D` (mm) the ramp goes to D instead, into
 //! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of BENCHMARKS.md runs
 //! since session 16's contact; its fit is a study, not a test).
@@ -120,15 +120,15 @@ fn main() {
     }
     let depth = depth();
     let mut sub = if depth == DEPTH {
-        "data/two-stage-q1".to_string()
+        "tests/data/two-stage-q1".to_string()
     } else {
-        format!("data/two-stage-q1-{depth}mm")
+        format!("tests/data/two-stage-q1-{depth}mm")
     };
     if let Some(rho) = edge() {
         sub = format!("{sub}-edge{rho}");
     }
     let edge_mm = edge().unwrap_or(palpate_fe::q1::DEFAULT_EDGE_RADIUS);
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join(&sub);
+    let dir = palpate_tools::repo(&sub);
     std::fs::create_dir_all(&dir).expect("create the record's folder");
     let level = level();
     let f = model(level, 0.25)

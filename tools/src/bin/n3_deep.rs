@@ -3,7 +3,7 @@
 //! prints, for the cells whose smallest Gauss-point det F or corner
 //! Jacobian of the deformed geometry is lowest, where they are.
 //!
-//! `cargo run --release -p palpate-fe --example n3_deep -- DEPTH OUT.vtu [h,zone,growth]`
+//! `cargo run --release -p palpate-tools --bin n3_deep -- DEPTH OUT.vtu [h,zone,growth]`
 
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::jacobian::corner_jacobians;

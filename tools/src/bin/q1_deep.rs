@@ -4,7 +4,7 @@
 //! smallest corner Jacobian there, and writing the last converged state as
 //! VTU (`OUT.vtu`) for ParaView (Warp By Vector on `displacement`).
 //!
-//! `cargo run --release -p palpate-fe --example q1_deep -- LEVEL DEPTH [EDGE] [C10] [OUT.vtu]`
+//! `cargo run --release -p palpate-tools --bin q1_deep -- LEVEL DEPTH [EDGE] [C10] [OUT.vtu]`
 //! (env `STEP=` sample spacing in mm, default 0.05; `SMOOTH=` the contact
 //! smoothing as a fraction of the element size; `NODES=1` contact at the
 //! nodes; `LINE=slope` the slope line search; `STAG=` the relative

@@ -6,7 +6,7 @@
 //! prints the force at a half, three quarters and the end of the ramp, 20
 //! samples into the hold and at its end:
 //!
-//!   cargo run --release -p palpate-tests --example q1_fit_smoothness -- 0.3 0.2 3:0 3:1e-3 3:-1e-2
+//!   cargo run --release -p palpate-tools --bin q1_fit_smoothness -- 0.3 0.2 3:0 3:1e-3 3:-1e-2
 //!
 //! With the 0.2 mm edge the 0.3 mm mesh jumps branch (g2 -1 %: +11 % at the
 //! ramp's end); with a 0.6 mm edge it is smooth (docs/guide.md, two-stage).
@@ -18,7 +18,7 @@ fn main() {
     let a: Vec<String> = std::env::args().collect();
     let h: f64 = a[1].parse().unwrap();
     let edge: f64 = a[2].parse().unwrap();
-    let rec = std::fs::read_to_string("tests/data/two-stage-q1-5mm/record.csv").unwrap();
+    let rec = std::fs::read_to_string(palpate_tools::repo("tests/data/two-stage-q1-5mm/record.csv")).unwrap();
     let (mut t, mut d) = (vec![], vec![]);
     for l in rec.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();

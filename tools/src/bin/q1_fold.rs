@@ -3,7 +3,7 @@
 //! the equilibrium path turn (a fold, where the nodes would run away as the
 //! stop nears) or stay straight up to it?
 //!
-//! `cargo run --release -p palpate-fe --example q1_fold -- LEVEL FINE_FROM TO FINE_STEP`
+//! `cargo run --release -p palpate-tools --bin q1_fold -- LEVEL FINE_FROM TO FINE_STEP`
 //! (0.05 mm samples to FINE_FROM, then FINE_STEP to TO; env `REFINE=` the
 //! edge refinement, `EDGE=` the edge radius). Prints, per sample from 0.2 mm
 //! before FINE_FROM, the depth, the punch force and each watched node's

@@ -5,7 +5,7 @@
 //! punch edge 0.6 mm) and its standard errors `SE` (comma-separated, as
 //! THETA):
 //!
-//!   cargo run --release -p palpate-studies --example q1_mesh_check -- \
+//!   cargo run --release -p palpate-tools --bin q1_mesh_check -- \
 //!       0.06666666666666667 0.0015885,0.31586,0.41229,0.19992,9.6813 \
 //!       1.16e-5,7.56e-3,2.85e-2,7.36e-3,1.02 [ROUNDS]
 use palpate_material::Law;
@@ -29,7 +29,7 @@ fn main() -> anyhow::Result<()> {
     if let Some(r) = a.get(4) {
         o.correction_rounds = r.parse()?;
     }
-    let record = Q1Record::read(std::path::Path::new(
+    let record = Q1Record::read(&palpate_tools::repo(
         "tests/data/two-stage-q1-5mm/record.csv",
     ))?;
     let check = check_estimate(&record, &o, &theta, &se, &|s| eprintln!("{s}"))?;

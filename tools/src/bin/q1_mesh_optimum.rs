@@ -3,7 +3,7 @@
 //! an edge of `EDGE` mm (the fits' 1 s time step), with the Jacobian by
 //! central differences of `REL` of each parameter:
 //!
-//!   cargo run --release -p palpate-tests --example q1_mesh_optimum -- \
+//!   cargo run --release -p palpate-tools --bin q1_mesh_optimum -- \
 //!       0.1 0.2 0.01 0.0016055,0.311421,0.408215,0.201212,9.614416 [noise-free]
 //!
 //! The point is a corrected fit's estimate (`palpate calibrate --benchmark
@@ -35,7 +35,7 @@ fn main() {
     let theta: Vec<f64> = a[4].split(',').map(|x| x.parse().expect("point")).collect();
     assert_eq!(theta.len(), 5, "five parameters");
     let noise_free = a.get(5).is_some_and(|s| s == "noise-free");
-    let rec = std::fs::read_to_string("tests/data/two-stage-q1-5mm/record.csv").expect("record");
+    let rec = std::fs::read_to_string(palpate_tools::repo("tests/data/two-stage-q1-5mm/record.csv")).expect("record");
     let (mut t, mut d, mut f) = (vec![], vec![], vec![]);
     for l in rec.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
@@ -45,7 +45,7 @@ fn main() {
     }
     if noise_free {
         let truth: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string("tests/data/two-stage-q1-5mm/truth.json").expect("truth"),
+            &std::fs::read_to_string(palpate_tools::repo("tests/data/two-stage-q1-5mm/truth.json")).expect("truth"),
         )
         .expect("truth.json");
         f = truth["noise_free_force_N"]

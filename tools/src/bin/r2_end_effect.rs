@@ -6,7 +6,7 @@
 //! is the cause, `force_x` decays with the distance to the end and changes
 //! sign at the mirror position (`Fx(150 - x) = -Fx(x)`).
 //!
-//! `cargo run --release -p palpate-fe --example r2_end_effect -- [--rd 6]
+//! `cargo run --release -p palpate-tools --bin r2_end_effect -- [--rd 6]
 //!  [--h 2] [--nodules none]`
 
 use palpate_core::{Drive, ForwardModel, Loading};

@@ -5,7 +5,7 @@
 //! (clipped to the path 10..140) and F0 is one nodule-free pass; the table
 //! prints E at the offsets p - x_n.
 //!
-//! `cargo run --release -p palpate-fe --example r2_excess_shape -- [--rd 6]
+//! `cargo run --release -p palpate-tools --bin r2_excess_shape -- [--rd 6]
 //!  [--x 20,35,50,75] [--depth 10,20] [--step 2]`
 
 use palpate_fe::r2_scan::R2NoduleScan;

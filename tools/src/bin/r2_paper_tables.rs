@@ -17,7 +17,7 @@
 //! studied 8-24 mm. docs/validation/r2-localisation.md puts the table beside
 //! the paper's and the posterior's identifiability.
 //!
-//! `cargo run --release -p palpate-fe --example r2_paper_tables -- [--rd 3,4,5,6] [--level 1]`
+//! `cargo run --release -p palpate-tools --bin r2_paper_tables -- [--rd 3,4,5,6] [--level 1]`
 //! (presses in parallel threads, 2 by default: `--threads N`).
 
 use nalgebra::{Matrix3, Vector3};
