@@ -11,5 +11,7 @@ pub mod cpu;
 /// A path inside the repository, from its root (`rel` such as
 /// `"tests/data/gap-n1"`), whatever the working directory.
 pub fn repo(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..").join(rel)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("..")
+        .join(rel)
 }

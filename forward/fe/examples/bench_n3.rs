@@ -1,4 +1,4 @@
-//! Benchmark (issue 12): N3 (BENCHMARKS.md), the 3D quarter block with the
+//! Benchmark: N3 (BENCHMARKS.md), the 3D quarter block with the
 //! N1 needle, to `--depth` (default 10 mm) with the force every 0.25 mm, on
 //! the given mesh levels (default 1), for neo-Hookean `ecoflex-nh` and
 //! reduced polynomial `ecoflex-rp2`, friction 0 and 0.8. Each row prints
@@ -11,7 +11,7 @@
 //!
 //! By default the element is the 27-node Q2/P1 hexahedron on the quarter
 //! O-grid (`--element hex27`; level 1: cells of 1.6 mm), the mesh that
-//! meets issue 12's goal of 1 % at 10 mm in 60 s with friction 0.8;
+//! meets the goal of 1 % at 10 mm in 60 s with friction 0.8;
 //! `--element hex8` runs the Q1/P0 model's default (the graded box).
 //!
 //! `cargo run --release -p palpate-fe --example bench_n3 -- [level ...]

@@ -1,4 +1,4 @@
-//! R2 speed bench (issue 11: a full pass in 30 s or less on 2 cores): the
+//! R2 speed bench (goal: a full pass in 30 s or less on 2 cores): the
 //! BENCHMARKS.md R2 rolled pass, x 10 -> 140 mm every 0.5 mm, RD 6, the
 //! three default nodules, frictionless, at the accuracy-level mesh (level 1,
 //! h = 2 mm: within 0.63 % of h = 1 at the RD 3 presses of
@@ -199,7 +199,7 @@ fn main() {
 
 /// The processor's name (Linux: `model name` of /proc/cpuinfo), for the
 /// record: the same pass takes 2.4 x longer on some 2-core VMs than on
-/// others (docs/validation/fe.md R2, "Speed, session 14").
+/// others (docs/validation/fe.md, R2 speed).
 fn cpu_model() -> String {
     std::fs::read_to_string("/proc/cpuinfo")
         .ok()

@@ -25,8 +25,7 @@ fn forces(level: usize, at: &[f64]) -> Vec<f64> {
 }
 
 fn calculix(at: f64) -> f64 {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("data/calculix/n1/n1_nh_f0.8_k1000_n6.csv");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/calculix/n1/n1_nh_f0.8_k1000_n6.csv");
     let t = Table::read(&p).unwrap();
     let (x, y) = (
         t.column("displacement_mm").unwrap(),

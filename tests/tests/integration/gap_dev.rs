@@ -1,4 +1,4 @@
-//! Sim-to-real gap diagnosis on benchmark C1 (GAP.md, issue 6):
+//! Sim-to-real gap diagnosis on benchmark C1 (GAP.md):
 //!
 //! * the withheld-effect cases of `studies/data/gap-dev/c1` (generated outside
 //!   this project): verdict, planted parameters, held-out misfit;

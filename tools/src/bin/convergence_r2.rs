@@ -15,8 +15,8 @@ use palpate_core::{Drive, Loading};
 use palpate_fe::R2Rolling;
 use palpate_material::Law;
 
-use palpate_tools::cpu;
 use cpu::cpu_seconds;
+use palpate_tools::cpu;
 
 fn list(v: &str) -> Vec<f64> {
     v.split(',').map(|x| x.parse().expect("a number")).collect()

@@ -1,18 +1,18 @@
 //! The gap diagnosis on the FE models beyond N1's default candidates
-//! (issue 14, item 5), with what each costs: prints one table row per
+//! with what each costs: prints one table row per
 //! record (verdict, misfit before/after, FE solves by model, wall and CPU
 //! seconds).
 //!
 //! * Q1 `viscoelasticity`: the three records of `tests/data/gap-q1/`
-//!   (`examples/make_gap_q1.rs`) against the elastic punch on mesh level 2
+//!   (`make_gap_q1`) against the elastic punch on mesh level 2
 //!   (`-- q1 q1-relaxation,q1-none` for a subset).
 //! * N1 -> N3 `modelling_space`: the records of `tests/data/gap-n3/`
-//!   (`examples/make_gap_n3.rs`: a 6 mm needle record made by the 3D model,
+//!   (`make_gap_n3`: a 6 mm needle record made by the 3D model,
 //!   and a null one made by N1 on the MEDIUM mesh), diagnosed against the
 //!   coarse axisymmetric N1 base with `modelling_space` and `friction` as
 //!   candidates.
 //! * R2 `inclusion`, `friction`, `boundary_condition`: the records of
-//!   `tests/data/gap-r2/` (`examples/make_gap_r2.rs`) against the R2
+//!   `tests/data/gap-r2/` (`make_gap_r2`) against the R2
 //!   development pass on the 2 mm mesh ([`palpate_tests::r2_dev`]) with
 //!   every effect it offers (`-- r2 r2-inclusion` for a subset;
 //!   `-- r2probe [H [STEP]]` times one pass per effect).
@@ -155,7 +155,7 @@ fn read(path: &Path) -> (Loading, Vec<f64>) {
     (loading, f)
 }
 
-/// The R2 development records (`examples/make_gap_r2.rs`).
+/// The R2 development records (`make_gap_r2`).
 const R2_RECORDS: [&str; 4] = ["r2-inclusion", "r2-friction", "r2-sliding", "r2-none"];
 
 /// Element size (mm) of the R2 base model of the diagnosis.

@@ -10,7 +10,6 @@ use palpate_analytic::C1Compression;
 use palpate_core::{Drive, Loading, Table};
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, FoldLayout, GapOptions};
-use std::path::Path;
 use std::time::Instant;
 
 fn main() {

@@ -1,4 +1,4 @@
-//! R2 localisation: accuracy, coverage and speed (issue 11), release only.
+//! R2 localisation: accuracy, coverage and speed, release only.
 //!
 //! `cargo run --release -p palpate-tools --bin localize_r2 -- --rd 6
 //!  [--records 50] [--h-record 1.5] [--step-record 1] [--noise 0.01]
@@ -41,7 +41,7 @@ fn main() -> anyhow::Result<()> {
     let mut which = "r2".to_string();
     let mut record_only = false;
     // positions where the model of R2's three nodules is printed (to set
-    // beside FE presses of forward/fe/examples/r2_paper_tables.rs)
+    // beside FE presses of r2_paper_tables)
     let mut predict_at: Vec<f64> = Vec::new();
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut it = args.iter();

@@ -13,7 +13,6 @@ use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 struct Case {
     name: &'static str,
@@ -77,7 +76,7 @@ fn main() {
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(c.seed);
         let noise = Normal::new(0.0, sd).expect("noise sd");
         let mut csv = format!(
-            "# synthetic N1 record (tests/examples/make_gap_n1.rs): neo-Hookean C10 = {} MPa, \
+            "# synthetic N1 record (tools/src/bin/make_gap_n1.rs): neo-Hookean C10 = {} MPa, \
              friction {}, {:?} base, MEDIUM mesh, noise sd {:.3e} N (seed {})\n\
              displacement_mm,force_N\n",
             c.c10, c.friction, c.base, sd, c.seed

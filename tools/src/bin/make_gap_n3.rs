@@ -1,5 +1,5 @@
 //! Writes the `modelling_space` development records of `tests/data/gap-n3/`
-//! (issue 14, item 5; used by `examples/gap_fe_effects.rs -- n3` and
+//! (used by `gap_fe_effects -- n3` and
 //! `tests/integration/gap_fe_effects.rs`): needle indentation (BENCHMARKS.md N1/N3
 //! needle, neo-Hookean C10 1e-3 MPa, frictionless, bonded base) to 6 mm
 //! every 0.25 mm (25 samples), plus Gaussian noise of a fraction of the
@@ -30,7 +30,6 @@ use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 /// A record: name, generator, its noiseless forces, noise fraction of the
 /// peak, seed, planted effect.
@@ -95,7 +94,7 @@ fn main() {
         let noise = Normal::new(0.0, sd).expect("sd");
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
         let mut csv = format!(
-            "# synthetic needle record (tests/examples/make_gap_n3.rs): {}, C10 {c10} MPa, \
+            "# synthetic needle record (tools/src/bin/make_gap_n3.rs): {}, C10 {c10} MPa, \
              noise sd {sd:.3e} N ({} % of peak, seed {seed})\ndisplacement_mm,force_N\n",
             model.name(),
             100.0 * fraction

@@ -1,5 +1,5 @@
 //! Writes the synthetic Q1 withheld-effect records of `tests/data/gap-q1/`
-//! (used by `examples/gap_fe_effects.rs`): the Q1 flat punch (BENCHMARKS.md Q1,
+//! (used by `gap_fe_effects`): the Q1 flat punch (BENCHMARKS.md Q1,
 //! radius 2 mm, edge 0.2 mm, frictionless) ramped to 0.5 mm in 0.25 s and
 //! held 4 s — a short protocol so that one viscoelastic run of the base
 //! costs seconds and a diagnosis minutes (the first records, 1 mm and a 10 s
@@ -22,7 +22,6 @@ use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 struct Case {
     name: &'static str,
@@ -111,7 +110,7 @@ fn main() {
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(c.seed);
         let noise = Normal::new(0.0, sd).expect("noise sd");
         let mut csv = format!(
-            "# synthetic Q1 record (tests/examples/make_gap_q1.rs): neo-Hookean C10 = {} MPa, \
+            "# synthetic Q1 record (tools/src/bin/make_gap_q1.rs): neo-Hookean C10 = {} MPa, \
              Prony {:?}, mesh level 2, noise sd {:.3e} N (seed {})\n\
              time_s,displacement_mm,force_N\n",
             c.c10, c.prony, sd, c.seed

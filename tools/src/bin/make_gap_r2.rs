@@ -1,5 +1,5 @@
 //! Writes the synthetic R2 withheld-effect records of `tests/data/gap-r2/`
-//! (issue 14, item 5; used by `examples/gap_fe_effects.rs -- r2` and
+//! (used by `gap_fe_effects -- r2` and
 //! `tests/integration/gap_fe_effects.rs`): the R2 development pass (`palpate_tests::
 //! r2_dev`: an 80 x 20 mm neo-Hookean block, wheel of diameter 8 mm rolled at
 //! RD 3 mm from x = 28 to 52 mm, vertical force every 1 mm, 25 samples)
@@ -28,7 +28,6 @@ use palpate_tests::r2_dev;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 struct Case {
     name: &'static str,
@@ -131,7 +130,7 @@ fn main() {
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(c.seed);
         let noise = Normal::new(0.0, sd).expect("noise sd");
         let mut csv = format!(
-            "# synthetic R2 record (tests/examples/make_gap_r2.rs): {}, theta {:?}, 1 mm mesh, \
+            "# synthetic R2 record (tools/src/bin/make_gap_r2.rs): {}, theta {:?}, 1 mm mesh, \
              noise sd {:.3e} N (seed {})\nposition_mm,force_N\n",
             model.name(),
             theta,

@@ -1,4 +1,4 @@
-//! Writes the development records of gap diagnosis v2 (issue 14) to
+//! Writes the development records of gap diagnosis v2 to
 //! `tests/data/gap-v2/`, one group per weakness of the first version, each
 //! record seeded and with its truth in `truth.json` (used by
 //! `tests/integration/gap_v2.rs`):
@@ -34,7 +34,6 @@ use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 /// A C1 history sampled every `dt` s: a ramp at `rate` mm/s to `depth`,
 /// a hold of `hold` s, and an unloading at the same rate when `unload`.
@@ -203,7 +202,7 @@ fn main() {
         let e = noise(r.clean.len(), r.sd, r.phi, r.seed);
         let timed = r.loading.time.is_some();
         let mut csv = format!(
-            "# gap diagnosis v2 development record (tests/examples/make_gap_v2.rs), seed {}, noise sd {:.4e} N, AR(1) phi {}\n{}displacement_mm,force_N\n",
+            "# gap diagnosis v2 development record (tools/src/bin/make_gap_v2.rs), seed {}, noise sd {:.4e} N, AR(1) phi {}\n{}displacement_mm,force_N\n",
             r.seed,
             r.sd,
             r.phi,

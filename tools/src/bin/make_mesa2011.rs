@@ -41,7 +41,6 @@ use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 /// ecoflex-rp2 (BENCHMARKS.md), MPa.
 const RP2: [f64; 2] = [686.428e-6, 1929.606e-6];
@@ -67,7 +66,7 @@ fn main() {
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(2011);
     let noise = Normal::new(0.0, sd).expect("sd");
     let mut csv = format!(
-        "# synthetic C1 compression record (tests/examples/make_mesa2011.rs): ecoflex-rp2, \
+        "# synthetic C1 compression record (tools/src/bin/make_mesa2011.rs): ecoflex-rp2, \
          reduced polynomial N=2, C10 = {} MPa, C20 = {} MPa, analytic (lubricated), \
          2 mm at 0.4 mm/s sampled at 100 Hz, noise sd {sd:.4e} N (seed 2011)\n\
          displacement_mm,force_N\n",
@@ -127,7 +126,7 @@ fn main() {
         let delta: f64 = offset.sample(&mut rng);
         let mut csv = format!(
             "# synthetic needle record of the mesa2011 phantom, replicate {r} \
-             (tests/examples/make_mesa2011.rs): N3 block, 0.6 mm hexahedra, friction 0.8, \
+             (tools/src/bin/make_mesa2011.rs): N3 block, 0.6 mm hexahedra, friction 0.8, \
              Yeoh C10 = {} C20 = {} C30 = {C30} MPa; stiffness factor 1{s:+.5}, depth offset \
              {delta:+.4} mm, noise sd {sd:.4e} N (seed 2012)\n\
              displacement_mm,force_N\n",

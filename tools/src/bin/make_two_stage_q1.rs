@@ -21,15 +21,15 @@
 //! The record is committed; rerun only to change it:
 //! `cargo run --release -p palpate-tools --bin make_two_stage_q1`.
 //! With env `Q1_RECORD_DEPTH=D` (mm) the ramp goes to D instead, into
-//! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of BENCHMARKS.md runs
-//! since session 16's contact; its fit is a study, not a test).
+//! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of BENCHMARKS.md; its fit is a
+//! study, not a test).
 //! With env `Q1_RECORD_LEVEL=L` the record is made on mesh level L instead
 //! of 2 (the 5 mm record is level 3, finer than the level-2 mesh that
 //! corrects its fits: `--correct-mesh`).
 //! With env `Q1_RECORD_EDGE=R` (mm) the punch's edge is rounded to R instead
 //! of 0.2 mm, into `tests/data/two-stage-q1-Dmm-edgeR/` (an edge the meshes
 //! resolve: the 5 mm record whose fit is not limited by the 0.2 mm edge's
-//! discretisation error; docs/guide.md, session 24).
+//! discretisation error; docs/guide.md, two-stage).
 //! (`-- --time LEVEL DT` instead times one run of the record's history).
 
 use palpate_core::{Drive, ForwardModel, Loading};
@@ -38,7 +38,6 @@ use palpate_material::Law;
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::path::Path;
 
 /// The truth: C10 (MPa), g1, tau1 (s), g2, tau2 (s).
 const TRUTH: [f64; 5] = [0.0016, 0.3, 0.5, 0.2, 10.0];
@@ -139,7 +138,7 @@ fn main() {
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(13);
     let noise = Normal::new(0.0, sd).expect("sd");
     let mut csv = format!(
-        "# synthetic Q1 ramp-and-hold record (tests/examples/make_two_stage_q1.rs): flat punch r 2 mm \
+        "# synthetic Q1 ramp-and-hold record (tools/src/bin/make_two_stage_q1.rs): flat punch r 2 mm \
          (edge {edge_mm} mm), neo-Hookean C10 = {} MPa, Prony g1 = {}, tau1 = {} s, g2 = {}, tau2 = {} s, \
          {depth} mm in {RAMP} s, hold {HOLD} s, mesh level {level}, time step 0.25 s, noise sd {sd:.4e} N (seed 13)\n\
          time_s,displacement_mm,force_N\n",

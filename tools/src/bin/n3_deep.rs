@@ -1,4 +1,4 @@
-//! Diagnostic (issue 12): N3 with 27-node hexahedra, frictionless, run to
+//! Diagnostic: N3 with 27-node hexahedra, frictionless, run to
 //! `DEPTH` (mm) every 0.25 mm; writes the deformed state's VTU to `OUT` and
 //! prints, for the cells whose smallest Gauss-point det F or corner
 //! Jacobian of the deformed geometry is lowest, where they are.

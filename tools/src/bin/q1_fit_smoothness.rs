@@ -1,7 +1,7 @@
 //! Is a Q1 fit mesh's force smooth in the parameters at depth? The 5 mm
 //! record's history (tests/data/two-stage-q1-5mm) run on a mesh of `H` mm
-//! under a punch with an edge of `EDGE` mm at the point where session 18's
-//! staged polish stopped (C10 0.00166, g1 0.327, tau1 0.306 s, g2 0.206,
+//! under a punch with an edge of `EDGE` mm at the point where a staged
+//! polish stopped (C10 0.00166, g1 0.327, tau1 0.306 s, g2 0.206,
 //! tau2 8.30 s), each `J:REL` changing parameter `J` by `REL` of itself;
 //! prints the force at a half, three quarters and the end of the ramp, 20
 //! samples into the hold and at its end:
@@ -18,7 +18,10 @@ fn main() {
     let a: Vec<String> = std::env::args().collect();
     let h: f64 = a[1].parse().unwrap();
     let edge: f64 = a[2].parse().unwrap();
-    let rec = std::fs::read_to_string(palpate_tools::repo("tests/data/two-stage-q1-5mm/record.csv")).unwrap();
+    let rec = std::fs::read_to_string(palpate_tools::repo(
+        "tests/data/two-stage-q1-5mm/record.csv",
+    ))
+    .unwrap();
     let (mut t, mut d) = (vec![], vec![]);
     for l in rec.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();

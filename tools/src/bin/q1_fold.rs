@@ -1,5 +1,5 @@
 //! Q1's top-surface nodes near the punch edge against depth, sampled finely
-//! before the stop near 2 mm (docs/validation/fe.md "Q1", session 14): does
+//! before the stop near 2 mm (docs/validation/fe.md "Q1"): does
 //! the equilibrium path turn (a fold, where the nodes would run away as the
 //! stop nears) or stay straight up to it?
 //!

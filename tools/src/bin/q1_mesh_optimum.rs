@@ -10,8 +10,7 @@
 //! Q1 ... --correct-mesh`); if the step from it is small against the
 //! standard errors, that estimate is the mesh's own optimum and a bias in
 //! it is the mesh's (not the correction's fixed point); if the step is
-//! large, the correction settles elsewhere (docs/guide.md, two-stage,
-//! session 22). `noise-free` fits the record's noise-free force
+//! large, the correction settles elsewhere (docs/guide.md, two-stage). `noise-free` fits the record's noise-free force
 //! (truth.json) instead of the record. It prints the forward and backward
 //! differences' largest disagreement per parameter (a branch jump shows
 //! there), the step and the point it reaches. 11 runs, in parallel; env
@@ -35,7 +34,10 @@ fn main() {
     let theta: Vec<f64> = a[4].split(',').map(|x| x.parse().expect("point")).collect();
     assert_eq!(theta.len(), 5, "five parameters");
     let noise_free = a.get(5).is_some_and(|s| s == "noise-free");
-    let rec = std::fs::read_to_string(palpate_tools::repo("tests/data/two-stage-q1-5mm/record.csv")).expect("record");
+    let rec = std::fs::read_to_string(palpate_tools::repo(
+        "tests/data/two-stage-q1-5mm/record.csv",
+    ))
+    .expect("record");
     let (mut t, mut d, mut f) = (vec![], vec![], vec![]);
     for l in rec.lines().filter(|l| !l.starts_with('#')).skip(1) {
         let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
@@ -45,7 +47,10 @@ fn main() {
     }
     if noise_free {
         let truth: serde_json::Value = serde_json::from_str(
-            &std::fs::read_to_string(palpate_tools::repo("tests/data/two-stage-q1-5mm/truth.json")).expect("truth"),
+            &std::fs::read_to_string(palpate_tools::repo(
+                "tests/data/two-stage-q1-5mm/truth.json",
+            ))
+            .expect("truth"),
         )
         .expect("truth.json");
         f = truth["noise_free_force_N"]

@@ -1,4 +1,4 @@
-//! Why the R2 wheel feels a horizontal force at x = 10 mm (issue 11): a
+//! Why the R2 wheel feels a horizontal force at x = 10 mm: a
 //! frictionless wheel pressed into a block is pushed sideways only when the
 //! block is not mirror-symmetric about the wheel. Presses to RD on the
 //! block without nodules at positions near the left end (x = 0), mid-block,

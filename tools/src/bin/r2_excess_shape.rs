@@ -1,5 +1,5 @@
 //! How the excess force of one R2 nodule, E(p; x_n, d) = F(p) - F0(p),
-//! changes with the nodule's distance to the block's end (issue 11: the
+//! changes with the nodule's distance to the block's end (the
 //! localisation's x bias near the ends). For each nodule position x_n and
 //! depth d the wheel is rolled over the window x_n - 30 .. x_n + 30 mm
 //! (clipped to the path 10..140) and F0 is one nodule-free pass; the table
