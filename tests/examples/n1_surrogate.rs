@@ -10,7 +10,7 @@
 //! C20 = 1929.606 Pa), every 0.25 mm to 10 mm, plus Gaussian noise of SD 2 %
 //! of the peak force (seeded).
 //!
-//!     cargo run --release -p palpate-uq --example n1_surrogate [RUNS]
+//!     cargo run --release -p palpate-tests --example n1_surrogate [RUNS]
 
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::{Bulk, MeshDensity, N1Needle};
