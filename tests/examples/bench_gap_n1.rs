@@ -1,4 +1,4 @@
-//! Speed of the N1 gap diagnosis (issue 14, item 6: a 10 mm record in 60 s
+//! Speed of the N1 gap diagnosis (goal: a 10 mm record in 60 s
 //! or less on 2 cores). Writes (once, to `target/bench_gap_n1.csv`) a 10 mm
 //! needle record every 0.25 mm (41 samples) with friction 0.5 on the MEDIUM
 //! mesh, C10 1.2e-3 MPa, noise 1 % of the peak force, then diagnoses it

@@ -4,23 +4,14 @@
 //!
 //! Helpers shared by those tests live here.
 
-use std::path::PathBuf;
-
-/// Path of a file in the shared folder beside the workspace (`../shared`).
-pub fn shared(rel: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared")
-        .join(rel)
-}
-
-/// The R2 development experiment of the gap diagnosis (issue 14, item 5):
+/// The R2 development experiment of the gap diagnosis:
 /// a shorter, thinner block than BENCHMARKS.md R2 so that one rolled pass
 /// costs seconds, not minutes — 80 mm long, 20 mm high, 50 mm thick,
 /// neo-Hookean tissue, no nodule, bonded bottom, frictionless wheel of
 /// diameter 8 mm rolled at RD 3 mm from x = 28 to 52 mm in steps of at most
 /// 1 mm (R2's 0.5 mm steps double the cost for the same forces within the
 /// solver tolerance); the records
-/// (`examples/make_gap_r2.rs`) and the diagnoses (`examples/gap_fe_effects.rs
+/// (`tools/src/bin/make_gap_r2.rs`) and the diagnoses (`tools/src/bin/gap_fe_effects.rs
 /// -- r2`, `tests/integration/gap_fe_effects.rs`) share it.
 pub mod r2_dev {
     use palpate_core::{Drive, Loading};

@@ -14,9 +14,9 @@ use palpate_enrich::{qlv_convolve, ToolCompliance, Viscoelastic, ZeroOffset};
 use palpate_material::{Law, Volumetric};
 use std::path::Path;
 
-fn shared(rel: &str) -> std::path::PathBuf {
+fn test_data(rel: &str) -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared")
+        .join("../../tests/data")
         .join(rel)
 }
 
@@ -70,7 +70,7 @@ fn neo_hookean_homogeneous_closed_forms() {
 
 #[test]
 fn c1_force_matches_the_reference_table_at_2_mm() {
-    let table = Table::read(shared("reference/calculix/c1/analytic_uniaxial.csv")).unwrap();
+    let table = Table::read(test_data("calculix/c1/analytic_uniaxial.csv")).unwrap();
     let strain = table.column("strain").unwrap();
     let row = strain
         .iter()

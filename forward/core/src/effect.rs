@@ -98,11 +98,20 @@ mod tests {
     fn names_round_trip() {
         for e in Effect::ALL {
             assert_eq!(e.name().parse::<Effect>().unwrap(), e);
-            assert_eq!(serde_json_like(e), e.name());
+            assert_eq!(e.to_string(), e.name());
         }
         assert!("viscosity".parse::<Effect>().is_err());
     }
-    fn serde_json_like(e: Effect) -> String {
-        format!("{e}")
+
+    /// JSON (results, reports) spells an effect as its canonical name and
+    /// reads it back.
+    #[test]
+    fn serde_round_trips_through_the_canonical_name() {
+        for e in Effect::ALL {
+            let json = serde_json::to_string(&e).unwrap();
+            assert_eq!(json, format!("\"{}\"", e.name()));
+            assert_eq!(serde_json::from_str::<Effect>(&json).unwrap(), e);
+        }
+        assert!(serde_json::from_str::<Effect>("\"viscosity\"").is_err());
     }
 }

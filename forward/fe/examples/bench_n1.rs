@@ -1,7 +1,7 @@
 //! Benchmark: N1 (BENCHMARKS.md) neo-Hookean `ecoflex-nh`,
 //! friction 0.8, bonded base, exact incompressibility, needle to 10 mm with
 //! the force every 0.25 mm, on 1 and 2 threads, against CalculiX on the
-//! reference deck `../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp`.
+//! reference deck `tests/data/calculix/n1/n1_nh_f0.8_k1000_n6.inp`.
 //!
 //! Meshes: the Q2/P1 benchmark mesh ([`Q9_GRADING`], 9-node cells with a
 //! discontinuous linear pressure), the Q1/P0 benchmark mesh ([`MeshDensity::BENCH_GRADING`], the cheapest
@@ -149,7 +149,7 @@ fn run(case: Case, threads: usize) -> Run {
 /// Reruns CalculiX on the reference deck: (wall, CPU) seconds.
 fn calculix() -> Option<(f64, f64)> {
     let deck = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.inp");
+        .join("../../tests/data/calculix/n1/n1_nh_f0.8_k1000_n6.inp");
     let dir = std::env::temp_dir().join(format!("palpate_bench_ccx_{}", std::process::id()));
     std::fs::create_dir_all(&dir).ok()?;
     std::fs::copy(&deck, dir.join("n1.inp")).ok()?;

@@ -3,7 +3,7 @@
 //! `W = mu sum_{i=1..5} C_i / lambda_m^(2i-2) (I1b^i - 3^i)` with
 //! `C = 1/2, 1/20, 11/1050, 19/7000, 519/673750` (Arruda & Boyce 1993, series of the inverse
 //! Langevin function as in the Abaqus Theory Manual, "Hyperelastic material behavior"; see
-//! `shared/BENCHMARKS.md`). The initial shear modulus is
+//! `docs/benchmarks.md`). The initial shear modulus is
 //! `mu0 = 2 dW/dI1 (I1 = 3) = mu (1 + 3/(5 lm^2) + 99/(175 lm^4) + 513/(875 lm^6) + 42039/(67375 lm^8))`.
 
 use crate::InvariantDerivs;

@@ -416,7 +416,7 @@ fn shear_modulus_is_the_small_strain_slope() {
 
 fn read_curve(name: &str) -> Vec<(f64, f64)> {
     let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/data/treloar")
+        .join("../../studies/data/treloar")
         .join(name);
     let text = std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     text.lines()
@@ -715,7 +715,7 @@ fn compressible_uniaxial_converges_at_extreme_stretches() {
 
 #[test]
 fn benchmark_materials_are_valid_and_drucker_stable() {
-    // shared/BENCHMARKS.md, Materials (1 Pa = 1e-6 MPa).
+    // docs/benchmarks.md, Materials (1 Pa = 1e-6 MPa).
     let materials = [
         ("ecoflex-nh", Law::NeoHookean, vec![1101.295e-6]),
         (

@@ -19,7 +19,7 @@
 //!
 //! [response.calibration]  # optional: each run is an analytic calibration
 //! metric = "r2"           # r2 or rms of the fit
-//! data = { uniaxial = "../../../shared/data/treloar/uniaxial.csv" }
+//! data = { uniaxial = "../data/treloar/uniaxial.csv" }
 //!
 //! [analysis]              # optional
 //! max_order = 1

@@ -736,8 +736,8 @@ fn fixed_values_outside_the_laws_domain_name_the_option() {
     // C01 < 0 is allowed while C10 + C01 > 0: the fit starts inside that
     // domain (C10 above 0.1 MPa) instead of failing on a NaN at its start.
     let brain = format!(
-        "uniaxial={}/../shared/data/real/brain_budday2017/cortex_compression_tension.csv",
-        env!("CARGO_MANIFEST_DIR").trim_end_matches("/studies")
+        "uniaxial={}/data/real/brain_budday2017/cortex_compression_tension.csv",
+        env!("CARGO_MANIFEST_DIR")
     );
     for data in [&u, &brain] {
         let json = s.path("fit.json").display().to_string();

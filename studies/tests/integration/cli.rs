@@ -553,7 +553,7 @@ fn the_report_says_when_a_parameter_ends_on_its_bound() {
              [[steps]]\n[steps.calibrate]\nname = \"fit\"\nmodels = [\"ogden2\"]\n\
              fits = {{ uniaxial = [\"uniaxial\"] }}\nresiduals = [\"absolute\"]\n",
             Path::new(env!("CARGO_MANIFEST_DIR"))
-                .join("../../shared/data/real/brain_budday2017/cortex_compression_tension.csv")
+                .join("data/real/brain_budday2017/cortex_compression_tension.csv")
                 .display()
         ),
     )

@@ -84,7 +84,7 @@ fn a_record_of_the_base_law_gets_none() {
 fn a_real_brain_record_is_diagnosed_end_to_end() {
     let s = Scratch::new();
     let f = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data/real/brain_budday2017/cortex_compression_tension.csv");
+        .join("data/real/brain_budday2017/cortex_compression_tension.csv");
     let data = format!("uniaxial={}", f.display());
     let r = diagnose(&s, &["--data", &data, "--law", "neo-hookean"]);
     assert!(r["verdict"].is_string(), "{r:#}");

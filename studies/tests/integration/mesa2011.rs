@@ -284,20 +284,3 @@ fn new_steps_are_validated_naming_the_manifest_and_the_field() {
         .to_string();
     assert!(e.contains("m.toml") && e.contains("calibraton"), "{e}");
 }
-
-#[test]
-fn the_published_table_is_the_shared_one() {
-    let shared = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data/published/mesa2011_table1.csv");
-    let Ok(shared) = std::fs::read_to_string(shared) else {
-        return; // outside the project's checkout there is no ../shared
-    };
-    let ours = std::fs::read_to_string(data_dir().join("published-table1.csv")).unwrap();
-    let rows = |t: &str| -> Vec<String> {
-        t.lines()
-            .filter(|l| !l.starts_with('#'))
-            .map(str::to_string)
-            .collect()
-    };
-    assert_eq!(rows(&ours), rows(&shared));
-}

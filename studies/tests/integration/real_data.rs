@@ -1,4 +1,4 @@
-//! Every file in `../shared/data/real` loads without editing and fits: the
+//! Every file in `studies/data/real` loads without editing and fits: the
 //! test walks the directory, so a new file with no known test kind fails it.
 //! Each record gets a neo-Hookean fit (one parameter, cheap); the timed VHB
 //! records also a one-term QLV fit. The full comparison of laws is
@@ -12,7 +12,7 @@ use palpate_studies::models::Viscous;
 use std::path::{Path, PathBuf};
 
 fn real() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/real")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data/real")
 }
 
 /// The `--data` option of a file, from its folder and name (the same

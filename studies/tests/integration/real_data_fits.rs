@@ -34,7 +34,7 @@ fn law_of(name: &str) -> Law {
 }
 
 fn records(case: &Value) -> Vec<TestData> {
-    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/real");
+    let real = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/real");
     let specs: Vec<String> = case["data"]
         .as_array()
         .unwrap()

@@ -2,9 +2,9 @@
 //! neo-Hookean `ecoflex-nh`, friction 0.8): the coarse (level 1, 864
 //! elements) and medium (level 2, 3286 elements) meshes agree within 0.5 %
 //! at 2 mm (0.36 %), and both agree with the CalculiX reference within its error budget
-//! (../shared/reference/calculix/README.md: mesh 0.3 %, penalty contact
+//! (tests/data/calculix/README.md: mesh 0.3 %, penalty contact
 //! 0.4-0.8 % low). The full study on three meshes to 10 mm (observed order,
-//! extrapolated force) is `forward/fe/examples/convergence_n1.rs`, numbers in
+//! extrapolated force) is `tools/src/bin/convergence_n1.rs`, numbers in
 //! docs/validation/fe.md.
 
 use std::path::Path;
@@ -25,8 +25,7 @@ fn forces(level: usize, at: &[f64]) -> Vec<f64> {
 }
 
 fn calculix(at: f64) -> f64 {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/reference/calculix/n1/n1_nh_f0.8_k1000_n6.csv");
+    let p = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/calculix/n1/n1_nh_f0.8_k1000_n6.csv");
     let t = Table::read(&p).unwrap();
     let (x, y) = (
         t.column("displacement_mm").unwrap(),

@@ -1,6 +1,6 @@
-//! Sim-to-real gap diagnosis on benchmark C1 (GAP.md, issue 6):
+//! Sim-to-real gap diagnosis on benchmark C1 (GAP.md):
 //!
-//! * the withheld-effect cases of `shared/data/gap-dev/c1` (generated outside
+//! * the withheld-effect cases of `studies/data/gap-dev/c1` (generated outside
 //!   this project): verdict, planted parameters, held-out misfit;
 //! * synthetic cases of our own, from the analytic models with other seeds,
 //!   strengths, noise levels and protocols (the method is judged on cases
@@ -16,7 +16,7 @@ use palpate_uq::gap::{diagnose, GapError, GapOptions, GapReport, RankedEffect};
 use std::path::{Path, PathBuf};
 
 fn gap_dev_dir() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/gap-dev/c1")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../studies/data/gap-dev/c1")
 }
 
 fn read_case(name: &str) -> (Loading, Vec<f64>) {

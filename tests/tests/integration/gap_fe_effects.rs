@@ -1,10 +1,10 @@
-//! Gap diagnosis on every FE model (issue 14, item 5). The cheap tests run
+//! Gap diagnosis on every FE model. The cheap tests run
 //! in CI; the full diagnoses of the development records are `#[ignore]`d
 //! (minutes of CPU each) and run with
 //!
 //!     cargo test -p palpate-tests --test integration gap_fe_effects:: -- --ignored
 //!
-//! (or the release example `examples/gap_fe_effects.rs`, which prints the
+//! (or the release program `tools/src/bin/gap_fe_effects.rs`, which prints the
 //! table of docs/gap-diagnosis.md).
 //!
 //! * Q1 (`viscoelasticity`): the enrichment's "off" point and its
@@ -276,7 +276,7 @@ fn check_verdicts(
     assert!(wrong.is_empty(), "{wrong:?}");
 }
 
-/// The R2 development records (`examples/make_gap_r2.rs`: 1 mm mesh) against
+/// The R2 development records (`tools/src/bin/make_gap_r2.rs`: 1 mm mesh) against
 /// the 2 mm base with its three effects. Heavy: some 50-80 passes of 8 s of
 /// CPU per record.
 #[test]
@@ -286,7 +286,7 @@ fn r2_records_get_the_expected_verdicts() {
     check_verdicts("gap-r2", Drive::PositionMm, &base, None);
 }
 
-/// The Q1 development records (`examples/make_gap_q1.rs`: two-term
+/// The Q1 development records (`tools/src/bin/make_gap_q1.rs`: two-term
 /// generator, steps of tau_min / 10) against the elastic punch on mesh
 /// level 2 with `viscoelasticity`.
 #[test]
@@ -302,7 +302,7 @@ fn q1_records_get_the_expected_verdicts() {
     );
 }
 
-/// The needle records of `tests/data/gap-n3/` (`examples/make_gap_n3.rs`)
+/// The needle records of `tests/data/gap-n3/` (`tools/src/bin/make_gap_n3.rs`)
 /// against the coarse axisymmetric N1 base with `modelling_space` and
 /// `friction`.
 #[test]

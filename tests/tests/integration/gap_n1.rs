@@ -1,7 +1,7 @@
-//! Sim-to-real gap diagnosis on benchmark N1 (issue 6): the finite-element
+//! Sim-to-real gap diagnosis on benchmark N1: the finite-element
 //! needle model as the base (neo-Hookean, frictionless needle, bonded base,
 //! coarse mesh), on the synthetic withheld-effect records of
-//! `tests/data/gap-n1/` (written by `examples/make_gap_n1.rs` on the MEDIUM
+//! `tests/data/gap-n1/` (written by `tools/src/bin/make_gap_n1.rs` on the MEDIUM
 //! mesh, so the data do not share the base model's discretisation):
 //!
 //! * planted friction 0.5 -> verdict `friction`, friction within 3 standard

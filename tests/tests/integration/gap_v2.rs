@@ -1,6 +1,6 @@
-//! Gap diagnosis v2 (issue 14) on the development records of
+//! Gap diagnosis v2 on the development records of
 //! `tests/data/gap-v2/` (seeded, with truth; written by
-//! `examples/make_gap_v2.rs`), one group per weakness of the first version:
+//! `tools/src/bin/make_gap_v2.rs`), one group per weakness of the first version:
 //!
 //! 1. a true effect must not be rejected by its own cross-validation: fast
 //!    ramp, long hold, two-term relaxation -> `viscoelasticity` on every

@@ -1,11 +1,16 @@
-//! Every model kind runs through `Box<dyn ForwardModel>` (as studies hold
-//! them), every declared enrichment can be built and reproduces its base at
-//! the "effect off" point, and evaluation in parallel threads gives
+//! Every analytic model kind, and the FE C1 model with bonded and with
+//! frictionless platens (the cheapest FE model: the FE models share one
+//! `ForwardModel` and `Enrichable` implementation, so one stands for the
+//! scaffolding of all), runs through `Box<dyn ForwardModel>` (as studies hold
+//! them), every declared enrichment (every analytic model declares some; FE
+//! C1 declares none) can be built and reproduces its base at the "effect
+//! off" point, and evaluation in parallel threads gives
 //! bit-identical predictions to serial evaluation.
 
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::enrichable::{effects_of, embed, enrich};
 use palpate_core::{Drive, ForwardModel, Loading};
+use palpate_fe::{C1Fe, Platens};
 use palpate_material::Law;
 use rayon::prelude::*;
 
@@ -45,9 +50,22 @@ fn analytic_models() -> Vec<(Box<dyn ForwardModel>, Loading)> {
     v
 }
 
+/// The analytic models, then C1 by finite elements on its default 19 x 9
+/// mesh, compressed 0.4 mm in two timed samples (timed, so that the
+/// viscoelastic enrichment applies too).
+fn models() -> Vec<(Box<dyn ForwardModel>, Loading)> {
+    let mut v = analytic_models();
+    let law: Law = "neo-hookean".parse().unwrap();
+    for platens in [Platens::Bonded, Platens::Frictionless] {
+        let loading = Loading::timed(Drive::DisplacementMm, vec![0.5, 1.0], vec![0.2, 0.4]);
+        v.push((Box::new(C1Fe::new(law, platens)), loading));
+    }
+    v
+}
+
 #[test]
 fn every_model_predicts_through_the_trait_object() {
-    for (m, loading) in analytic_models() {
+    for (m, loading) in models() {
         let theta = m.space().initial();
         let f = m
             .predict(&theta, &loading)
@@ -61,11 +79,16 @@ fn every_model_predicts_through_the_trait_object() {
 
 #[test]
 fn every_declared_enrichment_is_off_at_its_embedding() {
-    for (m, loading) in analytic_models() {
+    // every analytic model has the capability, reached through the trait object
+    for (m, _) in analytic_models() {
+        assert!(m.as_enrichable().is_some(), "{}", m.name());
+    }
+    for (m, loading) in models() {
+        if m.as_enrichable().is_none() {
+            continue; // FE C1: nothing declared
+        }
         let theta = m.space().initial();
         let base = m.predict(&theta, &loading).unwrap();
-        // every analytic model has the capability, reached through the trait object
-        assert!(m.as_enrichable().is_some(), "{}", m.name());
         for effect in effects_of(m.as_ref()) {
             let enriched = enrich(m.as_ref(), effect)
                 .unwrap_or_else(|e| panic!("{} + {effect}: {e}", m.name()));
@@ -87,7 +110,7 @@ fn every_declared_enrichment_is_off_at_its_embedding() {
 
 #[test]
 fn parallel_and_serial_evaluation_are_bit_identical() {
-    let models = analytic_models();
+    let models = models();
     let thetas: Vec<Vec<f64>> = (0..8)
         .map(|k| {
             let m = &models[0].0;

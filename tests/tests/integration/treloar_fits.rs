@@ -17,8 +17,8 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-fn shared() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data/treloar")
+fn treloar() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../studies/data/treloar")
 }
 
 fn data_set(law: Law, mode: &str) -> DataSet {
@@ -28,7 +28,7 @@ fn data_set(law: Law, mode: &str) -> DataSet {
         "planar" => "pure_shear.csv",
         other => panic!("unknown mode {other}"),
     };
-    let table = Table::read(shared().join(file)).unwrap();
+    let table = Table::read(treloar().join(file)).unwrap();
     let stretch = table.column("stretch").unwrap().to_vec();
     let stress = table.column("stress_MPa").unwrap().to_vec();
     let model = Homogeneous::new(law, mode.parse::<Mode>().unwrap());

@@ -17,8 +17,8 @@ use palpate_uq::stats::PBound;
 use std::path::Path;
 
 fn table1() -> palpate_uq::anova::Analysis {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../shared/data/published/mesa2011_table1.csv");
+    let path =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../tests/data/mesa2011/published-table1.csv");
     let t = RunsTable::read(&path).unwrap();
     let factors = vec![t.factor("material").unwrap(), t.factor("space").unwrap()];
     let y = t.numeric("r2").unwrap();

@@ -1,4 +1,4 @@
-//! C1 with bonded platens against CalculiX (../shared/reference/calculix/c1,
+//! C1 with bonded platens against CalculiX (tests/data/calculix/c1,
 //! 38 x 18 CAX8R, K = 1000 mu): same K and element count, agreement within
 //! 3 %; the exactly incompressible model comes out at or above the
 //! K = 1000 mu curve at 2 mm, as the README expects of a locking-free model.
@@ -11,7 +11,7 @@ use palpate_fe::{Bulk, C1Fe, Platens};
 #[test]
 fn bonded_c1_matches_calculix_and_exact_is_stiffer() {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/reference/calculix/c1/c1_nh_bonded_k1000_m38x18_force.csv");
+        .join("../../tests/data/calculix/c1/c1_nh_bonded_k1000_m38x18_force.csv");
     let t = Table::read(&p).unwrap();
     let (x, y) = (
         t.column("displacement_mm").unwrap(),

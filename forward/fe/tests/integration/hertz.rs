@@ -245,20 +245,3 @@ fn sphere_force_tends_to_hertz_at_small_depth() {
     assert!(dev.iter().all(|r| r.abs() < 0.012), "{msg}");
     assert!(rel.iter().all(|r| r.abs() < CCX_TOLERANCE), "{msg}");
 }
-
-/// Prints the FE curve of the docs table (CSV on stderr):
-/// `cargo test -p palpate-fe --test integration hertz::print_fe_curve -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn print_fe_curve() {
-    let depths: Vec<f64> = (1..=10).map(|k| 0.025 * k as f64).collect();
-    let f = forces(&sphere_model(0.04, 1.2, 1.0, depths[0]), &depths);
-    eprintln!("depth_mm,force_N,fe_over_hertz_minus_1,fe_over_sneddon_minus_1");
-    for (d, f) in depths.iter().zip(&f) {
-        eprintln!(
-            "{d:.4},{f:.9e},{:.5},{:.5}",
-            f / hertz(*d) - 1.0,
-            f / sneddon(*d) - 1.0
-        );
-    }
-}

@@ -1,7 +1,7 @@
 //! N1 needle indentation (BENCHMARKS.md) on the coarse mesh:
 //! all four {neo-Hookean, reduced polynomial} x {friction 0, 0.8} cases reach
 //! 10 mm, and the neo-Hookean curves agree with the CalculiX reference
-//! (../shared/reference/calculix/n1) within its stated uncertainty plus 2 %.
+//! (tests/data/calculix/n1) within its stated uncertainty plus 2 %.
 //!
 //! CalculiX uses K = 1000 mu; these runs use exact incompressibility
 //! (faster here), whose forces are at most ~0.1 % above K = 1000 mu.
@@ -27,7 +27,7 @@ fn model(law: &str, friction: f64) -> N1Needle {
 
 fn reference(name: &str) -> (Vec<f64>, Vec<f64>) {
     let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("../../../shared/reference/calculix/n1")
+        .join("../../tests/data/calculix/n1")
         .join(name);
     let t = Table::read(&p).unwrap();
     (
