@@ -4,7 +4,7 @@
 use crate::boundary_polish::boundary_polish;
 use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
-use crate::wall_slide::wall_slide;
+use crate::wall_slide::{limit_ahead, wall_slide};
 use crate::{
     covariance, jacobian_unbounded, sum_of_squares, BoundSide, FdOptions, FitReport, InverseError,
     Method, Objective, ParameterEstimate, SetReport, SharedObserver,
@@ -157,7 +157,9 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
         reason: "no start produced a finite SSE".into(),
     })?;
     // A run that ended against an admissibility limit (a failed trial step)
-    // continues along it (see `wall_slide`).
+    // continues along it (see `wall_slide`); whether it ended on that limit
+    // (not at a minimum short of it) is reported as `on_limit`.
+    let blocked = outcome.blocked;
     let outcome = match outcome.blocked {
         true => match wall_slide(objective, &options.fd, &outcome) {
             Some(slid) => {
@@ -180,6 +182,10 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
                 evaluations += polished.evaluations;
                 jacobians += polished.jacobians;
                 let mut report = statistics(&polished.objective, &polished.outcome.z, &options.fd)?;
+                if blocked {
+                    report.on_limit =
+                        limit_ahead(&polished.objective, &options.fd, &polished.outcome.z);
+                }
                 for &(k, side) in &polished.held {
                     report.parameters[k].fixed = false;
                     report.parameters[k].at_bound = Some(side);
@@ -191,7 +197,10 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
                 (polished.outcome, report)
             }
             None => {
-                let report = statistics(objective, &outcome.z, &options.fd)?;
+                let mut report = statistics(objective, &outcome.z, &options.fd)?;
+                if blocked {
+                    report.on_limit = limit_ahead(objective, &options.fd, &outcome.z);
+                }
                 (outcome, report)
             }
         };
@@ -330,5 +339,6 @@ pub fn statistics(
         failed_starts: 0,
         sets,
         identifiability: cov.identifiability,
+        on_limit: false,
     })
 }

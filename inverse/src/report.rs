@@ -88,6 +88,18 @@ pub struct FitReport {
     pub failed_starts: usize,
     pub sets: Vec<SetReport>,
     pub identifiability: Identifiability,
+    /// The optimum lies against an admissibility limit of the model that is
+    /// not a box bound (Mooney-Rivlin's `C10 + C01 > 0`): the Gauss-Newton
+    /// step from it reaches parameters the model refuses, so the fit stopped
+    /// on that limit rather than at a minimum. Standard errors, correlations
+    /// and `identifiability` assume an interior minimum and do not describe
+    /// such a fit. Serialised only when set.
+    #[serde(skip_serializing_if = "is_false")]
+    pub on_limit: bool,
+}
+
+fn is_false(b: &bool) -> bool {
+    !*b
 }
 
 impl FitReport {
@@ -109,5 +121,29 @@ impl FitReport {
     /// The full physical parameter vector.
     pub fn theta(&self) -> Vec<f64> {
         self.parameters.iter().map(|p| p.value).collect()
+    }
+
+    /// What holds the optimum other than the data, one phrase each: the
+    /// model's admissibility limit ([`FitReport::on_limit`]) and every
+    /// parameter on a bound of its range. Empty for an interior optimum.
+    pub fn constraints(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.on_limit {
+            out.push("stopped on an admissibility limit of the model".to_string());
+        }
+        for p in &self.parameters {
+            match p.at_bound {
+                Some(BoundSide::Lower) => out.push(format!("{} on its lower bound", p.name)),
+                Some(BoundSide::Upper) => out.push(format!("{} on its upper bound", p.name)),
+                None => {}
+            }
+        }
+        out
+    }
+
+    /// Whether the data alone determine the optimum: identifiable
+    /// parameters at an interior minimum (no [`FitReport::constraints`]).
+    pub fn determined(&self) -> bool {
+        self.identifiability.identifiable && self.constraints().is_empty()
     }
 }

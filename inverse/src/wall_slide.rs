@@ -121,6 +121,30 @@ fn solve(a: &DMatrix<f64>, b: &[f64]) -> Option<Vec<f64>> {
     x.iter().all(|v| v.is_finite()).then_some(x)
 }
 
+/// Whether the fit at `z` stopped on an admissibility limit: the
+/// Gauss-Newton step from `z` reaches parameters the model refuses, so the
+/// unconstrained minimum the local model points to lies beyond the limit.
+/// At an interior minimum that step is tiny and evaluates.
+pub(crate) fn limit_ahead(objective: &Objective, fd: &FdOptions, z: &[f64]) -> bool {
+    let mut w = Walker {
+        objective,
+        evaluators: objective.evaluators(),
+        evaluations: 0,
+    };
+    let Some((r, _)) = w.eval(z) else {
+        return false;
+    };
+    let Ok(jac) = jacobian_unbounded(objective, z, Some(&r), fd) else {
+        return false;
+    };
+    let minus_r: Vec<f64> = r.iter().map(|v| -v).collect();
+    let Some(h) = solve(&jac.matrix, &minus_r) else {
+        return false;
+    };
+    let ahead: Vec<f64> = z.iter().zip(&h).map(|(a, b)| a + b).collect();
+    !w.admissible(&ahead)
+}
+
 /// Continues a blocked run along the limit it ran into; `None` when nothing
 /// lowered the SSE.
 pub(crate) fn wall_slide(

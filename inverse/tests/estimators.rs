@@ -115,6 +115,10 @@ fn recovers_exponential_decay_without_noise() {
     // The report serialises (NaN -> null).
     let json = serde_json::to_string(&r).unwrap();
     assert!(json.contains("\"termination\""));
+    // An interior optimum: nothing holds it but the data, and the report
+    // does not carry the limit flag at all.
+    assert!(!r.on_limit && r.constraints().is_empty() && r.determined());
+    assert!(!json.contains("on_limit"));
 }
 
 #[test]
@@ -631,4 +635,13 @@ fn an_optimum_on_an_admissibility_limit_is_reached_along_it() {
         "SSE {} vs {sse_star}",
         r.sse
     );
+    // The fit is reported as held by the limit, not as a determined minimum.
+    assert!(r.on_limit);
+    assert_eq!(
+        r.constraints(),
+        ["stopped on an admissibility limit of the model"]
+    );
+    assert!(!r.determined());
+    let json = serde_json::to_value(&r).unwrap();
+    assert_eq!(json["on_limit"], true);
 }

@@ -5,13 +5,12 @@
 use crate::calibration::{calibrate, parse_method, Request, TestData};
 use crate::manifest::{CalibrateStep, ModelForm};
 use crate::output::write_atomic;
-use crate::report::fit_plot;
+use crate::report::{calibrate_tables, fit_plot, fit_row, r2_cells};
 use crate::runner::{FitEntry, Run, StepResult};
 use anyhow::Context;
-use palpate_inverse::{BoundSide, ResidualKind};
+use palpate_inverse::ResidualKind;
 use palpate_material::Law;
 use serde::{Deserialize, Serialize};
-use std::fmt::Write;
 
 /// A finished fit as cached: its results entry, its report rows and its plot.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -91,20 +90,8 @@ pub(crate) fn run_calibrate(
                         calibration,
                     };
                     Ok(FitUnit {
-                        row: fit_row(&fit),
-                        r2: fit
-                            .calibration
-                            .predictions
-                            .iter()
-                            .map(|p| {
-                                let cell = if p.fitted {
-                                    format!("{:.4}", p.r2)
-                                } else {
-                                    format!("*{:.4}*", p.r2)
-                                };
-                                (p.data.clone(), cell)
-                            })
-                            .collect(),
+                        row: fit_row(&fit.model, &fit.group, &fit.residual, &fit.calibration),
+                        r2: r2_cells(&fit.calibration),
                         plot: fit_plot(&fit.calibration).to_svg(),
                         entry: serde_json::to_value(&fit)?,
                     })
@@ -118,108 +105,19 @@ pub(crate) fn run_calibrate(
             }
         }
     }
-    write_calibrate_report(step, &units, report);
+    let rows: Vec<_> = units
+        .iter()
+        .map(|((m, g, r), u)| {
+            (
+                (m.as_str(), g.as_str(), r.as_str()),
+                u.row.as_str(),
+                &u.r2[..],
+            )
+        })
+        .collect();
+    report.push_str(&calibrate_tables(&step.name, &step.estimator, &rows));
     Ok(StepResult::Calibrate {
         name: step.name.clone(),
         fits: units.into_iter().map(|(_, u)| u.entry).collect(),
     })
-}
-
-/// The row of one fit in the report's fit table.
-fn fit_row(f: &FitEntry) -> String {
-    let c = &f.calibration;
-    let params: Vec<String> = c
-        .params
-        .iter()
-        .map(|(n, p)| {
-            // A parameter the fit left on a bound of its range (e.g. an Ogden
-            // exponent on ±OGDEN_ALPHA_BOUND) is said to be there.
-            let bound = c
-                .fit
-                .parameters
-                .iter()
-                .find(|q| &q.name == n)
-                .and_then(|q| q.at_bound)
-                .map(|side| match side {
-                    BoundSide::Lower => " (on its lower bound)".to_string(),
-                    BoundSide::Upper => " (on its upper bound)".to_string(),
-                })
-                .unwrap_or_default();
-            match p.standard_error {
-                Some(se) if c.identifiable => {
-                    format!("{n} = {:.5e} ± {:.2e}{bound}", p.value, se)
-                }
-                _ => format!("{n} = {:.5e}{bound}", p.value),
-            }
-        })
-        .collect();
-    let d = &c.drucker;
-    format!(
-        "| {} (`{}`) | {} | {} | {:.6e} | {:.5} | {} | {} | [{:.2}, {:.2}] / [{:.2}, {:.2}] / [{:.2}, {:.2}] |",
-        f.model,
-        c.law,
-        f.group,
-        f.residual,
-        c.sse,
-        c.r2,
-        if c.identifiable { "yes".to_string() } else { format!("**no** ({})", c.fit.identifiability.involved.join(", ")) },
-        params.join("<br>"),
-        d.uniaxial.lower,
-        d.uniaxial.upper,
-        d.biaxial.lower,
-        d.biaxial.upper,
-        d.planar.lower,
-        d.planar.upper
-    )
-}
-
-type FitName<'a> = (&'a String, &'a String, &'a String);
-
-fn write_calibrate_report(step: &CalibrateStep, fits: &[(FitName, FitUnit)], r: &mut String) {
-    let _ = writeln!(r, "## Calibration `{}`\n", step.name);
-    let _ = writeln!(r, "Estimator `{}`. R^2 = 1 - SS_res/SS_tot on the fitted data; predictions of the other tests use the fitted parameters.\n", step.estimator);
-    let _ = writeln!(r, "| model | fitted to | residual | SSE | R^2 (fit) | identifiable | parameters | Drucker stable (uniaxial / biaxial / planar) |");
-    let _ = writeln!(r, "|---|---|---|---|---|---|---|---|");
-    for (_, f) in fits {
-        let _ = writeln!(r, "{}", f.row);
-    }
-    // The data sets in order of first appearance.
-    let mut names: Vec<&String> = Vec::new();
-    for (d, _) in fits.iter().flat_map(|(_, f)| &f.r2) {
-        if !names.contains(&d) {
-            names.push(d);
-        }
-    }
-    let _ = writeln!(
-        r,
-        "\nR^2 on each data set (*italic*: predicted, not fitted):\n"
-    );
-    let header: Vec<&str> = names.iter().map(|n| n.as_str()).collect();
-    let _ = writeln!(
-        r,
-        "| model | fitted to | residual | {} |",
-        header.join(" | ")
-    );
-    let _ = writeln!(r, "|---|---|---|{}", "---|".repeat(names.len()));
-    for ((model, group, residual), f) in fits {
-        let cells: Vec<&str> = names
-            .iter()
-            .map(|n| {
-                f.r2.iter()
-                    .find(|(d, _)| d == *n)
-                    .map(|(_, c)| c.as_str())
-                    .unwrap_or("")
-            })
-            .collect();
-        let _ = writeln!(
-            r,
-            "| {model} | {group} | {residual} | {} |",
-            cells.join(" | ")
-        );
-    }
-    let _ = writeln!(
-        r,
-        "\nPlots: `plots/{}-<model>-<group>-<residual>.svg`.\n",
-        step.name
-    );
 }

@@ -344,6 +344,12 @@ pub struct Calibration {
     pub evaluations: usize,
     pub converged: bool,
     pub identifiable: bool,
+    /// Why the fitted law is degenerate, one phrase each: an initial shear
+    /// modulus of ~0, a data set it predicts as ~0 throughout
+    /// ([`degeneracy`]). Such a fit is not a description of the material
+    /// however well it matches. Serialised only when not empty.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub degenerate: Vec<String>,
     /// Stretch ranges where the calibrated law is Drucker stable.
     pub drucker: DruckerReport,
     pub predictions: Vec<Prediction>,
@@ -505,6 +511,7 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
         })
         .collect::<Vec<_>>();
     let params = NamedParams(params);
+    let degenerate = degeneracy(&req.law, &theta, &predictions);
     Ok(Calibration {
         law: req.law.to_string(),
         data: req.fitted.iter().map(|d| d.name.clone()).collect(),
@@ -518,11 +525,43 @@ pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
         evaluations: report.evaluations,
         converged: report.converged,
         identifiable: report.identifiability.identifiable,
+        degenerate,
         // A viscoelastic fit appends Prony terms: the law is the leading part.
         drucker: drucker(&req.law, &theta[..req.law.param_count().min(theta.len())]),
         predictions,
         fit: report,
     })
+}
+
+/// Relative size below which a shear modulus or a prediction counts as 0.
+const DEGENERATE: f64 = 1e-6;
+
+/// What makes a fitted law degenerate: its initial shear modulus is ~0
+/// (below 1e-6 of the sum of its moduli' magnitudes: Mooney-Rivlin held on
+/// `C01 = -C10`), or it predicts ~0 (below 1e-6 of the data's largest
+/// magnitude) at every sample of a data set (Mooney-Rivlin with
+/// `C01 = -C10` in planar tension). One phrase each; empty when neither.
+pub fn degeneracy(law: &Law, theta: &[f64], predictions: &[Prediction]) -> Vec<String> {
+    let mut out = Vec::new();
+    let n = law.param_count().min(theta.len());
+    let moduli: f64 = law
+        .params()
+        .iter()
+        .zip(&theta[..n])
+        .filter(|(s, _)| s.unit == "MPa")
+        .map(|(_, v)| v.abs())
+        .sum();
+    let mu0 = law.shear_modulus(&theta[..n]);
+    if moduli > 0.0 && mu0.abs() <= DEGENERATE * moduli {
+        out.push(format!("initial shear modulus {mu0:.1e} MPa ~ 0"));
+    }
+    for p in predictions {
+        let scale = p.observed.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+        if scale > 0.0 && p.predicted.iter().all(|v| v.abs() <= DEGENERATE * scale) {
+            out.push(format!("predicts ~0 throughout `{}`", p.data));
+        }
+    }
+    out
 }
 
 /// A start inside the law's domain when fixed values push the default one

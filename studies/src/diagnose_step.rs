@@ -6,7 +6,7 @@
 use crate::manifest::{DiagnoseStep, ModelForm};
 use crate::models::{build, default_effects, gap_base_for, parse_effects};
 use crate::output::write_atomic;
-use crate::report::gap_svg;
+use crate::report::{data_unit, gap_svg, gap_table_header};
 use crate::runner::{DiagnoseEntry, Run, StepResult};
 use anyhow::Context;
 use palpate_material::Law;
@@ -43,8 +43,8 @@ pub(crate) fn run_diagnose(
         "## Gap diagnosis `{}` (base `{}`)\n",
         step.name, base_name
     );
-    let _ = writeln!(report, "| data | verdict | noise SD (N) | base misfit (N) | best effect | misfit after (N) | held-out before / after (N) |");
-    let _ = writeln!(report, "|---|---|---|---|---|---|---|");
+    let units: Vec<&str> = step.data.iter().map(|n| data_unit(data[n].test)).collect();
+    report.push_str(&gap_table_header(&units));
     for name in &step.data {
         let d = &data[name];
         let spec = match named {

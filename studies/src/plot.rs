@@ -1,5 +1,7 @@
 //! Minimal SVG plotting: line/marker/bar series on linear axes, shaded bands
-//! and highlighted x-windows, composed into grids (corner plots).
+//! and highlighted x-windows, composed into grids (corner plots). A plot
+//! may fix its y range ([`Plot::y_range`]): what leaves it is clipped at the
+//! frame and marked there by a triangle pointing the way it left.
 //!
 //! Written here rather than with `plotters`: plotters' text layout pulls in a
 //! font backend (font-kit/freetype or ab_glyph with a bundled font) for what
@@ -100,6 +102,10 @@ pub struct Plot {
     pub y_categories: Option<Vec<String>>,
     /// Tick labels for the x axis instead of numbers (for level names).
     pub x_categories: Option<Vec<String>>,
+    /// The y axis's range instead of the data's: lines are clipped at the
+    /// frame and points outside it drawn as triangles on the edge they
+    /// left by, with a note saying so.
+    pub y_range: Option<(f64, f64)>,
     pub width: f64,
     pub height: f64,
 }
@@ -192,7 +198,6 @@ impl Plot {
         };
         let (x0, x1) = span(&xs);
         let (y0, y1) = span(&ys);
-        let py = 0.05 * (y1 - y0);
         let px = if self
             .series
             .iter()
@@ -202,6 +207,10 @@ impl Plot {
         } else {
             0.0
         };
+        if let Some((lo, hi)) = self.y_range.filter(|(lo, hi)| hi > lo) {
+            return ((x0 - px, x1 + px), (lo, hi));
+        }
+        let py = 0.05 * (y1 - y0);
         ((x0 - px, x1 + px), (y0 - py, y1 + py))
     }
 
@@ -229,7 +238,8 @@ impl Plot {
             esc(&self.title)
         );
         for &(a, b) in &self.windows {
-            let (a, b) = (a.max(x0), b.min(x1));
+            // (from, to) of a record whose axis decreases (a compression's stretch) too.
+            let (a, b) = (a.min(b).max(x0), a.max(b).min(x1));
             if b > a {
                 let _ = writeln!(
                     out,
@@ -335,6 +345,8 @@ impl Plot {
             );
         }
         let mut legend = Vec::new();
+        // (x, above the frame, colour) of every place a series leaves it.
+        let mut exits: Vec<(f64, bool, String)> = Vec::new();
         for (k, s) in self.series.iter().enumerate() {
             let c = s
                 .color
@@ -342,20 +354,34 @@ impl Plot {
                 .unwrap_or_else(|| PALETTE[k % PALETTE.len()].to_string());
             match s.style {
                 Style::Line | Style::Dashed => {
+                    // Each segment clipped to the y range; where it leaves
+                    // or re-enters the frame, a triangle on the edge.
                     let mut d = String::new();
                     let mut pen = false;
-                    for (x, y) in s.x.iter().zip(&s.y) {
-                        if x.is_finite() && y.is_finite() {
-                            let _ = write!(
-                                d,
-                                "{}{},{} ",
-                                if pen { "L" } else { "M" },
-                                fmt(sx(*x)),
-                                fmt(sy(*y))
-                            );
-                            pen = true;
-                        } else {
+                    for (a, b) in s.x.iter().zip(&s.y).zip(s.x.iter().zip(&s.y).skip(1)) {
+                        let (a, b) = ((*a.0, *a.1), (*b.0, *b.1));
+                        if !(a.0.is_finite()
+                            && a.1.is_finite()
+                            && b.0.is_finite()
+                            && b.1.is_finite())
+                        {
                             pen = false;
+                            continue;
+                        }
+                        let Some((p, q, entered, left)) = clip_segment(a, b, y0, y1) else {
+                            pen = false;
+                            continue;
+                        };
+                        if entered || !pen {
+                            let _ = write!(d, "M{},{} ", fmt(sx(p.0)), fmt(sy(p.1)));
+                        }
+                        if entered {
+                            exits.push((p.0, a.1 > y1, c.clone()));
+                        }
+                        let _ = write!(d, "L{},{} ", fmt(sx(q.0)), fmt(sy(q.1)));
+                        pen = !left;
+                        if left {
+                            exits.push((q.0, b.1 > y1, c.clone()));
                         }
                     }
                     let dash = if s.style == Style::Dashed {
@@ -371,7 +397,9 @@ impl Plot {
                 }
                 Style::Markers => {
                     for (x, y) in s.x.iter().zip(&s.y) {
-                        if x.is_finite() && y.is_finite() {
+                        if x.is_finite() && y.is_finite() && !(y0..=y1).contains(y) {
+                            exits.push((*x, *y > y1, c.clone()));
+                        } else if x.is_finite() && y.is_finite() {
                             let _ = writeln!(
                                 out,
                                 r#"<circle cx="{}" cy="{}" r="2.6" fill="none" stroke="{c}"/>"#,
@@ -474,6 +502,31 @@ impl Plot {
                 esc(label)
             );
         }
+        // Over the legend: a series leaving the frame is never hidden.
+        for (x, above, c) in &exits {
+            let (x, y) = (sx(*x), if *above { oy + mt } else { oy + mt + ph });
+            // Pointing out of the frame, its tip on the edge.
+            let d = if *above { -7.0 } else { 7.0 };
+            let _ = writeln!(
+                out,
+                r#"<polygon class="off-frame" points="{},{} {},{} {},{}" fill="{c}"/>"#,
+                fmt(x),
+                fmt(y),
+                fmt(x - 4.5),
+                fmt(y - d),
+                fmt(x + 4.5),
+                fmt(y - d)
+            );
+        }
+        if !exits.is_empty() {
+            let _ = writeln!(
+                out,
+                r##"<text x="{}" y="{}" font-size="11" text-anchor="end" fill="#444">{}</text>"##,
+                fmt(ox + ml + pw),
+                fmt(oy + self.height - 10.0),
+                esc("\u{25b2}\u{25bc} leaves the frame")
+            );
+        }
     }
 }
 
@@ -483,8 +536,25 @@ pub fn grid_svg(cells: &[Option<Plot>], cols: usize, title: &str) -> String {
     let cols = cols.max(1);
     let rows = cells.len().div_ceil(cols);
     let cw = cells.iter().flatten().map(|p| p.width).fold(0.0, f64::max);
-    let ch = cells.iter().flatten().map(|p| p.height).fold(0.0, f64::max);
-    let (w, h) = (cw * cols as f64, ch * rows as f64 + 30.0);
+    // Each row as tall as its tallest plot.
+    let heights: Vec<f64> = (0..rows)
+        .map(|r| {
+            cells[r * cols..((r + 1) * cols).min(cells.len())]
+                .iter()
+                .flatten()
+                .map(|p| p.height)
+                .fold(0.0, f64::max)
+        })
+        .collect();
+    let tops: Vec<f64> = heights
+        .iter()
+        .scan(30.0, |y, h| {
+            let top = *y;
+            *y += h;
+            Some(top)
+        })
+        .collect();
+    let (w, h) = (cw * cols as f64, 30.0 + heights.iter().sum::<f64>());
     let mut out = String::new();
     let _ = writeln!(
         out,
@@ -501,15 +571,57 @@ pub fn grid_svg(cells: &[Option<Plot>], cols: usize, title: &str) -> String {
     );
     for (i, cell) in cells.iter().enumerate() {
         if let Some(p) = cell {
-            p.draw(
-                &mut out,
-                (i % cols) as f64 * cw,
-                30.0 + (i / cols) as f64 * ch,
-            );
+            p.draw(&mut out, (i % cols) as f64 * cw, tops[i / cols]);
         }
     }
     out.push_str("</svg>\n");
     out
+}
+
+/// A clipped segment: its two ends, whether it enters and whether it leaves.
+type Clipped = ((f64, f64), (f64, f64), bool, bool);
+
+/// The part of the segment `a`-`b` with y in `[lo, hi]` (Liang-Barsky in
+/// y): its ends, and whether the segment enters (starts outside) and leaves
+/// (ends outside) the range; `None` when no part is inside.
+fn clip_segment(a: (f64, f64), b: (f64, f64), lo: f64, hi: f64) -> Option<Clipped> {
+    let dy = b.1 - a.1;
+    let (mut t0, mut t1) = (0.0f64, 1.0f64);
+    for (p, q) in [(-dy, a.1 - lo), (dy, hi - a.1)] {
+        if p == 0.0 {
+            if q < 0.0 {
+                return None;
+            }
+        } else {
+            let r = q / p;
+            if p < 0.0 {
+                t0 = t0.max(r);
+            } else {
+                t1 = t1.min(r);
+            }
+        }
+    }
+    if t0 > t1 {
+        return None;
+    }
+    let at = |t: f64| (a.0 + t * (b.0 - a.0), a.1 + t * dy);
+    Some((at(t0), at(t1), t0 > 0.0, t1 < 1.0))
+}
+
+/// At most about `max` evenly spaced samples of `(x, y)` (the first and
+/// the last kept): markers that show the data without hiding a fit drawn
+/// over them.
+pub fn thinned(x: &[f64], y: &[f64], max: usize) -> (Vec<f64>, Vec<f64>) {
+    let n = x.len().min(y.len());
+    let step = n.div_ceil(max.max(1)).max(1);
+    let mut keep: Vec<usize> = (0..n).step_by(step).collect();
+    if n > 0 && keep.last() != Some(&(n - 1)) {
+        keep.push(n - 1);
+    }
+    (
+        keep.iter().map(|&i| x[i]).collect(),
+        keep.iter().map(|&i| y[i]).collect(),
+    )
 }
 
 /// "Nice" tick positions (1, 2, 5 x 10^k steps) covering [lo, hi].
@@ -621,5 +733,38 @@ mod tests {
         assert!(a.starts_with("<svg") && a.trim_end().ends_with("</svg>"));
         assert!(a.contains("t &lt; 1"));
         assert_eq!(a.matches("<circle").count(), 20 + 1);
+    }
+
+    #[test]
+    fn a_fixed_y_range_clips_lines_and_marks_where_they_leave() {
+        let x = [0.0, 1.0, 2.0, 3.0];
+        let mut p = Plot::new("t", "x", "y")
+            .with(Series::line("fit", &x, &[0.0, 0.5, 3e21, 0.5]))
+            .with(Series::markers("data", &x, &[0.0, 0.5, -5.0, 0.5]));
+        p.y_range = Some((-1.0, 1.0));
+        let svg = p.to_svg();
+        // Leaves upwards and comes back (two triangles), one marker below.
+        assert_eq!(svg.matches(r#"class="off-frame""#).count(), 3, "{svg}");
+        assert_eq!(svg.matches("<circle").count(), 3 + 1);
+        assert!(svg.contains("leaves the frame"));
+        // Nothing drawn beyond the frame's top (y = 34) or bottom (420 - 50).
+        let path = svg.lines().find(|l| l.starts_with("<path")).unwrap();
+        for point in path.split(['M', 'L', '"']).filter(|t| t.contains(',')) {
+            let y: f64 = point.trim().split(',').nth(1).unwrap().parse().unwrap();
+            assert!((34.0..=370.0).contains(&y), "{y} in {path}");
+        }
+        // Without a range the same line sets the axis and nothing is marked.
+        p.y_range = None;
+        assert!(!p.to_svg().contains("off-frame"));
+    }
+
+    #[test]
+    fn thinning_keeps_the_ends_and_at_most_about_max_points() {
+        let x: Vec<f64> = (0..1200).map(f64::from).collect();
+        let (tx, ty) = thinned(&x, &x, 60);
+        assert!(tx.len() <= 61 && tx.len() >= 59, "{}", tx.len());
+        assert_eq!((tx[0], *tx.last().unwrap()), (0.0, 1199.0));
+        assert_eq!(tx, ty);
+        assert_eq!(thinned(&x[..5], &x[..5], 60).0.len(), 5);
     }
 }

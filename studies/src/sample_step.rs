@@ -411,6 +411,15 @@ pub(crate) fn run_sample(
         "surrogate": surrogate_info,
     });
     write_report(step, &summary, x.n_chains, x.n_draws, converged, report);
+    for (file, svg) in crate::report::posterior_plots(&post, &x, seed)? {
+        let path = run.out.join("plots").join(format!("{}-{file}", step.name));
+        crate::output::write_atomic(&path, svg.as_bytes())?;
+    }
+    let _ = writeln!(
+        report,
+        "Plots: `plots/{0}-corner.svg` (marginals and pairs of the draws), `plots/{0}-predictive_<data>.svg` (94 % bands and the data).\n",
+        step.name
+    );
     Ok(StepResult::Sample {
         name: step.name.clone(),
         result,

@@ -6,12 +6,11 @@
 
 use crate::cli::calibrate::read_data_with;
 use crate::output::{write_atomic, write_json};
-use crate::plot::{grid_svg, Band, Plot, Series, Style};
 use anyhow::Context;
 use palpate_material::Law;
 use palpate_uq::likelihood::{
-    fit_and_laplace, predictive_band, thermodynamic_integration, Correlation, DataSet, NoiseModel,
-    NoiseSd, Posterior, Prior,
+    fit_and_laplace, thermodynamic_integration, Correlation, DataSet, NoiseModel, NoiseSd,
+    Posterior, Prior,
 };
 use palpate_uq::mcmc::{
     correlation, sample_until_converged, summarize, Chains, Convergence, DemcSettings,
@@ -643,87 +642,11 @@ fn report(
     })
 }
 
-/// Every `step`-th point of the chains (for scatter plots).
-fn thinned(x: &Chains, max_points: usize) -> Vec<&[f64]> {
-    let total = x.n_chains * x.n_draws;
-    let step = total.div_ceil(max_points.max(1)).max(1);
-    x.points().step_by(step).collect()
-}
-
-fn histogram(v: &[f64], bins: usize) -> (Vec<f64>, Vec<f64>, f64) {
-    let lo = v.iter().copied().fold(f64::INFINITY, f64::min);
-    let hi = v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-    let w = ((hi - lo) / bins as f64).max(1e-300);
-    let mut counts = vec![0.0; bins];
-    for &x in v {
-        let b = (((x - lo) / w) as usize).min(bins - 1);
-        counts[b] += 1.0;
-    }
-    let centres = (0..bins).map(|b| lo + (b as f64 + 0.5) * w).collect();
-    (centres, counts, w)
-}
-
+/// Writes the posterior's corner plot and predictive plots
+/// ([`crate::report::posterior_plots`]) into `dir`.
 fn plots(dir: &Path, post: &Posterior, x: &Chains, seed: u64) -> anyhow::Result<()> {
-    let names = post.names();
-    let d = x.dim;
-    let pts = thinned(x, 2000);
-    let mut cells = Vec::with_capacity(d * d);
-    for i in 0..d {
-        for j in 0..d {
-            cells.push(if i == j {
-                let v: Vec<f64> = x.points().map(|p| p[i]).collect();
-                let (c, n, w) = histogram(&v, 40);
-                let mut p = Plot::new(names[i].clone(), names[i].clone(), "draws");
-                p.push(Series::line(names[i].clone(), &c, &n).style(Style::Bars(w)));
-                Some(p)
-            } else if i > j {
-                let xs: Vec<f64> = pts.iter().map(|p| p[j]).collect();
-                let ys: Vec<f64> = pts.iter().map(|p| p[i]).collect();
-                let mut p = Plot::new(
-                    format!("{} vs {}", names[i], names[j]),
-                    names[j].clone(),
-                    names[i].clone(),
-                );
-                p.push(Series::markers("draws", &xs, &ys));
-                Some(p)
-            } else {
-                None
-            });
-        }
-    }
-    write_atomic(
-        &dir.join("corner.svg"),
-        grid_svg(&cells, d, "posterior").as_bytes(),
-    )?;
-    for (s, ds) in post.datasets().iter().enumerate() {
-        let band = predictive_band(post, s, x, 400, 0.94, seed)?;
-        let unit = ds.model.observable().column();
-        let mut p = Plot::new(
-            format!("posterior predictive: {}", ds.name),
-            ds.loading.drive_kind.column(),
-            unit,
-        );
-        p.bands.push(Band {
-            label: "94 % new observation".into(),
-            x: band.drive.clone(),
-            lower: band.lower_observed.clone(),
-            upper: band.upper_observed.clone(),
-            color: "#9ecae1".into(),
-        });
-        p.bands.push(Band {
-            label: "94 % model".into(),
-            x: band.drive.clone(),
-            lower: band.lower.clone(),
-            upper: band.upper.clone(),
-            color: "#d62728".into(),
-        });
-        p.push(Series::markers("data", &ds.loading.drive, &ds.observed).color("#333"));
-        p.push(Series::line("posterior median", &band.drive, &band.median).color("#d62728"));
-        let file = format!(
-            "predictive_{}.svg",
-            ds.name.replace(|c: char| !c.is_ascii_alphanumeric(), "_")
-        );
-        write_atomic(&dir.join(file), p.to_svg().as_bytes())?;
+    for (file, svg) in crate::report::posterior_plots(post, x, seed)? {
+        write_atomic(&dir.join(file), svg.as_bytes())?;
     }
     Ok(())
 }

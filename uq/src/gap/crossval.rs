@@ -21,7 +21,7 @@ use std::sync::Arc;
 /// parameters of the effect that acts there (the time constants), and the
 /// refit then extrapolates an unidentified parameter into the left-out
 /// block; the cross-validation penalises the effect for the design of the
-/// folds, not for overfitting (issue 14, weakness 1). Chunks rather than
+/// folds, not for overfitting. Chunks rather than
 /// single samples: under residual correlation, neighbouring samples of a
 /// left-out sample would otherwise predict it (Roberts et al. 2017,
 /// "Cross-validation strategies for data with temporal, spatial,

@@ -188,9 +188,34 @@ pub struct GapReport {
     pub plot: GapPlot,
 }
 
+impl GapPlot {
+    /// The unit of the record's observable, from what drives it: a stretch
+    /// or an amount of shear drives a homogeneous test whose observable is
+    /// a nominal stress (`MPa`); a displacement or a position drives a tool
+    /// whose observable is a force (`N`).
+    pub fn data_unit(&self) -> &'static str {
+        match self.drive_name.as_str() {
+            "stretch" | "amount_of_shear" => "MPa",
+            _ => "N",
+        }
+    }
+
+    /// The unit of the horizontal axis (`s`, `mm` or `dimensionless`).
+    pub fn axis_unit(&self) -> &'static str {
+        match self.axis.as_str() {
+            "time_s" => "s",
+            "displacement_mm" | "position_mm" => "mm",
+            _ => "dimensionless",
+        }
+    }
+}
+
 impl GapReport {
-    /// The report as markdown (tables of windows and candidates).
+    /// The report as markdown (tables of windows and candidates), every
+    /// quantity with its unit (the data's: MPa for a stress record, N for a
+    /// force record).
     pub fn to_markdown(&self) -> String {
+        let unit = self.plot.data_unit();
         let mut s = String::new();
         let _ = writeln!(s, "# Sim-to-real gap diagnosis\n");
         let _ = writeln!(s, "**Verdict: `{}`**", self.verdict);
@@ -230,7 +255,7 @@ impl GapReport {
         let t = &self.base.tests;
         let _ = writeln!(
             s,
-            "- noise SD (from second differences): {:.4e}; misfit RMS {:.4e} (RMS/noise {:.2}, z = {:.1}, p = {:.2e})",
+            "- noise SD (from second differences): {:.4e} {unit}; misfit RMS {:.4e} {unit} (RMS/noise {:.2}, z = {:.1}, p = {:.2e})",
             self.noise_sd, self.base.misfit, t.rms_over_noise, t.misfit_z, t.misfit_p
         );
         let _ = writeln!(
@@ -256,7 +281,8 @@ impl GapReport {
         } else {
             let _ = writeln!(
                 s,
-                "| axis | from | to | misfit RMS | mean residual | significance |"
+                "| axis | from ({a}) | to ({a}) | misfit RMS ({unit}) | mean residual ({unit}) | significance |",
+                a = self.plot.axis_unit()
             );
             let _ = writeln!(s, "|---|---|---|---|---|---|");
             for w in &self.where_ {
@@ -271,7 +297,7 @@ impl GapReport {
         let _ = writeln!(s, "## Candidates (best first)\n");
         let _ = writeln!(
             s,
-            "| effect | parameters | misfit before -> after | held-out before -> after | score (p) | LR (p) | dBIC AR(1) | earns | identifiable |"
+            "| effect | parameters (physical units) | misfit RMS before -> after ({unit}) | held-out RMS before -> after ({unit}) | score statistic (p) | LR statistic (p) | dBIC AR(1) (dimensionless) | earns | identifiable |"
         );
         let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
         for r in &self.ranking {
@@ -326,7 +352,7 @@ impl GapReport {
             );
             let _ = writeln!(
                 s,
-                "| effect | parameter | range | base parameters at the ends | misfit at the ends | p (LR vs base) |"
+                "| effect | parameter | range (the parameter's unit) | base parameters at the ends (their units) | misfit RMS at the ends ({unit}) | p (LR vs base) |"
             );
             let _ = writeln!(s, "|---|---|---|---|---|---|");
             for u in &self.undetectable {

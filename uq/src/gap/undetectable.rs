@@ -1,7 +1,6 @@
 //! What an effect the record cannot see would do to the base parameters:
 //! the base model refitted with the effect held at each end of its
-//! plausible range (issue 14, weakness 3: "undetectable does not mean
-//! harmless").
+//! plausible range: undetectable does not mean harmless.
 //!
 //! A likelihood-ratio or cross-validation test that does not reject "off"
 //! says the data are consistent with the effect being absent, not that it
