@@ -2,10 +2,10 @@
 //! [`ModelSpec`] a record of a test is fitted with when the user names only
 //! a law (`--benchmark`, a manifest's `law = "..."`), the base model of the
 //! gap diagnosis, and the effects it looks for. Moved out of
-//! [`crate::models`] (the spec and its factory), which re-exports them.
+//! [`crate::model`] (the spec and its factory), which re-exports them.
 
-use crate::calibration::TestKind;
-use crate::models::{C1Spec, HomogeneousSpec, ModelSpec, N1NeedleSpec};
+use crate::model::{C1Spec, HomogeneousSpec, ModelSpec, N1NeedleSpec};
+use crate::records::TestKind;
 use palpate_core::{Effect, ForwardModel};
 use palpate_material::Law;
 
@@ -66,11 +66,11 @@ pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
     }
 }
 
-/// [`gap_base`] for one record read by [`crate::calibration::TestData`]:
+/// [`gap_base`] for one record read by [`crate::records::TestData`]:
 /// a simple-shear record keeps the axial stretch it was read with.
-pub fn gap_base_for(record: &crate::calibration::TestData, law: Law) -> anyhow::Result<ModelSpec> {
+pub fn gap_base_for(record: &crate::records::TestData, law: Law) -> anyhow::Result<ModelSpec> {
     if record.test.is_homogeneous() {
-        Ok(record.spec(law, None))
+        Ok(super::record_spec(record, law, None))
     } else {
         gap_base(record.test, law)
     }

@@ -1,9 +1,9 @@
 //! The parsers of a model spec's text fields (`mesh`, `element`, `bulk`,
 //! `tool`, `mode`, `prony`), each error naming the spec's kind and field
-//! ([`ModelError`]). Split from [`crate::models`], which uses them and
+//! ([`ModelError`]). Split from [`crate::model`], which uses them and
 //! re-exports the public ones.
 
-use crate::models::{ModelError, DEFAULT_MESH, MAX_MESH_LEVEL};
+use crate::model::{ModelError, DEFAULT_MESH, MAX_MESH_LEVEL};
 use palpate_analytic::Mode;
 use palpate_fe::{Bulk, MeshDensity, N1Element, Prony, ToolShape};
 use serde::Deserialize;

@@ -63,7 +63,14 @@
 //! in the model of each data set's test" ([`for_test`]); the gap diagnosis's
 //! `base = "..."` means the base model of [`gap_base`].
 
-use crate::calibration::TestKind;
+pub mod calibration;
+pub mod defaults;
+pub mod entry;
+pub mod fields;
+
+pub use entry::{ModelEntry, ModelForm};
+
+use crate::records::{TestData, TestKind};
 use palpate_analytic::{
     C1Compression, GeneralBiaxial, Homogeneous, Mode, SimpleShear, ViscousUniaxial,
 };
@@ -75,13 +82,14 @@ use palpate_fe::{
 use palpate_material::Law;
 use serde::Deserialize;
 use std::fmt;
+use std::sync::Arc;
 
-pub use crate::model_defaults::{
+pub use defaults::{
     check_effects, default_effects, for_test, gap_base, gap_base_for, parse_effects,
     spans_tension_and_compression,
 };
-use crate::model_fields::{parse_bulk, parse_element, parse_mode, parse_prony, parse_tool};
-pub use crate::model_fields::{parse_mesh, text_or_number};
+use fields::{parse_bulk, parse_element, parse_mode, parse_prony, parse_tool};
+pub use fields::{parse_mesh, text_or_number};
 
 /// Default Coulomb friction between the N1 needle and the material (BENCHMARKS.md).
 pub const DEFAULT_FRICTION: f64 = 0.8;
@@ -750,6 +758,25 @@ fn homogeneous_model(law: Law, s: &HomogeneousSpec) -> Result<Model, ModelError>
             ))
         }
     })
+}
+
+/// The forward model of a test for a law ([`for_test`]).
+pub fn test_model(test: TestKind, law: Law) -> anyhow::Result<Arc<dyn ForwardModel>> {
+    let m = build(&for_test(test, law)).map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(Arc::from(m))
+}
+
+/// The model of a record's test for `law` ([`for_test`]), with its axial
+/// stretch and, if given, a viscoelastic form.
+pub fn record_spec(record: &TestData, law: Law, viscous: Option<Viscous>) -> ModelSpec {
+    let mut spec = for_test(record.test, law);
+    if let ModelSpec::Homogeneous(h) = &mut spec {
+        if record.test == TestKind::SimpleShear && record.axial_stretch != 1.0 {
+            h.axial_stretch = Some(record.axial_stretch);
+        }
+        h.viscoelastic = viscous.map(|v| v.to_string());
+    }
+    spec
 }
 
 #[cfg(test)]

@@ -1,6 +1,6 @@
-//! Unit tests of [`crate::models`] (the spec and its factory).
+//! Unit tests of [`crate::model`] (the spec and its factory).
 
-use crate::models::*;
+use crate::model::*;
 use palpate_fe::N1Element;
 
 #[test]

@@ -20,7 +20,7 @@
 //! disagreement is an error naming the file, line and column (the usual
 //! cause is a mislabelled unit).
 
-use crate::calibration::TestKind;
+use crate::records::TestKind;
 use palpate_core::data::Table;
 use palpate_core::Drive;
 

@@ -2,9 +2,13 @@
 //! calibration's table and its data against the fit; the gap diagnosis's
 //! terminal summary and two panels.
 
-use crate::calibration::{Calibration, TestKind};
-use crate::plot::{grid_svg, Band, Plot, Series};
+pub mod anova;
+pub mod plot;
+
+use crate::model::calibration::Calibration;
+use crate::records::TestKind;
 use palpate_uq::gap::GapReport;
+use plot::{grid_svg, Band, Plot, Series};
 
 /// Data (markers) against the fitted law (lines), one colour per data set.
 pub fn fit_plot(c: &Calibration) -> Plot {

@@ -15,8 +15,8 @@
 //! * Parameters held fixed in a fit are parameters of the law, inside their
 //!   bounds and of a plausible size, and leave something to fit.
 
-use crate::limits::fmt_value;
-use crate::models::Model;
+use crate::model::Model;
+use crate::run::limits::fmt_value;
 use palpate_material::Law;
 
 /// Largest magnitude of a law parameter in MPa (1 TPa).
@@ -128,7 +128,7 @@ pub fn check_fixed(law: &Law, fixed: &[(String, f64)], option: &str) -> anyhow::
         );
     }
     // A fit must be able to start inside the law's domain with these values.
-    crate::calibration::admissible_start(law, fixed).map_err(|e| {
+    crate::model::calibration::admissible_start(law, fixed).map_err(|e| {
         let all: Vec<String> = fixed
             .iter()
             .map(|(n, v)| format!("{option} {n}={}", fmt_value(*v)))
@@ -242,6 +242,16 @@ pub fn check_travel(option: &str, depth: f64, model: &Model) -> anyhow::Result<(
     Ok(())
 }
 
+/// Checks a significance level (`what` names the option or field): a
+/// probability strictly between 0 and 1.
+pub fn check_alpha(what: &str, alpha: f64) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        alpha > 0.0 && alpha < 1.0,
+        "{what} {alpha}: expected a significance level strictly between 0 and 1, such as 0.05"
+    );
+    Ok(())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -304,7 +314,7 @@ mod tests {
 
     #[test]
     fn a_displacement_through_the_body_is_refused() {
-        let spec = crate::models::ModelSpec::C1Fe(crate::models::C1FeSpec {
+        let spec = crate::model::ModelSpec::C1Fe(crate::model::C1FeSpec {
             law: "neo-hookean".into(),
             ..Default::default()
         });

@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 /// The lock file the binary was built with, for the versions of the key crates.
-const CARGO_LOCK: &str = include_str!("../../Cargo.lock");
+const CARGO_LOCK: &str = include_str!("../../../Cargo.lock");
 
 /// Crates whose versions are recorded.
 const KEY_CRATES: [&str; 9] = [

@@ -28,7 +28,7 @@
 //! The lock is an advisory `flock`, released by the system when its process
 //! dies, so a killed run never leaves a stale lock.
 
-use crate::output::{check_writable, is_temp_name, write_atomic, write_json};
+use crate::run::output::{check_writable, is_temp_name, write_atomic, write_json};
 use anyhow::Context;
 use sha2::{Digest, Sha256};
 use std::fs::File;
@@ -118,12 +118,12 @@ impl RunFolder {
         Ok(folder)
     }
 
-    /// Opens the run folder `out` for shard `shard` ([`crate::shard`]):
+    /// Opens the run folder `out` for shard `shard` ([`crate::run::shard`]):
     /// under a shared lock (shards run side by side; a full run or a merge
     /// waits for none of them and is refused while one runs), creating the
     /// folder and its cache if needed, marking a new folder incomplete. It
     /// removes nothing: the temporary files may be other shards' writes.
-    pub fn open_shared(out: &Path, shard: crate::shard::Shard) -> anyhow::Result<RunFolder> {
+    pub fn open_shared(out: &Path, shard: crate::run::shard::Shard) -> anyhow::Result<RunFolder> {
         let shown = out.display();
         if out.exists() && !out.is_dir() {
             anyhow::bail!("run folder {shown}: is a file; give a folder with --out");
@@ -320,7 +320,7 @@ fn lock(path: &Path, out: &Path) -> anyhow::Result<File> {
 /// Takes the lock file's shared lock for a shard (refused while a full run
 /// holds it exclusively), and marks the shard running (its pid in
 /// `.palpate/shards/I-of-N.running` while the process lives).
-fn lock_shared(path: &Path, out: &Path, shard: crate::shard::Shard) -> anyhow::Result<File> {
+fn lock_shared(path: &Path, out: &Path, shard: crate::run::shard::Shard) -> anyhow::Result<File> {
     let file = std::fs::OpenOptions::new()
         .read(true)
         .write(true)
@@ -346,7 +346,7 @@ fn lock_shared(path: &Path, out: &Path, shard: crate::shard::Shard) -> anyhow::R
             return Err(e).with_context(|| format!("cannot lock {}", path.display()))
         }
     }
-    let running = crate::shard::records_dir(out).join(format!("{}.running", shard.stem()));
+    let running = crate::run::shard::records_dir(out).join(format!("{}.running", shard.stem()));
     write_atomic(&running, format!("{}\n", std::process::id()).as_bytes())?;
     Ok(file)
 }
@@ -354,7 +354,7 @@ fn lock_shared(path: &Path, out: &Path, shard: crate::shard::Shard) -> anyhow::R
 /// The shards marked running in `out` whose process still lives (their
 /// `I/N`, with the pid).
 fn running_shards(out: &Path) -> Vec<String> {
-    let Ok(entries) = std::fs::read_dir(crate::shard::records_dir(out)) else {
+    let Ok(entries) = std::fs::read_dir(crate::run::shard::records_dir(out)) else {
         return Vec::new();
     };
     let mut list = Vec::new();
@@ -392,7 +392,7 @@ fn is_empty(dir: &Path) -> anyhow::Result<bool> {
         e.map(|e| {
             e.file_name()
                 .to_string_lossy()
-                .starts_with(crate::output::WRITE_PROBE)
+                .starts_with(crate::run::output::WRITE_PROBE)
         })
         .unwrap_or(false)
     }))
@@ -407,7 +407,7 @@ fn is_plain_relative(f: &str) -> bool {
             .all(|c| matches!(c, std::path::Component::Normal(_)))
 }
 
-/// Removes the temporary files of [`crate::output::write_atomic`] in `dir`.
+/// Removes the temporary files of [`crate::run::output::write_atomic`] in `dir`.
 fn remove_temps(dir: &Path) {
     let Ok(entries) = std::fs::read_dir(dir) else {
         return;

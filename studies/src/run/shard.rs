@@ -3,7 +3,7 @@
 //! fits of a calibrate step, the records of a diagnose step, the model runs
 //! of a predict step, a two-stage identification, the FE runs and chains of
 //! a sample step, the FE runs and posteriors of a localize step) into the
-//! run folder's cache ([`crate::run_folder`]); `palpate merge RUN_DIR` then
+//! run folder's cache ([`crate::run::run_folder`]); `palpate merge RUN_DIR` then
 //! runs the study over the filled cache and writes the same bytes as a run
 //! in one process (a unit's record is the same JSON whichever process computed
 //! it, and the results are assembled in the manifest's order).
@@ -20,9 +20,8 @@
 //! takes it exclusively); each leaves `.palpate/shards/I-of-N.json` with
 //! what it computed, which `merge` checks before it runs.
 
-use crate::output::write_json;
-use crate::run_folder::STATE;
-use crate::runner::{run_study_counted, RunObserver, RunOptions};
+use crate::run::output::write_json;
+use crate::run::run_folder::STATE;
 use anyhow::Context;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
@@ -114,58 +113,6 @@ impl ShardRecord {
             self,
         )
     }
-}
-
-/// What a merge found and did.
-#[derive(Debug, Clone)]
-pub struct Merged {
-    pub folder: PathBuf,
-    pub shards: usize,
-    /// Units the merge took from the cache.
-    pub cached: usize,
-    /// Units the merge computed itself (those of deferred steps).
-    pub computed: usize,
-}
-
-/// Merges the shards of the run folder `out`: once every shard of one
-/// count N has left its record and the manifest is unchanged since, runs
-/// the study into `out` over the cache the shards filled (computing only
-/// the units of steps the shards deferred). Errors say which shards are
-/// missing, with the command that runs them.
-pub fn merge(out: &Path, observer: &dyn RunObserver) -> anyhow::Result<Merged> {
-    let (record, shards) = check_complete(out)?;
-    let shown = out.display();
-    let here = std::env::current_dir().context("cannot read the working directory")?;
-    if record.manifest.is_relative() && here != record.cwd {
-        anyhow::bail!(
-            "run folder {shown}: the shards ran {} from {}; run `palpate merge` from there too \
-             (the cache keys hold the data paths as the manifest gives them)",
-            record.manifest.display(),
-            record.cwd.display()
-        );
-    }
-    let hash = crate::provenance::hash_file(&record.manifest)
-        .with_context(|| format!("run folder {shown}: the shards' manifest"))?;
-    anyhow::ensure!(
-        record.manifest_sha256 == hash.sha256,
-        "run folder {shown}: the shards ran {} with sha256 {}, but it now has sha256 {}; \
-         run the shards again with the manifest as it is",
-        record.manifest.display(),
-        record.manifest_sha256,
-        hash.sha256
-    );
-    let options = RunOptions {
-        out: Some(out.to_path_buf()),
-        fresh: false,
-        shard: None,
-    };
-    let summary = run_study_counted(&record.manifest, &options, observer)?;
-    Ok(Merged {
-        folder: summary.folder,
-        shards,
-        cached: summary.units.cached,
-        computed: summary.units.computed,
-    })
 }
 
 /// The record of shard 0 of the largest N whose shards have all finished

@@ -12,8 +12,8 @@
 //! an interrupted build never leaves a truncated entry; an unreadable entry
 //! is reported and rebuilt.
 
-use crate::limits::Progress;
-use crate::output::write_atomic;
+use crate::run::limits::Progress;
+use crate::run::output::write_atomic;
 use palpate_core::{ForwardModel, Loading};
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use sha2::{Digest, Sha256};
@@ -100,7 +100,7 @@ pub fn code_version() -> &'static str {
 /// builds it (model runs in parallel with a progress report named `label`)
 /// and stores it there. `description` must name everything about the model
 /// that its name does not (e.g. `format!("{spec:?}")` of its
-/// [`crate::models::ModelSpec`]); the code version is added here.
+/// [`crate::model::ModelSpec`]); the code version is added here.
 pub fn load_or_build(
     model: &dyn ForwardModel,
     loading: &Loading,
@@ -182,4 +182,56 @@ pub fn load_or_compute<T: serde::Serialize + serde::de::DeserializeOwned>(
     let v = compute()?;
     write_atomic(&path, serde_json::to_string(&v)?.as_bytes())?;
     Ok((v, CacheStatus::Built(path)))
+}
+
+/// Parses `--box NAME=LO,HI` for every parameter of `model`; the error names
+/// the option or the missing parameters (with a suggestion around the law's
+/// typical value).
+pub fn parse_box(boxes: &[String], model: &dyn ForwardModel) -> anyhow::Result<ParamBox> {
+    let space = model.space();
+    let mut lower = vec![f64::NAN; space.len()];
+    let mut upper = vec![f64::NAN; space.len()];
+    for b in boxes {
+        let (name, range) = b
+            .split_once('=')
+            .filter(|(a, r)| !a.is_empty() && !r.is_empty())
+            .ok_or_else(|| anyhow::anyhow!("`{b}`: expected NAME=LO,HI, e.g. C10=0.0005,0.002"))?;
+        let k = space.index_of(name).ok_or_else(|| {
+            anyhow::anyhow!(
+                "--box {b}: unknown parameter `{name}` (the model has {})",
+                space.names().join(", ")
+            )
+        })?;
+        if !lower[k].is_nan() {
+            anyhow::bail!("--box {b}: a box for {name} is given twice; give each parameter once");
+        }
+        let (lo, hi) = range
+            .split_once(',')
+            .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
+            .ok_or_else(|| anyhow::anyhow!("--box {b}: expected NAME=LO,HI with two numbers"))?;
+        lower[k] = lo;
+        upper[k] = hi;
+    }
+    let missing: Vec<String> = space
+        .params
+        .iter()
+        .zip(&lower)
+        .filter(|(_, l)| l.is_nan())
+        .map(|(p, _)| {
+            format!(
+                "{} (e.g. --box {}={},{})",
+                p.name,
+                p.name,
+                p.initial / 4.0,
+                p.initial * 4.0
+            )
+        })
+        .collect();
+    if !missing.is_empty() {
+        anyhow::bail!(
+            "--box: the surrogate is trained inside a box that must hold the posterior; give NAME=LO,HI for {}",
+            missing.join(", ")
+        );
+    }
+    ParamBox::new(space, &lower, &upper).map_err(|e| anyhow::anyhow!("--box: {e}"))
 }

@@ -23,10 +23,12 @@
 //! cells by replicates (ours, then the published ones) and states in words
 //! which term matters, how much, and whether the two analyses agree.
 
-use crate::cli::anova::{check_alpha, plots};
-use crate::manifest::{Manifest, Step};
-use crate::output::write_atomic;
-use crate::runner::{Run, StepResult};
+use crate::report::anova::plots;
+use crate::run::checks::check_alpha;
+use crate::steps::predict::PredictStep;
+use crate::run::output::write_atomic;
+use crate::run::step::{At, Run, Step, StepResult, Study};
+use crate::run::step::{find_list, Sharding};
 use anyhow::Context;
 use palpate_uq::anova::{analyse, Analysis, AnovaOptions, FactorColumn, RunsTable};
 use serde::Deserialize;
@@ -71,9 +73,9 @@ const RESPONSES: [&str; 2] = ["r2", "rms"];
 impl AnovaStep {
     /// Checks the step (step `i` of `manifest`, read from `dir`); errors
     /// name the manifest file (`where_`) and the field.
-    pub fn validate(
+    pub(crate) fn check(
         &self,
-        manifest: &Manifest,
+        manifest: &Study,
         i: usize,
         where_: &str,
         dir: &std::path::Path,
@@ -92,12 +94,12 @@ impl AnovaStep {
                 "{where_}: {at}.predictions: step \"{}\" is steps[{j}], not before this one; steps run in order",
                 self.predictions
             ),
-            Some(j) => match &manifest.steps[j] {
-                Step::Predict(p) => p,
-                other => anyhow::bail!(
+            Some(j) => match manifest.steps[j].get::<PredictStep>() {
+                Some(p) => p,
+                None => anyhow::bail!(
                     "{where_}: {at}.predictions: step \"{}\" is a {} step; expected a predict step",
                     self.predictions,
-                    other.kind()
+                    manifest.steps[j].kind
                 ),
             },
         };
@@ -185,15 +187,8 @@ pub(crate) fn run_anova(
     step: &AnovaStep,
     done: &[StepResult],
     report: &mut String,
-) -> anyhow::Result<StepResult> {
-    let comparisons = done
-        .iter()
-        .find_map(|s| match s {
-            StepResult::Predict {
-                name, comparisons, ..
-            } if *name == step.predictions => Some(comparisons),
-            _ => None,
-        })
+) -> anyhow::Result<serde_json::Value> {
+    let comparisons = find_list(done, "predict", &step.predictions, "comparisons")
         .with_context(|| {
             format!(
                 "step `{}`: no results of predict step `{}`",
@@ -263,15 +258,15 @@ pub(crate) fn run_anova(
             )?;
         }
     }
-    Ok(StepResult::Anova {
-        name: step.name.clone(),
-        runs: serde_json::to_value(&runs)?,
-        analysis: serde_json::to_value(&ours)?,
-        published: published
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "runs": serde_json::to_value(&runs)?,
+        "analysis": serde_json::to_value(&ours)?,
+        "published": published
             .as_ref()
             .map(|(_, a)| serde_json::to_value(a))
             .transpose()?,
-    })
+    }))
 }
 
 fn mean(v: &[f64]) -> f64 {
@@ -557,4 +552,31 @@ pub fn conclusion(step: &AnovaStep, ours: &Analysis, published: Option<&Analysis
         );
     }
     s
+}
+
+impl Step for AnovaStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, at: &At) -> anyhow::Result<()> {
+        self.check(study, at.index, &at.file, at.dir)
+    }
+
+    fn inputs(&self) -> Vec<PathBuf> {
+        self.published.iter().cloned().collect()
+    }
+
+    fn sharding(&self) -> Sharding {
+        Sharding::AtMerge
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        run_anova(run, self, done, report)
+    }
 }

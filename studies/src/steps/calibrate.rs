@@ -1,17 +1,139 @@
-//! The `calibrate` step of a study ([`crate::manifest::CalibrateStep`]):
-//! each fit a unit of the run folder, cached under its inputs, and the
-//! step's tables and plots in the report. Split from [`crate::runner`].
+//! The `calibrate` step of a study ([`CalibrateStep`]): each fit a unit of
+//! the run folder, cached under its inputs, and the step's tables and plots
+//! in the report.
 
-use crate::calibration::{calibrate, parse_method, Request, TestData};
-use crate::manifest::{CalibrateStep, ModelForm};
-use crate::output::write_atomic;
+use crate::model::calibration::{calibrate, parse_method, Calibration, Request};
+use crate::records::TestData;
+use crate::model::ModelForm;
+use crate::run::output::write_atomic;
 use crate::report::fit_plot;
-use crate::runner::{FitEntry, Run, StepResult};
+use crate::run::step::{duplicate, keys, At, Run, Step, StepResult, Study};
+use std::collections::BTreeMap;
 use anyhow::Context;
 use palpate_inverse::{BoundSide, ResidualKind};
 use palpate_material::Law;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
+
+/// Fit every model to every group of data sets, with every residual kind.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CalibrateStep {
+    pub name: String,
+    /// Model names (keys of `[models]`).
+    pub models: Vec<String>,
+    /// Named groups of data sets fitted jointly, e.g. `{ all = ["uniaxial", "biaxial", "planar"] }`.
+    pub fits: BTreeMap<String, Vec<String>>,
+    /// Residual kinds: `absolute`, `relative`, `normalised`.
+    #[serde(default = "default_residuals")]
+    pub residuals: Vec<String>,
+    /// `lm`, `bfgs` or `lbfgs`.
+    #[serde(default = "default_estimator")]
+    pub estimator: String,
+    /// Data sets on which every fit is also evaluated (predictions of other modes).
+    #[serde(default)]
+    pub predict: Vec<String>,
+}
+
+fn default_residuals() -> Vec<String> {
+    vec!["absolute".into()]
+}
+fn default_estimator() -> String {
+    "lm".into()
+}
+
+/// One fit of a calibrate step.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitEntry {
+    pub model: String,
+    pub group: String,
+    pub residual: String,
+    pub calibration: Calibration,
+}
+
+impl Step for CalibrateStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, site: &At) -> anyhow::Result<()> {
+        let where_ = &site.file;
+            let at = site.step(&self.name);
+            for (field, list) in [
+                ("models", &self.models),
+                ("residuals", &self.residuals),
+                ("predict", &self.predict),
+            ] {
+                if list.is_empty() && field != "predict" {
+                    anyhow::bail!("{where_}: {at}.{field} = []: give at least one");
+                }
+                if let Some(d) = duplicate(list) {
+                    anyhow::bail!("{where_}: {at}.{field}: \"{d}\" is listed twice");
+                }
+            }
+            for m in &self.models {
+                if !study.models.contains_key(m) {
+                    anyhow::bail!(
+                        "{where_}: {at}.models: unknown model \"{m}\" (defined: {})",
+                        keys(&study.models)
+                    );
+                }
+            }
+            if self.fits.is_empty() {
+                anyhow::bail!(
+                    "{where_}: {at}.fits: at least one group of data sets is needed"
+                );
+            }
+            for (g, sets) in &self.fits {
+                if sets.is_empty() {
+                    anyhow::bail!("{where_}: {at}.fits.{g}: empty group");
+                }
+                for s in sets {
+                    if !study.data.contains_key(s) {
+                        anyhow::bail!("{where_}: {at}.fits.{g}: unknown data set \"{s}\" (defined: {})", keys(&study.data));
+                    }
+                }
+            }
+            for s in &self.predict {
+                if !study.data.contains_key(s) {
+                    anyhow::bail!(
+                        "{where_}: {at}.predict: unknown data set \"{s}\" (defined: {})",
+                        keys(&study.data)
+                    );
+                }
+            }
+            for m in &self.models {
+                let ModelForm::Spec(spec) = &study.models[m].model else {
+                    continue;
+                };
+                for s in self.fits.values().flatten().chain(&self.predict) {
+                    study.check_predicts(where_.to_string(), &at, m, spec, s)?;
+                }
+            }
+            for r in &self.residuals {
+                if !["absolute", "relative", "normalised"].contains(&r.as_str()) {
+                    anyhow::bail!("{where_}: {at}.residuals: \"{r}\" is not one of absolute, relative, normalised");
+                }
+            }
+            if !["lm", "bfgs", "lbfgs"].contains(&self.estimator.as_str()) {
+                anyhow::bail!(
+                    "{where_}: {at}.estimator: \"{}\" is not one of lm, bfgs, lbfgs",
+                    self.estimator
+                );
+            }
+        Ok(())
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        _done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        run_calibrate(run, self, report)
+    }
+}
+
 
 /// A finished fit as cached: its results entry, its report rows and its plot.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -28,7 +150,7 @@ pub(crate) fn run_calibrate(
     run: &Run,
     step: &CalibrateStep,
     report: &mut String,
-) -> anyhow::Result<StepResult> {
+) -> anyhow::Result<serde_json::Value> {
     let (manifest, data) = (run.manifest, run.data);
     let method = parse_method(&step.estimator)?;
     let predict: Vec<TestData> = step.predict.iter().map(|n| data[n].clone()).collect();
@@ -72,7 +194,7 @@ pub(crate) fn run_calibrate(
                         viscous: entry
                             .viscoelastic
                             .as_deref()
-                            .map(crate::models::Viscous::parse)
+                            .map(crate::model::Viscous::parse)
                             .transpose()
                             .map_err(|e| {
                                 anyhow::anyhow!("models.{model_name}.viscoelastic: {e}")
@@ -119,10 +241,10 @@ pub(crate) fn run_calibrate(
         }
     }
     write_calibrate_report(step, &units, report);
-    Ok(StepResult::Calibrate {
-        name: step.name.clone(),
-        fits: units.into_iter().map(|(_, u)| u.entry).collect(),
-    })
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "fits": units.into_iter().map(|(_, u)| u.entry).collect::<Vec<_>>(),
+    }))
 }
 
 /// The row of one fit in the report's fit table.

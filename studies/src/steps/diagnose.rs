@@ -1,17 +1,147 @@
-//! The `diagnose` step of a study ([`crate::manifest::DiagnoseStep`]): the
-//! gap diagnosis of each record, a unit of the run folder cached under its
-//! inputs, and its table and plots in the report. Split from
-//! [`crate::runner`].
+//! The `diagnose` step of a study ([`DiagnoseStep`]): the gap diagnosis of
+//! each record, a unit of the run folder cached under its inputs, and its
+//! table and plots in the report.
 
-use crate::manifest::{DiagnoseStep, ModelForm};
-use crate::models::{build, default_effects, gap_base_for, parse_effects};
-use crate::output::write_atomic;
+use crate::model::{ModelForm, ModelSpec};
+use crate::model::{build, default_effects, gap_base_for, parse_effects};
+use crate::run::output::write_atomic;
 use crate::report::gap_svg;
-use crate::runner::{DiagnoseEntry, Run, StepResult};
+use crate::run::step::{duplicate, keys, At, Run, Step, StepResult, Study};
 use anyhow::Context;
 use palpate_material::Law;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
+
+/// Diagnose the sim-to-real gap of a base model on C1 or N1 records.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiagnoseStep {
+    pub name: String,
+    /// Data set names (each diagnosed separately).
+    pub data: Vec<String>,
+    /// Base law, e.g. `neo-hookean`, in the base model of each record's test
+    /// ([`crate::model::gap_base`]: C1 analytic; N1 frictionless, coarse mesh).
+    #[serde(default)]
+    pub base: Option<String>,
+    /// Or the base model by name (a `[models.NAME.<kind>]` entry).
+    #[serde(default)]
+    pub model: Option<String>,
+    /// Candidate effects (GAP.md names); default: C1 every effect its model
+    /// offers, N1 `friction` and `boundary_condition`.
+    #[serde(default)]
+    pub effects: Option<Vec<String>>,
+}
+
+/// One diagnosed data set.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagnoseEntry {
+    pub data: String,
+    pub report: serde_json::Value,
+}
+
+impl Step for DiagnoseStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, site: &At) -> anyhow::Result<()> {
+        let where_ = &site.file;
+            let at = site.step(&self.name);
+            for s in &self.data {
+                match study.data.get(s) {
+                    None => anyhow::bail!(
+                        "{where_}: {at}.data: unknown data set \"{s}\" (defined: {})",
+                        keys(&study.data)
+                    ),
+                    Some(spec) if spec.test != "C1" && spec.test != "N1" => {
+                        anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 or N1 force record", spec.test)
+                    }
+                    _ => {}
+                }
+            }
+            match (&self.base, &self.model) {
+                (Some(base), None) => {
+                    if let Err(e) = base.parse::<palpate_material::Law>() {
+                        anyhow::bail!("{where_}: {at}.base = \"{base}\": {e}");
+                    }
+                }
+                (None, Some(m)) => match study.models.get(m).map(|e| &e.model) {
+                    None => anyhow::bail!(
+                        "{where_}: {at}.model: unknown model \"{m}\" (defined: {})",
+                        keys(&study.models)
+                    ),
+                    Some(ModelForm::Law(_)) => anyhow::bail!(
+                        "{where_}: {at}.model: \"{m}\" is a law alone; give the law as `base` or define models.{m}.c1 / models.{m}.n1_needle"
+                    ),
+                    Some(ModelForm::Spec(spec)) => {
+                        for s in &self.data {
+                            study.check_predicts(where_.to_string(), &at, m, spec, s)?;
+                        }
+                    }
+                },
+                _ => anyhow::bail!(
+                    "{where_}: {at}: give exactly one of `base` (a law) and `model` (a model name)"
+                ),
+            }
+            anyhow::ensure!(
+                !self.data.is_empty(),
+                "{where_}: {at}.data = []: give at least one record"
+            );
+            let mut effects = Vec::new();
+            for e in self.effects.iter().flatten() {
+                match e.parse::<palpate_core::Effect>() {
+                    Ok(e) => effects.push(e),
+                    Err(m) => anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}"),
+                }
+            }
+            if let Some(list) = &self.effects {
+                anyhow::ensure!(
+                    !list.is_empty(),
+                    "{where_}: {at}.effects = []: give at least one effect, or leave `effects` out for the default candidates"
+                );
+                if let Some(e) = duplicate(list) {
+                    anyhow::bail!("{where_}: {at}.effects: \"{e}\" is listed twice");
+                }
+            }
+            for s in &self.data {
+                let Some(spec) = diagnose_model(study, self, s) else {
+                    continue;
+                };
+                if let Ok(model) = crate::model::build(&spec) {
+                    crate::model::check_effects(model.as_ref(), &effects)
+                        .map_err(|e| anyhow::anyhow!("{where_}: {at}.effects: {e}"))?;
+                }
+            }
+        Ok(())
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        _done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        run_diagnose(run, self, report)
+    }
+}
+
+/// The base model a diagnose step uses on data set `data` (None when
+/// the step or the data set is wrong: reported elsewhere).
+fn diagnose_model(study: &Study, d: &DiagnoseStep, data: &str) -> Option<ModelSpec> {
+    match (&d.base, &d.model) {
+        (Some(base), None) => {
+            let test = crate::records::TestKind::parse(&study.data.get(data)?.test).ok()?;
+            crate::model::gap_base(test, base.parse().ok()?).ok()
+        }
+        (None, Some(m)) => match &study.models.get(m)?.model {
+            ModelForm::Spec(s) => Some(s.clone()),
+            ModelForm::Law(_) => None,
+        },
+        _ => None,
+    }
+}
+
+
 
 /// A diagnosed record as cached.
 #[derive(Debug, Clone, Serialize, Deserialize)]
@@ -25,7 +155,7 @@ pub(crate) fn run_diagnose(
     run: &Run,
     step: &DiagnoseStep,
     report: &mut String,
-) -> anyhow::Result<StepResult> {
+) -> anyhow::Result<serde_json::Value> {
     let (manifest, data) = (run.manifest, run.data);
     // The base model: a named model spec, or the base law in the gap base
     // model of each record's test (models::gap_base).
@@ -120,8 +250,8 @@ pub(crate) fn run_diagnose(
         cases.push(unit.entry);
     }
     let _ = writeln!(report, "\nPlots: `plots/{}-<data>.svg` (data, base and enriched fits, residuals with the flagged windows).\n", step.name);
-    Ok(StepResult::Diagnose {
-        name: step.name.clone(),
-        cases,
-    })
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "cases": cases,
+    }))
 }

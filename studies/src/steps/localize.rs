@@ -1,5 +1,5 @@
 //! The `localize` step of a study: the R2 tumour-localisation analysis
-//! (`crate::localize`) at each rolling depth.
+//! (`crate::apps::localize`) at each rolling depth.
 //!
 //! ```toml
 //! [[steps]]
@@ -15,12 +15,11 @@
 //!
 //! The noise of each RD's record is its own seeded stream, from the study's
 //! seed and the RD ([`noise_stream`]), so the RDs are independent
-//! experiments (before session 9 every RD's record carried the same noise
-//! pattern, and a nodule misread by one realisation was misread alike at
-//! every RD).
+//! experiments (with one noise pattern for all, a nodule misread by one
+//! realisation would be misread alike at every RD).
 //!
 //! Per RD: the localisation model (the scan surrogate + the nodule-free
-//! pass, `crate::localize`), the FE record of the nodules at the finer
+//! pass, `crate::apps::localize`), the FE record of the nodules at the finer
 //! mesh with seeded noise, the posterior; written as `<name>-rd<RD>.json`
 //! (the `palpate localize --json` form), `<name>-rd<RD>.svg` (force against
 //! position with the fit, the true and located nodules, and each nodule's
@@ -28,7 +27,7 @@
 //! force against depth of one nodule (R2-1, the scan surrogate at offset 0)
 //! and the quadratic depth = a F^2 + b F + c per RD (Table III).
 //!
-//! Units (shards, [`crate::shard`]), as in a sample step: first every FE
+//! Units (shards, [`crate::run::shard`]), as in a sample step: first every FE
 //! run of every RD in RD order (per RD the nodule-free pass, each scan of
 //! the surrogate's design, [`ModelUnits`], then the record), cached in the
 //! run folder as its result under a key of its inputs and the code version;
@@ -40,16 +39,15 @@
 //! second beside the FE runs). The FE runs do not use the surrogate cache
 //! of `palpate localize`: a study's units live in its run folder.
 
-use crate::cli::localize::plot_svg;
-use crate::localize::posterior::{localize, LocOptions, LocSampler, Localisation};
-use crate::localize::record::Record;
-use crate::localize::units::{ModelRun, ModelUnits};
-use crate::localize::{LocModel, LocSetup};
-use crate::manifest::Manifest;
-use crate::output::{write_atomic, write_json};
-use crate::run_folder::RunFolder;
-use crate::runner::{Run, StepResult};
-use crate::surrogate::code_version;
+use crate::apps::localize::plot::plot_svg;
+use crate::apps::localize::posterior::{localize, LocOptions, LocSampler, Localisation};
+use crate::apps::localize::record::Record;
+use crate::apps::localize::units::{ModelRun, ModelUnits};
+use crate::apps::localize::{LocModel, LocSetup};
+use crate::run::output::{write_atomic, write_json};
+use crate::run::run_folder::RunFolder;
+use crate::run::step::{At, Run, Step, StepResult, Study};
+use crate::run::surrogate::code_version;
 use palpate_fe::r2::check_model;
 use palpate_fe::r2_scan::R2NoduleScan;
 use palpate_fe::{Nodule, R2Rolling};
@@ -148,7 +146,7 @@ impl LocalizeStep {
     }
 
     /// Checks the step (step `i`); errors name the manifest and the field.
-    pub fn validate(&self, _m: &Manifest, i: usize, where_: &str) -> anyhow::Result<()> {
+    pub(crate) fn check(&self, _m: &Study, i: usize, where_: &str) -> anyhow::Result<()> {
         let at = format!("{where_}: steps[{i}].localize (\"{}\")", self.name);
         anyhow::ensure!(!self.rds.is_empty(), "{at}.rds = []: give at least one RD");
         if let Some(c) = &self.cache {
@@ -224,7 +222,7 @@ pub(crate) fn run_localize(
     run: &Run,
     step: &LocalizeStep,
     report: &mut String,
-) -> anyhow::Result<StepResult> {
+) -> anyhow::Result<serde_json::Value> {
     let at = format!("step `{}`", step.name);
     let seed = run.manifest.study.seed;
     let plans: Vec<RdPlan> = step
@@ -342,17 +340,17 @@ pub(crate) fn run_localize(
         })?;
     if posteriors.iter().any(Option::is_none) {
         // Units of other shards: the runner defers the step.
-        return Ok(StepResult::Localize {
-            name: step.name.clone(),
-            results: Vec::new(),
-        });
+        return Ok(serde_json::json!({
+            "name": step.name.clone(),
+            "results": Vec::<serde_json::Value>::new(),
+        }));
     }
 
     let mut results = Vec::new();
     let _ = writeln!(report, "## Localisation `{}`\n", step.name);
     let _ = writeln!(
         report,
-        "FE records of the nodules `{}` at h = {} mm every {} mm, Gaussian noise SD {} % of the peak force (seed {seed}); posterior on the localisation model (studies/src/localize), {}.\n",
+        "FE records of the nodules `{}` at h = {} mm every {} mm, Gaussian noise SD {} % of the peak force (seed {seed}); posterior on the localisation model (studies/src/apps/localize), {}.\n",
         step.nodules,
         step.record_h_mm,
         step.record_step_mm,
@@ -455,10 +453,10 @@ pub(crate) fn run_localize(
     report.push_str(&table3);
     report.push_str(&leans);
     report.push('\n');
-    Ok(StepResult::Localize {
-        name: step.name.clone(),
-        results,
-    })
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "results": results,
+    }))
 }
 
 /// The FE record of an RD: the force of the nodules' model at the record's
@@ -539,6 +537,27 @@ pub fn quadratic(f: &[f64], d: &[f64]) -> [f64; 3] {
     a.lu()
         .solve(&r)
         .map_or([f64::NAN; 3], |s| [s[0], s[1], s[2]])
+}
+
+
+impl Step for LocalizeStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, at: &At) -> anyhow::Result<()> {
+        self.check(study, at.index, &at.file)
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        let _ = done;
+        run_localize(run, self, report)
+    }
 }
 
 #[cfg(test)]

@@ -13,18 +13,20 @@
 //! Each model runs once, with the parameters of the one fit of the
 //! calibrate step whose law is the model's law, on the union of the
 //! records' displacements; each (model, record) pair gets R^2 = 1 -
-//! SS_res/SS_tot and the RMS residual ([`crate::calibration::r2_rms`]).
+//! SS_res/SS_tot and the RMS residual ([`crate::model::calibration::r2_rms`]).
 //! The runs are units of the run folder's cache keyed by (model, parameters,
 //! loading), so an edit of any other step does not run them again; runs not
 //! cached are computed in parallel (one per thread) with a progress report
 //! over their load steps.
 
-use crate::calibration::r2_rms;
-use crate::manifest::{Manifest, ModelForm, Step};
-use crate::models::{Model, ModelSpec};
-use crate::output::write_atomic;
-use crate::plot::{Plot, Series};
-use crate::runner::{Run, StepResult};
+use crate::model::calibration::r2_rms;
+use crate::model::ModelForm;
+use crate::steps::calibrate::CalibrateStep;
+use crate::model::{Model, ModelSpec};
+use crate::run::output::write_atomic;
+use crate::report::plot::{Plot, Series};
+use crate::run::step::{At, Run, Step, StepResult, Study};
+use crate::run::step::{find_list, Sharding};
 use anyhow::Context;
 use palpate_core::{Drive, Loading};
 use palpate_material::Law;
@@ -48,7 +50,7 @@ pub struct PredictStep {
 impl PredictStep {
     /// Checks the step (step `i` of `manifest`); errors name the manifest
     /// file (`where_`) and the field.
-    pub fn validate(&self, manifest: &Manifest, i: usize, where_: &str) -> anyhow::Result<()> {
+    pub(crate) fn check(&self, manifest: &Study, i: usize, where_: &str) -> anyhow::Result<()> {
         let at = format!("steps[{i}].predict (\"{}\")", self.name);
         let calibrate = match manifest
             .steps
@@ -63,12 +65,12 @@ impl PredictStep {
                 "{where_}: {at}.calibration: step \"{}\" is steps[{j}], not before this one; steps run in order",
                 self.calibration
             ),
-            Some(j) => match &manifest.steps[j] {
-                Step::Calibrate(c) => c,
-                other => anyhow::bail!(
+            Some(j) => match manifest.steps[j].get::<CalibrateStep>() {
+                Some(c) => c,
+                None => anyhow::bail!(
                     "{where_}: {at}.calibration: step \"{}\" is a {} step; expected a calibrate step",
                     self.calibration,
-                    other.kind()
+                    manifest.steps[j].kind
                 ),
             },
         };
@@ -89,7 +91,7 @@ impl PredictStep {
             let spec = match manifest.models.get(m).map(|e| &e.model) {
                 None => anyhow::bail!(
                     "{where_}: {at}.models: unknown model \"{m}\" (defined: {})",
-                    crate::manifest::keys(&manifest.models)
+                    crate::run::step::keys(&manifest.models)
                 ),
                 Some(ModelForm::Law(_)) => anyhow::bail!(
                     "{where_}: {at}.models: \"{m}\" is a law alone; a prediction needs a model kind, e.g. [models.{m}.n1_needle]"
@@ -117,7 +119,7 @@ impl PredictStep {
                 if !manifest.data.contains_key(d) {
                     anyhow::bail!(
                         "{where_}: {at}.data: unknown data set \"{d}\" (defined: {})",
-                        crate::manifest::keys(&manifest.data)
+                        crate::run::step::keys(&manifest.data)
                     );
                 }
                 manifest.check_predicts(where_.to_string(), &at, m, spec, d)?;
@@ -129,8 +131,8 @@ impl PredictStep {
 
 /// The fits of a calibrate step whose model has `law`, as `model/group/residual`.
 fn fits_of_law(
-    manifest: &Manifest,
-    step: &crate::manifest::CalibrateStep,
+    manifest: &Study,
+    step: &CalibrateStep,
     law: Law,
 ) -> Vec<String> {
     let mut out = Vec::new();
@@ -201,13 +203,8 @@ pub(crate) fn run_predict(
     step: &PredictStep,
     done: &[StepResult],
     report: &mut String,
-) -> anyhow::Result<StepResult> {
-    let fits = done
-        .iter()
-        .find_map(|s| match s {
-            StepResult::Calibrate { name, fits } if *name == step.calibration => Some(fits),
-            _ => None,
-        })
+) -> anyhow::Result<serde_json::Value> {
+    let fits = find_list(done, "calibrate", &step.calibration, "fits")
         .with_context(|| {
             format!(
                 "step `{}`: no results of calibrate step `{}`",
@@ -246,7 +243,7 @@ pub(crate) fn run_predict(
         let theta: Vec<f64> = params.iter().map(|p| p.1).collect();
         // Keyed by what the run depends on, not by names: a renamed step
         // or model reuses it.
-        let key = crate::run_folder::RunFolder::key(&("predict", spec, &theta, &drive));
+        let key = crate::run::run_folder::RunFolder::key(&("predict", spec, &theta, &drive));
         jobs.push(Job {
             model: m.clone(),
             spec: spec.clone(),
@@ -314,11 +311,11 @@ pub(crate) fn run_predict(
     }
     if others {
         // Runs of other shards are missing: the runner defers the step.
-        return Ok(StepResult::Predict {
-            name: step.name.clone(),
-            runs: Vec::new(),
-            comparisons: Vec::new(),
-        });
+        return Ok(serde_json::json!({
+            "name": step.name.clone(),
+            "runs": Vec::<serde_json::Value>::new(),
+            "comparisons": Vec::<serde_json::Value>::new(),
+        }));
     }
     let forces: Vec<Vec<f64>> = forces.into_iter().map(Option::unwrap_or_default).collect();
 
@@ -364,17 +361,17 @@ pub(crate) fn run_predict(
         &run.out.join("plots").join(format!("{}.svg", step.name)),
         svg.as_bytes(),
     )?;
-    Ok(StepResult::Predict {
-        name: step.name.clone(),
-        runs: runs
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "runs": runs
             .iter()
             .map(serde_json::to_value)
-            .collect::<Result<_, _>>()?,
-        comparisons: comparisons
+            .collect::<Result<Vec<serde_json::Value>, _>>()?,
+        "comparisons": comparisons
             .iter()
             .map(serde_json::to_value)
-            .collect::<Result<_, _>>()?,
-    })
+            .collect::<Result<Vec<serde_json::Value>, _>>()?,
+    }))
 }
 
 /// Runs each (model, parameters) on `loading`, as many at once as there are
@@ -533,4 +530,27 @@ fn plot(step: &PredictStep, run: &Run, runs: &[PredictionRun]) -> Plot {
         ));
     }
     p
+}
+
+impl Step for PredictStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, at: &At) -> anyhow::Result<()> {
+        self.check(study, at.index, &at.file)
+    }
+
+    fn sharding(&self) -> Sharding {
+        Sharding::AfterEarlierSteps
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        run_predict(run, self, done, report)
+    }
 }

@@ -20,7 +20,7 @@
 //! holdout = 8                  # held-out FE runs (default max(8, 3 x parameters))
 //! ```
 //!
-//! Units (shards, [`crate::shard`]): first, for an FE model, each run of the
+//! Units (shards, [`crate::run::shard`]): first, for an FE model, each run of the
 //! surrogate's design (a Halton point of the box, [`Surrogate::design`]),
 //! cached as its outputs (or the reason it failed); then each independent
 //! unit of the sampler ([`Sampler::run_unit`]: a NUTS chain, a DE-MCz
@@ -36,11 +36,11 @@
 //! `palpate sample`, whose extension needs every chain at once): the
 //! results say whether R-hat < 1.01 and bulk ESS >= 400 hold.
 
-use crate::calibration::TestData;
-use crate::manifest::{Manifest, ModelForm};
-use crate::models::ModelSpec;
-use crate::run_folder::RunFolder;
-use crate::runner::{Run, StepResult};
+use crate::records::TestData;
+use crate::model::ModelForm;
+use crate::model::ModelSpec;
+use crate::run::run_folder::RunFolder;
+use crate::run::step::{At, Run, Step, StepResult, Study};
 use anyhow::Context;
 use palpate_core::ForwardModel;
 use palpate_uq::likelihood::{fit_and_laplace, DataSet, NoiseModel, NoiseSd, Posterior, Prior};
@@ -142,14 +142,14 @@ impl SampleStep {
 
     /// Checks the step (step `i` of `manifest`); errors name the manifest
     /// file (`where_`) and the field.
-    pub fn validate(&self, manifest: &Manifest, i: usize, where_: &str) -> anyhow::Result<()> {
+    pub(crate) fn check(&self, manifest: &Study, i: usize, where_: &str) -> anyhow::Result<()> {
         let at = format!("steps[{i}].sample (\"{}\")", self.name);
         self.sampler(&format!("{where_}: {at}"))?;
         let entry = manifest.models.get(&self.model).with_context(|| {
             format!(
                 "{where_}: {at}.model: unknown model \"{}\" (defined: {})",
                 self.model,
-                crate::manifest::keys(&manifest.models)
+                crate::run::step::keys(&manifest.models)
             )
         })?;
         anyhow::ensure!(
@@ -160,7 +160,7 @@ impl SampleStep {
             anyhow::ensure!(
                 manifest.data.contains_key(d),
                 "{where_}: {at}.data: unknown data set \"{d}\" (defined: {})",
-                crate::manifest::keys(&manifest.data)
+                crate::run::step::keys(&manifest.data)
             );
             anyhow::ensure!(
                 !self.data[..k].contains(d),
@@ -220,7 +220,7 @@ pub(crate) fn run_sample(
     run: &Run,
     step: &SampleStep,
     report: &mut String,
-) -> anyhow::Result<StepResult> {
+) -> anyhow::Result<serde_json::Value> {
     let at = format!("step `{}`", step.name);
     let sampler = step.sampler(&at)?;
     let entry = &run.manifest.models[&step.model];
@@ -252,7 +252,7 @@ pub(crate) fn run_sample(
         seed,
         // FE models: the chains depend on the FE code through the surrogate.
         match &entry.model {
-            ModelForm::Spec(spec) if is_fe(spec) => crate::surrogate::code_version(),
+            ModelForm::Spec(spec) if is_fe(spec) => crate::run::surrogate::code_version(),
             _ => "",
         },
     );
@@ -261,14 +261,14 @@ pub(crate) fn run_sample(
     let sets: Option<Vec<DataSet>> = match &entry.model {
         ModelForm::Spec(spec) if is_fe(spec) => {
             let rec = records[0];
-            let model = crate::models::build(spec)
+            let model = crate::model::build(spec)
                 .map_err(|e| anyhow::anyhow!("models.{}.{e}", step.model))?;
             let boxes: Vec<String> = step
                 .bounds
                 .iter()
                 .map(|(n, b)| format!("{n}={},{}", b[0], b[1]))
                 .collect();
-            let bounds = crate::cli::sample_fe::parse_box(&boxes, model.as_ref())
+            let bounds = crate::run::surrogate::parse_box(&boxes, model.as_ref())
                 .with_context(|| format!("{at}: box"))?;
             let mut options = SurrogateOptions::for_dimension(bounds.len());
             options.training_runs = step.design.unwrap_or(options.training_runs);
@@ -289,7 +289,7 @@ pub(crate) fn run_sample(
                         spec,
                         &rec.loading,
                         theta,
-                        crate::surrogate::code_version(),
+                        crate::run::surrogate::code_version(),
                     ))
                 })
                 .collect();
@@ -331,14 +331,15 @@ pub(crate) fn run_sample(
                 .iter()
                 .map(|r| -> anyhow::Result<DataSet> {
                     let spec = match form {
-                        ModelForm::Law(law) => r.spec(
+                        ModelForm::Law(law) => crate::model::record_spec(
+                            r,
                             law.parse()
                                 .map_err(|e| anyhow::anyhow!("models.{}.law: {e}", step.model))?,
                             None,
                         ),
                         ModelForm::Spec(s) => s.clone(),
                     };
-                    let model: Arc<dyn ForwardModel> = crate::models::build(&spec)
+                    let model: Arc<dyn ForwardModel> = crate::model::build(&spec)
                         .map_err(|e| anyhow::anyhow!("models.{}.{e}", step.model))?
                         .into();
                     Ok(DataSet {
@@ -411,19 +412,19 @@ pub(crate) fn run_sample(
         "surrogate": surrogate_info,
     });
     write_report(step, &summary, x.n_chains, x.n_draws, converged, report);
-    Ok(StepResult::Sample {
-        name: step.name.clone(),
-        result,
-    })
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "result": result,
+    }))
 }
 
 /// The result of a step whose units are not all there (never written:
 /// the runner defers the step).
-fn empty(step: &SampleStep) -> StepResult {
-    StepResult::Sample {
-        name: step.name.clone(),
-        result: serde_json::Value::Null,
-    }
+fn empty(step: &SampleStep) -> serde_json::Value {
+    serde_json::json!({
+        "name": step.name.clone(),
+        "result": serde_json::Value::Null,
+    })
 }
 
 fn write_report(
@@ -468,9 +469,30 @@ fn write_report(
     let _ = writeln!(r);
 }
 
+
+impl Step for SampleStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, at: &At) -> anyhow::Result<()> {
+        self.check(study, at.index, &at.file)
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        let _ = done;
+        run_sample(run, self, report)
+    }
+}
+
 #[cfg(test)]
 mod tests {
-    use crate::manifest::Manifest;
+    use crate::study::manifest::Manifest;
 
     /// The manifest of one sample step with `fields` (TOML lines), its
     /// refusal (parse or validation) as text, or "" when accepted.
@@ -487,7 +509,7 @@ mod tests {
         );
         let path = dir.path().join("s.toml");
         std::fs::write(&path, &text).unwrap();
-        match Manifest::parse(&path, &text).and_then(|m| m.validate(&path).map(|_| m)) {
+        match Manifest::parse(&path, &text).and_then(|m| m.validate(&path)) {
             Ok(_) => String::new(),
             Err(e) => format!("{e:#}"),
         }

@@ -1,9 +1,11 @@
 //! The staged Q1 identification as a study step (`[[steps]] two_stage =
 //! {...}` in a manifest, `studies/two-stage-q1.toml`): its fields, their
 //! checks and its run, cached as a unit of the run folder. The
-//! identification itself is [`crate::two_stage`].
+//! identification itself is [`crate::apps::two_stage`].
 
-use crate::two_stage::{identify, report, Q1Record, TwoStageOptions};
+use crate::apps::two_stage::{identify, report, Q1Record, TwoStageOptions};
+use crate::run::step::{At, Run, Step, StepResult, Study};
+use std::path::PathBuf;
 use palpate_core::ForwardModel;
 use palpate_material::Law;
 use serde::Serialize;
@@ -108,7 +110,7 @@ impl TwoStageStep {
     }
 
     /// Checks the step before any run (the manifest's validation).
-    pub fn validate(&self, where_: &str, at: &str, dir: &std::path::Path) -> anyhow::Result<()> {
+    pub(crate) fn check(&self, where_: &str, at: &str, dir: &std::path::Path) -> anyhow::Result<()> {
         self.options()
             .map_err(|e| anyhow::anyhow!("{where_}: {at}.{e}"))?;
         let f = dir.join(&self.record);
@@ -130,10 +132,10 @@ pub(crate) struct TwoStageUnit {
 
 /// Runs the step (cached under the record's bytes and the options).
 pub(crate) fn run_two_stage(
-    run: &crate::runner::Run<'_>,
+    run: &Run<'_>,
     step: &TwoStageStep,
     report_md: &mut String,
-) -> anyhow::Result<crate::runner::StepResult> {
+) -> anyhow::Result<serde_json::Value> {
     use std::fmt::Write;
     let path = run.manifest_dir.join(&step.record);
     let bytes = std::fs::read(&path).map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
@@ -142,7 +144,7 @@ pub(crate) fn run_two_stage(
         "two_stage",
         format!("{step:?}"),
         bytes,
-        crate::surrogate::code_version(),
+        crate::run::surrogate::code_version(),
     );
     let label = format!("{}: two-stage identification of {}", step.name, step.record);
     let Some(unit): Option<TwoStageUnit> = run.unit(&label, &inputs, || {
@@ -157,18 +159,43 @@ pub(crate) fn run_two_stage(
     })?
     else {
         // Another shard's unit: the runner defers the step.
-        return Ok(crate::runner::StepResult::TwoStage {
-            name: step.name.clone(),
-            result: serde_json::Value::Null,
-        });
+        return Ok(serde_json::json!({
+            "name": step.name.clone(),
+            "result": serde_json::Value::Null,
+        }));
     };
     let _ = writeln!(
         report_md,
         "## {} (two-stage inverse FE, Q1)\n\n{}",
         step.name, unit.report
     );
-    Ok(crate::runner::StepResult::TwoStage {
-        name: step.name.clone(),
-        result: unit.result,
-    })
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "result": unit.result,
+    }))
+}
+
+impl Step for TwoStageStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, at: &At) -> anyhow::Result<()> {
+        let _ = study;
+        self.check(&at.file, &at.step(&self.name), at.dir)
+    }
+
+    fn inputs(&self) -> Vec<PathBuf> {
+        vec![PathBuf::from(&self.record)]
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        let _ = done;
+        run_two_stage(run, self, report)
+    }
 }

@@ -7,22 +7,25 @@
 //! * `provenance.json` — hashes, git commit, crate versions, seed, threads, timings.
 //!
 //! The folder is staged, locked, marked while incomplete and resumable
-//! ([`crate::run_folder`]): each fit and each diagnosed record is a unit
+//! ([`crate::run::run_folder`]): each fit and each diagnosed record is a unit
 //! cached under the hash of its inputs, so a rerun (after a kill, or after
 //! an edit of another step) computes only the units whose inputs changed.
 
-use crate::calibration::{Calibration, TestData, TestKind};
-use crate::manifest::{CalibrateStep, DiagnoseStep, Manifest, Step};
-use crate::output::{write_atomic, write_json};
-use crate::provenance::{crate_versions, git_state, hash_file, Provenance};
-use crate::run_folder::RunFolder;
-use crate::shard::{Shard, ShardRecord};
+use crate::records::{TestData, TestKind};
+use crate::run::output::{write_atomic, write_json};
+use crate::run::provenance::{crate_versions, git_state, hash_file, Provenance};
+use crate::run::run_folder::RunFolder;
+use crate::run::shard::{Shard, ShardRecord};
+use crate::run::step::{Run, Sharding};
+use crate::study::manifest::Manifest;
 use anyhow::Context;
 use serde::Serialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
+
+pub use crate::run::step::{RunObserver, StepResult};
 
 /// The results of a whole study (`results.json`).
 #[derive(Debug, Clone, Serialize)]
@@ -33,50 +36,6 @@ pub struct StudyResults {
     pub steps: Vec<StepResult>,
 }
 
-/// The results of one step. Each fit is a [`FitEntry`] and each case a
-/// [`DiagnoseEntry`], held as JSON so that a unit read from the cache and
-/// one computed now give the same bytes.
-#[derive(Debug, Clone, Serialize)]
-#[serde(rename_all = "snake_case")]
-pub enum StepResult {
-    Calibrate {
-        name: String,
-        fits: Vec<serde_json::Value>,
-    },
-    Diagnose {
-        name: String,
-        cases: Vec<serde_json::Value>,
-    },
-    /// [`crate::predict_step`]: each model's run and each (model, record) comparison.
-    Predict {
-        name: String,
-        runs: Vec<serde_json::Value>,
-        comparisons: Vec<serde_json::Value>,
-    },
-    /// [`crate::two_stage`]: the staged inverse FE identification of a Q1 record.
-    TwoStage {
-        name: String,
-        result: serde_json::Value,
-    },
-    /// [`crate::anova_step`]: the runs, our analysis and the published one.
-    Anova {
-        name: String,
-        runs: serde_json::Value,
-        analysis: serde_json::Value,
-        published: Option<serde_json::Value>,
-    },
-    /// [`crate::localize_step`]: per RD, the localisation and the peak-force table.
-    Localize {
-        name: String,
-        results: Vec<serde_json::Value>,
-    },
-    /// [`crate::sample_step`]: the posterior summary.
-    Sample {
-        name: String,
-        result: serde_json::Value,
-    },
-}
-
 /// How to run a study.
 #[derive(Debug, Clone, Default)]
 pub struct RunOptions {
@@ -84,7 +43,7 @@ pub struct RunOptions {
     pub out: Option<PathBuf>,
     /// Compute every unit again (the cache of finished units is emptied).
     pub fresh: bool,
-    /// Compute only this shard's units into the cache ([`crate::shard`]):
+    /// Compute only this shard's units into the cache ([`crate::run::shard`]):
     /// no results are written, other shards may run at the same time.
     pub shard: Option<Shard>,
 }
@@ -108,36 +67,6 @@ pub struct RunSummary {
     /// Steps a shard run deferred (they need the results of steps whose
     /// units other shards compute).
     pub deferred_steps: Vec<String>,
-}
-
-/// One fit of a calibrate step.
-#[derive(Debug, Clone, Serialize)]
-pub struct FitEntry {
-    pub model: String,
-    pub group: String,
-    pub residual: String,
-    pub calibration: Calibration,
-}
-
-/// One diagnosed data set.
-#[derive(Debug, Clone, Serialize)]
-pub struct DiagnoseEntry {
-    pub data: String,
-    pub report: serde_json::Value,
-}
-
-/// Progress messages of a run (the CLI shows them; tests ignore them).
-pub trait RunObserver {
-    fn message(&self, text: &str);
-    /// `done` of `total` load steps of the FE runs of a step (`label`);
-    /// called on the runner's thread.
-    fn progress(&self, _label: &str, _done: u64, _total: u64) {}
-}
-
-impl<F: Fn(&str)> RunObserver for F {
-    fn message(&self, text: &str) {
-        self(text)
-    }
 }
 
 /// Runs the manifest at `path` into `out_dir` (default `runs/<study name>`),
@@ -179,7 +108,7 @@ pub fn run_study_counted(
         anyhow::bail!(
             "--fresh with --shard {shard}: a shard would empty the cache the other shards fill; \
              empty it once before the shards (palpate run --fresh without --shard, or remove RUN_DIR/{}/cache)",
-            crate::run_folder::STATE
+            crate::run::run_folder::STATE
         );
     }
     let started = std::time::Instant::now();
@@ -187,8 +116,7 @@ pub fn run_study_counted(
         .duration_since(std::time::UNIX_EPOCH)
         .map(|d| d.as_secs())
         .unwrap_or(0);
-    let manifest = Manifest::read(path)?;
-    manifest.validate(path)?;
+    let manifest = Manifest::read(path)?.validate(path)?;
     let dir = path.parent().unwrap_or(Path::new("."));
     let out = options
         .out
@@ -211,11 +139,13 @@ pub fn run_study_counted(
         .data
         .values()
         .map(|d| dir.join(&d.file))
-        .chain(manifest.steps.iter().filter_map(|s| match s {
-            Step::Anova(a) => a.published.as_ref().map(|p| dir.join(p)),
-            Step::TwoStage(t) => Some(dir.join(&t.record)),
-            _ => None,
-        }))
+        .chain(
+            manifest
+                .steps
+                .iter()
+                .flat_map(|s| s.step().inputs())
+                .map(|p| dir.join(p)),
+        )
         .collect();
     let inputs: Vec<PathBuf> = std::iter::once(path.to_path_buf())
         .chain(data_files.iter().cloned())
@@ -229,8 +159,8 @@ pub fn run_study_counted(
     let scratch = match options.shard {
         Some(_) => Some(
             tempfile::Builder::new()
-                .prefix(crate::run_folder::SHARD_SCRATCH)
-                .tempdir_in(out.join(crate::run_folder::STATE))
+                .prefix(crate::run::run_folder::SHARD_SCRATCH)
+                .tempdir_in(out.join(crate::run::run_folder::STATE))
                 .with_context(|| format!("cannot create a scratch folder in {}", out.display()))?,
         ),
         None => None,
@@ -250,8 +180,9 @@ pub fn run_study_counted(
     if !manifest.study.description.is_empty() {
         let _ = writeln!(report, "{}\n", manifest.study.description.trim());
     }
+    let study = manifest.study_view();
     let run = Run {
-        manifest: &manifest,
+        manifest: &study,
         manifest_dir: dir,
         data: &data,
         out: &stage,
@@ -266,14 +197,15 @@ pub fn run_study_counted(
     };
     // Shard runs: the steps left for a later pass or the merge.
     let mut deferred: Vec<String> = Vec::new();
-    for (i, step) in manifest.steps.iter().enumerate() {
+    for (i, step) in study.steps.iter().enumerate() {
         run.step_index.store(i, Ordering::Relaxed);
         run.unit_index.store(0, Ordering::Relaxed);
         if let Some(shard) = options.shard {
             // Steps on the results of other steps wait until those are whole;
             // steps without units of their own are left to the merge.
-            let waits = matches!(step, Step::Predict(_) | Step::Anova(_)) && !deferred.is_empty();
-            if waits || matches!(step, Step::Anova(_)) {
+            let at_merge = step.step.sharding() == Sharding::AtMerge;
+            let waits = step.step.sharding() != Sharding::Units && !deferred.is_empty();
+            if waits || at_merge {
                 observer.message(&format!(
                     "{}: left to {} (shard {shard})",
                     step.name(),
@@ -288,21 +220,14 @@ pub fn run_study_counted(
             }
         }
         let others_before = run.others.load(Ordering::Relaxed);
-        let r = match step {
-            Step::Calibrate(c) => run.calibrate(c, &mut report)?,
-            Step::Diagnose(d) => run.diagnose(d, &mut report)?,
-            Step::Predict(p) => {
-                crate::predict_step::run_predict(&run, p, &results.steps, &mut report)?
-            }
-            Step::Anova(a) => crate::anova_step::run_anova(&run, a, &results.steps, &mut report)?,
-            Step::TwoStage(t) => crate::two_stage_step::run_two_stage(&run, t, &mut report)?,
-            Step::Localize(l) => crate::localize_step::run_localize(&run, l, &mut report)?,
-            Step::Sample(p) => crate::sample_step::run_sample(&run, p, &mut report)?,
-        };
+        let body = step.step.run(&run, &results.steps, &mut report)?;
         if run.others.load(Ordering::Relaxed) > others_before {
             deferred.push(step.name().to_string());
         } else {
-            results.steps.push(r);
+            results.steps.push(StepResult {
+                kind: manifest.steps[i].kind(),
+                body,
+            });
         }
     }
     let units = UnitCounts {
@@ -323,7 +248,7 @@ pub fn run_study_counted(
         };
         record.write(&out, shard)?;
         std::fs::remove_file(
-            crate::shard::records_dir(&out).join(format!("{}.running", shard.stem())),
+            crate::run::shard::records_dir(&out).join(format!("{}.running", shard.stem())),
         )
         .ok();
         drop(scratch);
@@ -378,178 +303,4 @@ fn check_not_inside(out: &Path, inputs: &[PathBuf]) -> anyhow::Result<()> {
         }
     }
     Ok(())
-}
-
-/// One study run: what every step needs.
-pub(crate) struct Run<'a> {
-    pub(crate) manifest: &'a Manifest,
-    /// The manifest's folder (its relative paths start there).
-    pub(crate) manifest_dir: &'a Path,
-    pub(crate) data: &'a BTreeMap<String, TestData>,
-    /// The staging folder the files are written into.
-    pub(crate) out: &'a Path,
-    pub(crate) folder: &'a RunFolder,
-    pub(crate) observer: &'a dyn RunObserver,
-    /// A shard run computes only its own units ([`crate::shard`]).
-    pub(crate) shard: Option<Shard>,
-    /// The step being run and the number of its units met so far (the
-    /// unit's place, which says which shard computes it).
-    step_index: AtomicUsize,
-    unit_index: AtomicUsize,
-    computed: AtomicUsize,
-    cached: AtomicUsize,
-    others: AtomicUsize,
-}
-
-impl Run<'_> {
-    /// A unit's record: from the cache when its inputs are unchanged, else
-    /// computed and cached at once (so a kill after it keeps it). `None`:
-    /// a unit of another shard, not cached yet (shard runs only).
-    pub(crate) fn unit<T, K>(
-        &self,
-        label: &str,
-        inputs: &K,
-        compute: impl FnOnce() -> anyhow::Result<T>,
-    ) -> anyhow::Result<Option<T>>
-    where
-        T: Serialize + serde::de::DeserializeOwned,
-        K: std::fmt::Debug,
-    {
-        let key = RunFolder::key(inputs);
-        let claim = self.claim(&key);
-        if claim.is_none() {
-            if let Some(record) = self.folder.cached(&key) {
-                self.observer.message(&format!("{label} (cached)"));
-                return Ok(Some(record));
-            }
-            // Unreadable: computed again (by its owner).
-        }
-        if claim == Some(false) {
-            return Ok(None);
-        }
-        self.observer.message(label);
-        let record = compute()?;
-        self.folder.store(&key, &record)?;
-        Ok(Some(record))
-    }
-
-    /// Takes the next unit of the step (key `key`): `None` when it is
-    /// cached, else whether this process computes it (every unit without
-    /// shards; the shard's own ones with). Counts the unit. Call it once
-    /// per unit, in the manifest's order, cached or not.
-    pub(crate) fn claim(&self, key: &str) -> Option<bool> {
-        let k = self.unit_index.fetch_add(1, Ordering::Relaxed);
-        if self.folder.has(key) {
-            self.cached.fetch_add(1, Ordering::Relaxed);
-            return None;
-        }
-        let mine = self
-            .shard
-            .is_none_or(|s| s.owns(self.step_index.load(Ordering::Relaxed), k));
-        let counter = if mine { &self.computed } else { &self.others };
-        counter.fetch_add(1, Ordering::Relaxed);
-        Some(mine)
-    }
-
-    /// Counts the next unit of the step (key `key`) as one that cannot be
-    /// computed yet (it needs units of other shards): cached, or left to a
-    /// later pass or the merge whichever shard owns it. Call it where
-    /// [`Run::claim`] would be called.
-    pub(crate) fn wait(&self, key: &str) {
-        self.unit_index.fetch_add(1, Ordering::Relaxed);
-        let counter = if self.folder.has(key) {
-            &self.cached
-        } else {
-            &self.others
-        };
-        counter.fetch_add(1, Ordering::Relaxed);
-    }
-
-    /// The units of `keys` (in order, each claimed once): cached ones read,
-    /// this process's computed in parallel (`compute(k)`), each cached as
-    /// soon as it is done, others' `None`.
-    pub(crate) fn units<T>(
-        &self,
-        keys: &[String],
-        label: &str,
-        compute: impl Fn(usize) -> anyhow::Result<T> + Sync,
-    ) -> anyhow::Result<Vec<Option<T>>>
-    where
-        T: Serialize + serde::de::DeserializeOwned + Send,
-    {
-        self.units_when(keys, &vec![true; keys.len()], label, compute)
-    }
-
-    /// [`Run::units`] for units of a second level: unit k can be computed
-    /// only when `ready[k]` (the units it needs are all there); one not
-    /// ready is counted with [`Run::wait`] at its place and is `None`. Every
-    /// process meets the units in the same order, ready or not, so they
-    /// agree on each unit's owner.
-    pub(crate) fn units_when<T>(
-        &self,
-        keys: &[String],
-        ready: &[bool],
-        label: &str,
-        compute: impl Fn(usize) -> anyhow::Result<T> + Sync,
-    ) -> anyhow::Result<Vec<Option<T>>>
-    where
-        T: Serialize + serde::de::DeserializeOwned + Send,
-    {
-        use rayon::prelude::*;
-        let claims: Vec<Option<Option<bool>>> = keys
-            .iter()
-            .zip(ready)
-            .map(|(k, &r)| {
-                if r {
-                    Some(self.claim(k))
-                } else {
-                    self.wait(k);
-                    None
-                }
-            })
-            .collect();
-        let mut out: Vec<Option<T>> = keys
-            .iter()
-            .zip(&claims)
-            .map(|(k, c)| c.and_then(|_| self.folder.cached(k)))
-            .collect();
-        let cached = out.iter().filter(|u| u.is_some()).count();
-        if cached > 0 {
-            self.observer
-                .message(&format!("{label}: {cached} of {} cached", keys.len()));
-        }
-        let todo: Vec<usize> = (0..keys.len())
-            .filter(|&k| out[k].is_none() && matches!(claims[k], Some(c) if c != Some(false)))
-            .collect();
-        if !todo.is_empty() {
-            self.observer.message(&format!(
-                "{label}: computing {} of {}",
-                todo.len(),
-                keys.len()
-            ));
-            // Each unit is cached as soon as it is computed: a kill (or a
-            // failed unit) keeps the others (FE runs of minutes each).
-            let folder = self.folder;
-            let done: Vec<anyhow::Result<T>> = todo
-                .par_iter()
-                .map(|&k| {
-                    let unit = compute(k)?;
-                    folder.store(&keys[k], &unit)?;
-                    Ok(unit)
-                })
-                .collect();
-            for (&k, r) in todo.iter().zip(done) {
-                out[k] = Some(r?);
-            }
-        }
-        Ok(out)
-    }
-
-    fn calibrate(&self, step: &CalibrateStep, report: &mut String) -> anyhow::Result<StepResult> {
-        crate::calibrate_step::run_calibrate(self, step, report)
-    }
-
-    fn diagnose(&self, step: &DiagnoseStep, report: &mut String) -> anyhow::Result<StepResult> {
-        crate::diagnose_step::run_diagnose(self, step, report)
-    }
 }

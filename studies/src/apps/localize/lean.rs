@@ -20,11 +20,11 @@
 //! ([`fit_shift`]), and interpolated bilinearly in (e, d); it is zero from
 //! the last measured distance to the centre. One number per scan cannot fit
 //! the centre surrogate's own error or the mesh differences between scans
-//! the way a correction of the whole curve did (session 11: that fitted
-//! ~0.1 N of noise and cost depth accuracy).
+//! the way a correction of the whole curve did (that fitted ~0.1 N of
+//! noise and cost depth accuracy).
 
 use super::{LocModel, LocSetup};
-use crate::surrogate::load_or_compute;
+use crate::run::surrogate::load_or_compute;
 use palpate_fe::r2_scan::R2NoduleScan;
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -192,7 +192,7 @@ pub fn load_or_measure(model: &LocModel, setup: &LocSetup, cache: &Path) -> anyh
     let cases = cases();
     let (runs, _) = load_or_compute("r2-lean", &setup.lean_description(), cache, || {
         use rayon::prelude::*;
-        let bar = crate::limits::Progress::new(
+        let bar = crate::run::limits::Progress::new(
             cases.len() as u64,
             &format!("R2 end-lean FE scans, RD {}", setup.template.rd),
             "{msg} [{bar:40}] {pos}/{len} FE scans ({elapsed}, eta {eta})",

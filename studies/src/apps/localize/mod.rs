@@ -32,15 +32,15 @@
 //!   rolled path are undefined, so one trend + GP per offset). It removes
 //!   most of the shallow nodules' lean, but on the FE records its depths
 //!   are worse than the centre model's (the correction also fits the mesh
-//!   differences between the scans): not the default (session 10
-//!   measurements in the validation doc);
+//!   differences between the scans): not the default (measurements in
+//!   the validation doc);
 //! * the centre model with the end lean ([`LocSetup::r2_lean`], the
 //!   default of `palpate localize` and of a study's localize step): each
 //!   nodule's excess shifted by one measured lean per position and depth
 //!   ([`lean`]); its 94 % x intervals cover at the nominal rate on 50 FE
 //!   records, where the centre model's cover 81 %.
 //!
-//! All are cached on disk per RD ([`crate::surrogate`]). The surrogate's
+//! All are cached on disk per RD ([`crate::run::surrogate`]). The surrogate's
 //! held-out error variance, per offset, is added to the likelihood's noise
 //! variance (posterior.rs).
 //!
@@ -49,11 +49,12 @@
 //! one step past the half-width.
 
 pub mod lean;
+pub mod plot;
 pub mod posterior;
 pub mod record;
 pub mod units;
 
-use crate::surrogate::{load_or_build, load_or_compute, CacheStatus};
+use crate::run::surrogate::{load_or_build, load_or_compute, CacheStatus};
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::r2::check_model;
 use palpate_fe::r2_scan::R2NoduleScan;
@@ -440,7 +441,7 @@ impl LocModel {
         }
         let (baseline, baseline_status) =
             load_or_compute("r2-baseline", &setup.description(), cache, || {
-                let bar = crate::limits::Progress::new(
+                let bar = crate::run::limits::Progress::new(
                     setup.baseline_positions().len() as u64,
                     "nodule-free FE pass",
                     "{msg} [{bar:40}] {pos}/{len} positions ({elapsed}, eta {eta})",
@@ -497,7 +498,7 @@ impl LocModel {
                     std::time::Instant::now(),
                     palpate_uq::surrogate::cpu_seconds(),
                 );
-                let bar = crate::limits::Progress::new(
+                let bar = crate::run::limits::Progress::new(
                     n as u64,
                     &label,
                     "{msg} [{bar:40}] {pos}/{len} FE scans ({elapsed}, eta {eta})",

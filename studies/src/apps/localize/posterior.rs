@@ -5,7 +5,7 @@
 //!
 //! Why NUTS by default: on the RD 6 three-nodule record (8 parameters) the
 //! ensemble sampler stopped at its draw cap with R-hat 1.03-1.04 on every
-//! record tried (session 8, 50 seeds), in 10-60 s; NUTS (4 chains, gradients
+//! record tried (50 seeds), in 10-60 s; NUTS (4 chains, gradients
 //! by finite differences of the surrogate's density) converges to R-hat
 //! 1.005 with the same means and SDs to 0.01 mm, in 4.7 s for the whole
 //! study step (docs/validation/r2-localisation.md).
@@ -63,7 +63,7 @@ pub struct SurrogateInfo {
     pub max_rel_error: f64,
 }
 
-/// The JSON of `palpate localize --json` (issue 11).
+/// The JSON of `palpate localize --json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Localisation {
     pub nodules: Vec<NoduleEstimate>,

@@ -1,6 +1,6 @@
 //! The FE runs behind the localisation model of one RD as independent
 //! units, what the shards of a study's localize step compute
-//! (`crate::localize_step`, `crate::shard`): unit 0 the nodule-free pass
+//! (`crate::steps::localize`, `crate::run::shard`): unit 0 the nodule-free pass
 //! F0 ([`LocSetup::baseline_pass`]), then one unit per scan of the
 //! surrogate's design (the depths [`Surrogate::design`] gives for
 //! [`LocSetup::scan_model`]: the training ones, then the held-out ones).
@@ -17,7 +17,7 @@
 //! uses [`ModelUnits::r2`].
 
 use super::{lean, Baseline, LocModel, LocSetup};
-use crate::surrogate::code_version;
+use crate::run::surrogate::code_version;
 use palpate_core::{ForwardModel, Loading};
 use palpate_fe::r2_scan::R2NoduleScan;
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateRequest};

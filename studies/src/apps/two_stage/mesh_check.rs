@@ -1,4 +1,4 @@
-//! How far a staged Q1 identification's estimates ([`crate::two_stage`])
+//! How far a staged Q1 identification's estimates ([`crate::apps::two_stage`])
 //! would move on another mesh: the discretisation error of the estimates,
 //! which their standard errors (noise only) do not hold.
 //!
@@ -23,9 +23,9 @@
 //! noise. It is read through the fit mesh's sensitivities: where their
 //! shape differs from the check mesh's (a fit mesh with its own punch edge,
 //! at depth), the fixed point is not the check mesh's own optimum (5 mm
-//! record, tau1: docs/guide.md, two-stage, session 22).
+//! record, tau1: docs/guide.md, two-stage).
 
-use crate::two_stage::{run_stage, Q1Record, Say, StageData, StageModels, TwoStageOptions};
+use crate::apps::two_stage::{run_stage, Q1Record, Say, StageData, StageModels, TwoStageOptions};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -59,7 +59,7 @@ pub struct MeshCheck {
 /// standard errors `se` (the polish's): the fit mesh's model corrected to
 /// the check mesh (`options.check_h`), from `theta`, round by round as the
 /// polish (at most `options.correction_rounds`, until the estimates move by
-/// less than [`crate::two_stage::ROUND_TOLERANCE`] SE).
+/// less than [`crate::apps::two_stage::ROUND_TOLERANCE`] SE).
 pub fn check_estimate(
     record: &Q1Record,
     options: &TwoStageOptions,

@@ -1,6 +1,6 @@
 //! The two-stage identification of a quasi-linear viscoelastic material by
-//! inverse finite elements on a Q1 ramp-and-hold record (BENCHMARKS.md Q1;
-//! issue 13, the third source study): Levenberg-Marquardt on the FE model
+//! inverse finite elements on a Q1 ramp-and-hold record (BENCHMARKS.md Q1,
+//! the third source study): Levenberg-Marquardt on the FE model
 //! (`palpate_fe::Q1Punch`), in stages,
 //!
 //! 1. `elastic`: the law's parameters of an *elastic* FE model fitted to the
@@ -37,7 +37,12 @@
 //! ([`TwoStageOptions::fd`]); the time step is fixed (`max_time_step`), so
 //! the discretisation does not move with `tau_i`.
 
-use crate::two_stage_mesh_check::MeshCheck;
+pub mod mesh_check;
+pub mod profile;
+pub mod ramp;
+pub mod report;
+
+use mesh_check::MeshCheck;
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::Q1Punch;
 use palpate_inverse::{
@@ -49,10 +54,9 @@ use serde::Serialize;
 use std::sync::Arc;
 use std::time::Instant;
 
-pub use crate::two_stage_profile::{Profile, CHI2_1_95};
-pub use crate::two_stage_ramp::ramp_correction;
-pub use crate::two_stage_report::report;
-pub use crate::two_stage_step::TwoStageStep;
+pub use profile::{Profile, CHI2_1_95};
+pub use ramp::ramp_correction;
+pub use report::report;
 
 /// The correction rounds stop when every estimate moves by less than this
 /// part of its standard error.
@@ -78,7 +82,7 @@ pub struct TwoStageOptions {
     /// Element size under the punch of a mesh the polish is checked on
     /// (mm; `None`: no check): one more round of the polish corrected to it
     /// gives the estimates' shift on that mesh
-    /// ([`crate::two_stage_mesh_check`]).
+    /// ([`crate::apps::two_stage::mesh_check`]).
     pub check_h: Option<f64>,
     /// Rounds of the polish and the one-stage fit with the correction: the
     /// anchor moves to each round's estimate until the estimates move by
@@ -346,7 +350,7 @@ impl Q1Record {
     /// Reads a record file (`time_s,displacement_mm,force_N`, as `palpate
     /// simulate --benchmark Q1 --csv` writes).
     pub fn read(path: &std::path::Path) -> anyhow::Result<Q1Record> {
-        let d = crate::calibration::TestData::read("Q1", crate::calibration::TestKind::N1, path)?;
+        let d = crate::records::TestData::read("Q1", crate::records::TestKind::N1, path)?;
         let time = d.loading.time.clone().ok_or_else(|| {
             anyhow::anyhow!(
                 "{}: a Q1 record is a timed ramp-and-hold: it needs a time_s column",
@@ -778,7 +782,7 @@ pub fn identify(
         Some(h) => {
             say(&format!(
                 "mesh check: the polish corrected to a {} mm mesh from its estimate",
-                crate::two_stage_mesh_check::mm(h)
+                crate::apps::two_stage::mesh_check::mm(h)
             ));
             let se: Vec<Option<f64>> = polish
                 .fit
@@ -786,7 +790,7 @@ pub fn identify(
                 .iter()
                 .map(|e| e.standard_error)
                 .collect();
-            let c = crate::two_stage_mesh_check::check_estimate(
+            let c = crate::apps::two_stage::mesh_check::check_estimate(
                 record,
                 options,
                 &polish.theta,
@@ -803,7 +807,7 @@ pub fn identify(
     };
     let profiles = if options.profile {
         say("profile-likelihood intervals of the polished parameters");
-        crate::two_stage_profile::profiles(&full, &polish, options)
+        crate::apps::two_stage::profile::profiles(&full, &polish, options)
     } else {
         Vec::new()
     };
@@ -845,5 +849,4 @@ pub fn identify(
 }
 
 #[cfg(test)]
-#[path = "two_stage_tests.rs"]
 mod tests;

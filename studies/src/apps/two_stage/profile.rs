@@ -1,8 +1,8 @@
 //! The profile-likelihood intervals of a staged Q1 identification's polished
-//! parameters ([`crate::two_stage`]): each side refitted by LM with the
+//! parameters ([`crate::apps::two_stage`]): each side refitted by LM with the
 //! parameter held.
 
-use crate::two_stage::{lm_fit, StageResult, TwoStageOptions};
+use crate::apps::two_stage::{lm_fit, StageResult, TwoStageOptions};
 use palpate_inverse::{DataSet, Objective, ResidualKind};
 use serde::Serialize;
 

@@ -1,8 +1,8 @@
 //! Stage 1's force-level correction of a staged Q1 identification
-//! ([`crate::two_stage`]): the relaxation during the ramp, from the elastic
+//! ([`crate::apps::two_stage`]): the relaxation during the ramp, from the elastic
 //! FE curve without another FE run.
 
-use crate::two_stage::Q1Record;
+use crate::apps::two_stage::Q1Record;
 use palpate_core::{ForwardModel, Loading};
 use palpate_inverse::{fit, DataSet, FitOptions, Objective, ResidualKind};
 use std::sync::Arc;

@@ -1,9 +1,9 @@
-//! The Markdown report of a staged Q1 identification ([`crate::two_stage`]):
+//! The Markdown report of a staged Q1 identification ([`crate::apps::two_stage`]):
 //! one row per stage (iterations, FE runs, wall time, RMS, estimates), the
 //! one-stage comparison, and the estimates with standard errors, profile
 //! intervals and, given the truth, their errors.
 
-use crate::two_stage::{StageResult, TwoStageResult};
+use crate::apps::two_stage::{StageResult, TwoStageResult};
 
 /// `theta` with its Prony pairs `(g_i, tau_i)` (the trailing parameters
 /// named `g<i>`, `tau<i>_s`) in increasing `tau`, and whether that moved
@@ -49,7 +49,7 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
              moved the anchor to their estimate, round by round, until the estimates moved by less \
              than {} of their standard errors. LM iterations are summed over the rounds (each round's \
              in brackets); FE runs are the fit mesh's, the correcting mesh's runs are counted apart.\n",
-            crate::two_stage::ROUND_TOLERANCE
+            crate::apps::two_stage::ROUND_TOLERANCE
         );
         if let Some(rho) = result.fit_edge_radius_mm {
             let _ = writeln!(
@@ -162,12 +162,12 @@ pub fn report(result: &TwoStageResult, truth: Option<&[f64]>) -> String {
                  optimum. More rounds, or a start nearer the optimum (the staged route's), settle it.",
                 s.stage,
                 s.last_round_move_se,
-                crate::two_stage::ROUND_TOLERANCE
+                crate::apps::two_stage::ROUND_TOLERANCE
             );
         }
     }
     if let Some(c) = &result.mesh_check {
-        r += &crate::two_stage_mesh_check::report(
+        r += &crate::apps::two_stage::mesh_check::report(
             c,
             &result.names,
             Some(result.correcting_mesh_mm.unwrap_or(result.fit_mesh_mm)),

@@ -1,4 +1,4 @@
-//! Unit tests of `two_stage.rs`.
+//! Unit tests of the two-stage identification.
 
 use super::*;
 
