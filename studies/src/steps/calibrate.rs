@@ -58,69 +58,69 @@ impl Step for CalibrateStep {
 
     fn validate(&self, study: &Study, site: &At) -> anyhow::Result<()> {
         let where_ = &site.file;
-            let at = site.step(&self.name);
-            for (field, list) in [
-                ("models", &self.models),
-                ("residuals", &self.residuals),
-                ("predict", &self.predict),
-            ] {
-                if list.is_empty() && field != "predict" {
-                    anyhow::bail!("{where_}: {at}.{field} = []: give at least one");
-                }
-                if let Some(d) = duplicate(list) {
-                    anyhow::bail!("{where_}: {at}.{field}: \"{d}\" is listed twice");
-                }
+        let at = site.step(&self.name);
+        for (field, list) in [
+            ("models", &self.models),
+            ("residuals", &self.residuals),
+            ("predict", &self.predict),
+        ] {
+            if list.is_empty() && field != "predict" {
+                anyhow::bail!("{where_}: {at}.{field} = []: give at least one");
             }
-            for m in &self.models {
-                if !study.models.contains_key(m) {
-                    anyhow::bail!(
-                        "{where_}: {at}.models: unknown model \"{m}\" (defined: {})",
-                        keys(&study.models)
-                    );
-                }
+            if let Some(d) = duplicate(list) {
+                anyhow::bail!("{where_}: {at}.{field}: \"{d}\" is listed twice");
             }
-            if self.fits.is_empty() {
+        }
+        for m in &self.models {
+            if !study.models.contains_key(m) {
                 anyhow::bail!(
-                    "{where_}: {at}.fits: at least one group of data sets is needed"
+                    "{where_}: {at}.models: unknown model \"{m}\" (defined: {})",
+                    keys(study.models)
                 );
             }
-            for (g, sets) in &self.fits {
-                if sets.is_empty() {
-                    anyhow::bail!("{where_}: {at}.fits.{g}: empty group");
-                }
-                for s in sets {
-                    if !study.data.contains_key(s) {
-                        anyhow::bail!("{where_}: {at}.fits.{g}: unknown data set \"{s}\" (defined: {})", keys(&study.data));
-                    }
-                }
+        }
+        if self.fits.is_empty() {
+            anyhow::bail!(
+                "{where_}: {at}.fits: at least one group of data sets is needed"
+            );
+        }
+        for (g, sets) in &self.fits {
+            if sets.is_empty() {
+                anyhow::bail!("{where_}: {at}.fits.{g}: empty group");
             }
-            for s in &self.predict {
+            for s in sets {
                 if !study.data.contains_key(s) {
-                    anyhow::bail!(
-                        "{where_}: {at}.predict: unknown data set \"{s}\" (defined: {})",
-                        keys(&study.data)
-                    );
+                    anyhow::bail!("{where_}: {at}.fits.{g}: unknown data set \"{s}\" (defined: {})", keys(study.data));
                 }
             }
-            for m in &self.models {
-                let ModelForm::Spec(spec) = &study.models[m].model else {
-                    continue;
-                };
-                for s in self.fits.values().flatten().chain(&self.predict) {
-                    study.check_predicts(where_.to_string(), &at, m, spec, s)?;
-                }
-            }
-            for r in &self.residuals {
-                if !["absolute", "relative", "normalised"].contains(&r.as_str()) {
-                    anyhow::bail!("{where_}: {at}.residuals: \"{r}\" is not one of absolute, relative, normalised");
-                }
-            }
-            if !["lm", "bfgs", "lbfgs"].contains(&self.estimator.as_str()) {
+        }
+        for s in &self.predict {
+            if !study.data.contains_key(s) {
                 anyhow::bail!(
-                    "{where_}: {at}.estimator: \"{}\" is not one of lm, bfgs, lbfgs",
-                    self.estimator
+                    "{where_}: {at}.predict: unknown data set \"{s}\" (defined: {})",
+                    keys(study.data)
                 );
             }
+        }
+        for m in &self.models {
+            let ModelForm::Spec(spec) = &study.models[m].model else {
+                continue;
+            };
+            for s in self.fits.values().flatten().chain(&self.predict) {
+                study.check_predicts(where_.to_string(), &at, m, spec, s)?;
+            }
+        }
+        for r in &self.residuals {
+            if !["absolute", "relative", "normalised"].contains(&r.as_str()) {
+                anyhow::bail!("{where_}: {at}.residuals: \"{r}\" is not one of absolute, relative, normalised");
+            }
+        }
+        if !["lm", "bfgs", "lbfgs"].contains(&self.estimator.as_str()) {
+            anyhow::bail!(
+                "{where_}: {at}.estimator: \"{}\" is not one of lm, bfgs, lbfgs",
+                self.estimator
+            );
+        }
         Ok(())
     }
 

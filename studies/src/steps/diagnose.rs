@@ -46,72 +46,72 @@ impl Step for DiagnoseStep {
 
     fn validate(&self, study: &Study, site: &At) -> anyhow::Result<()> {
         let where_ = &site.file;
-            let at = site.step(&self.name);
-            for s in &self.data {
-                match study.data.get(s) {
-                    None => anyhow::bail!(
-                        "{where_}: {at}.data: unknown data set \"{s}\" (defined: {})",
-                        keys(&study.data)
-                    ),
-                    Some(spec) if spec.test != "C1" && spec.test != "N1" => {
-                        anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 or N1 force record", spec.test)
-                    }
-                    _ => {}
-                }
-            }
-            match (&self.base, &self.model) {
-                (Some(base), None) => {
-                    if let Err(e) = base.parse::<palpate_material::Law>() {
-                        anyhow::bail!("{where_}: {at}.base = \"{base}\": {e}");
-                    }
-                }
-                (None, Some(m)) => match study.models.get(m).map(|e| &e.model) {
-                    None => anyhow::bail!(
-                        "{where_}: {at}.model: unknown model \"{m}\" (defined: {})",
-                        keys(&study.models)
-                    ),
-                    Some(ModelForm::Law(_)) => anyhow::bail!(
-                        "{where_}: {at}.model: \"{m}\" is a law alone; give the law as `base` or define models.{m}.c1 / models.{m}.n1_needle"
-                    ),
-                    Some(ModelForm::Spec(spec)) => {
-                        for s in &self.data {
-                            study.check_predicts(where_.to_string(), &at, m, spec, s)?;
-                        }
-                    }
-                },
-                _ => anyhow::bail!(
-                    "{where_}: {at}: give exactly one of `base` (a law) and `model` (a model name)"
+        let at = site.step(&self.name);
+        for s in &self.data {
+            match study.data.get(s) {
+                None => anyhow::bail!(
+                    "{where_}: {at}.data: unknown data set \"{s}\" (defined: {})",
+                    keys(study.data)
                 ),
+                Some(spec) if spec.test != "C1" && spec.test != "N1" => {
+                    anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 or N1 force record", spec.test)
+                }
+                _ => {}
             }
+        }
+        match (&self.base, &self.model) {
+            (Some(base), None) => {
+                if let Err(e) = base.parse::<palpate_material::Law>() {
+                    anyhow::bail!("{where_}: {at}.base = \"{base}\": {e}");
+                }
+            }
+            (None, Some(m)) => match study.models.get(m).map(|e| &e.model) {
+                None => anyhow::bail!(
+                    "{where_}: {at}.model: unknown model \"{m}\" (defined: {})",
+                    keys(study.models)
+                ),
+                Some(ModelForm::Law(_)) => anyhow::bail!(
+                    "{where_}: {at}.model: \"{m}\" is a law alone; give the law as `base` or define models.{m}.c1 / models.{m}.n1_needle"
+                ),
+                Some(ModelForm::Spec(spec)) => {
+                    for s in &self.data {
+                        study.check_predicts(where_.to_string(), &at, m, spec, s)?;
+                    }
+                }
+            },
+            _ => anyhow::bail!(
+                "{where_}: {at}: give exactly one of `base` (a law) and `model` (a model name)"
+            ),
+        }
+        anyhow::ensure!(
+            !self.data.is_empty(),
+            "{where_}: {at}.data = []: give at least one record"
+        );
+        let mut effects = Vec::new();
+        for e in self.effects.iter().flatten() {
+            match e.parse::<palpate_core::Effect>() {
+                Ok(e) => effects.push(e),
+                Err(m) => anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}"),
+            }
+        }
+        if let Some(list) = &self.effects {
             anyhow::ensure!(
-                !self.data.is_empty(),
-                "{where_}: {at}.data = []: give at least one record"
+                !list.is_empty(),
+                "{where_}: {at}.effects = []: give at least one effect, or leave `effects` out for the default candidates"
             );
-            let mut effects = Vec::new();
-            for e in self.effects.iter().flatten() {
-                match e.parse::<palpate_core::Effect>() {
-                    Ok(e) => effects.push(e),
-                    Err(m) => anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}"),
-                }
+            if let Some(e) = duplicate(list) {
+                anyhow::bail!("{where_}: {at}.effects: \"{e}\" is listed twice");
             }
-            if let Some(list) = &self.effects {
-                anyhow::ensure!(
-                    !list.is_empty(),
-                    "{where_}: {at}.effects = []: give at least one effect, or leave `effects` out for the default candidates"
-                );
-                if let Some(e) = duplicate(list) {
-                    anyhow::bail!("{where_}: {at}.effects: \"{e}\" is listed twice");
-                }
+        }
+        for s in &self.data {
+            let Some(spec) = diagnose_model(study, self, s) else {
+                continue;
+            };
+            if let Ok(model) = crate::model::build(&spec) {
+                crate::model::check_effects(model.as_ref(), &effects)
+                    .map_err(|e| anyhow::anyhow!("{where_}: {at}.effects: {e}"))?;
             }
-            for s in &self.data {
-                let Some(spec) = diagnose_model(study, self, s) else {
-                    continue;
-                };
-                if let Ok(model) = crate::model::build(&spec) {
-                    crate::model::check_effects(model.as_ref(), &effects)
-                        .map_err(|e| anyhow::anyhow!("{where_}: {at}.effects: {e}"))?;
-                }
-            }
+        }
         Ok(())
     }
 

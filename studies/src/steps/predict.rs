@@ -91,7 +91,7 @@ impl PredictStep {
             let spec = match manifest.models.get(m).map(|e| &e.model) {
                 None => anyhow::bail!(
                     "{where_}: {at}.models: unknown model \"{m}\" (defined: {})",
-                    crate::run::step::keys(&manifest.models)
+                    crate::run::step::keys(manifest.models)
                 ),
                 Some(ModelForm::Law(_)) => anyhow::bail!(
                     "{where_}: {at}.models: \"{m}\" is a law alone; a prediction needs a model kind, e.g. [models.{m}.n1_needle]"
@@ -119,7 +119,7 @@ impl PredictStep {
                 if !manifest.data.contains_key(d) {
                     anyhow::bail!(
                         "{where_}: {at}.data: unknown data set \"{d}\" (defined: {})",
-                        crate::run::step::keys(&manifest.data)
+                        crate::run::step::keys(manifest.data)
                     );
                 }
                 manifest.check_predicts(where_.to_string(), &at, m, spec, d)?;

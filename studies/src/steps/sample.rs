@@ -149,7 +149,7 @@ impl SampleStep {
             format!(
                 "{where_}: {at}.model: unknown model \"{}\" (defined: {})",
                 self.model,
-                crate::run::step::keys(&manifest.models)
+                crate::run::step::keys(manifest.models)
             )
         })?;
         anyhow::ensure!(
@@ -160,7 +160,7 @@ impl SampleStep {
             anyhow::ensure!(
                 manifest.data.contains_key(d),
                 "{where_}: {at}.data: unknown data set \"{d}\" (defined: {})",
-                crate::run::step::keys(&manifest.data)
+                crate::run::step::keys(manifest.data)
             );
             anyhow::ensure!(
                 !self.data[..k].contains(d),
