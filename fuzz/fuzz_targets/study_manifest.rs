@@ -4,7 +4,7 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use palpate_studies::manifest::Manifest;
+use palpate_studies::study::manifest::Manifest;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
@@ -17,7 +17,7 @@ fuzz_target!(|data: &[u8]| {
         Err(e) => e,
         Ok(m) => match m.validate(path) {
             Err(e) => e,
-            Ok(()) => return,
+            Ok(_) => return,
         },
     };
     let message = error.to_string();

@@ -14,15 +14,15 @@
 //! * in: a record's columns are read as borrowed slices of the numpy
 //!   arrays (`PyReadonlyArray1::as_slice`; a non-contiguous array, e.g. a
 //!   strided view, is copied once into a Vec instead) and named in the
-//!   options as `--data TEST=<array:K>` ([`palpate_studies::arrays`]);
+//!   options as `--data TEST=<array:K>` ([`palpate_studies::records::arrays`]);
 //! * out: a Vec palpate filled is moved into numpy (`PyArray1::from_vec`:
 //!   the array's memory is the Vec's, owned by a Rust container object that
 //!   is the array's `base`).
 
 use crate::{parse_cli, to_py};
 use numpy::{PyArray1, PyReadonlyArray1};
-use palpate_studies::arrays::ArrayRecord;
 use palpate_studies::cli::{calibrate, sample, simulate, Command};
+use palpate_studies::records::arrays::ArrayRecord;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::borrow::Cow;

@@ -3,8 +3,8 @@
 //! It runs palpate's own implementations in this process: a subcommand of
 //! the command line (`run_cli`, parsed by the same clap definitions, so the
 //! options, defaults and error messages are those of `palpate --help`), a
-//! study ([`palpate_studies::runner::run_study_counted`]) or the merge of
-//! its shards ([`palpate_studies::shard::merge`]). The GIL is released for
+//! study ([`palpate_studies::study::runner::run_study_counted`]) or the merge of
+//! its shards ([`palpate_studies::study::merge::merge`]). The GIL is released for
 //! the whole run (`Python::detach`), so Python threads (a Dask worker's
 //! other tasks) go on meanwhile. An error is raised as `PalpateError` with
 //! the message the command line prints (`error: ...` and each
@@ -17,8 +17,8 @@ mod arrays;
 
 use clap::Parser;
 use palpate_studies::cli::{dispatch, join_negative_values, Cli};
-use palpate_studies::runner::{run_study_counted, RunObserver, RunOptions};
-use palpate_studies::shard::Shard;
+use palpate_studies::run::shard::Shard;
+use palpate_studies::study::runner::{run_study_counted, RunObserver, RunOptions};
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::path::PathBuf;
@@ -131,7 +131,7 @@ fn run_study<'py>(
 #[pyo3(signature = (run_dir, verbose=false))]
 fn merge<'py>(py: Python<'py>, run_dir: PathBuf, verbose: bool) -> PyResult<Bound<'py, PyDict>> {
     let m = py
-        .detach(|| palpate_studies::shard::merge(&run_dir, &Say(verbose)))
+        .detach(|| palpate_studies::study::merge::merge(&run_dir, &Say(verbose)))
         .map_err(to_py)?;
     let d = PyDict::new(py);
     d.set_item("folder", m.folder)?;

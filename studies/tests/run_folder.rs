@@ -16,8 +16,8 @@ fn palpate() -> Command {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_palpate"));
     // A test run started in the background of a non-interactive shell
     // (`.ci/run &`, nohup) inherits SIGINT ignored, and so would the run:
-    // its SIGINT kills would then never land (the failures of this test in
-    // sessions 10 and 13, "the run had ended" after every SIGINT). Ctrl-C
+    // its SIGINT kills would then never land ("the run had ended" after
+    // every SIGINT). Ctrl-C
     // is what the test means, so the run gets SIGINT's default action.
     #[cfg(unix)]
     {
@@ -233,7 +233,7 @@ fn a_study_killed_at_several_points_resumes_to_the_same_results() {
     }
     // The kills at once and after the first fit must land inside the run
     // (else the test proves little). Those after 3 and 6 fits landed after
-    // its end in `.ci/run` (4 of 8 inside, session 10) though inside it in
+    // its end in `.ci/run` (4 of 8 inside) though inside it in
     // every run of this file alone: not required.
     assert!(
         interrupted >= 4,
@@ -288,7 +288,7 @@ fn a_study_killed_at_random_instants_resumes_to_the_same_results() {
     // load of the machine changes it; the seed fixes the fractions): the
     // second and third runs into a folder resume from its cache and end
     // sooner, so over 1.2 x the span fewer than half the kills landed
-    // inside a run on a busy machine (4 of 12, session 10).
+    // inside a run on a busy machine (4 of 12).
     let span = t0.elapsed().as_secs_f64() * 0.7;
     let want = std::fs::read(reference.join("results.json")).unwrap();
     let mut interrupted = 0;

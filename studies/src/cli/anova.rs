@@ -2,11 +2,11 @@
 //! (factor columns hold level names), with residual checks, a JSON record
 //! and SVG plots.
 
-use crate::output::{write_atomic, write_json};
-use crate::plot::{grid_svg, Plot, Series, Style};
+use crate::report::anova::plots;
+use crate::run::checks::check_alpha;
+use crate::run::output::{write_atomic, write_json};
 use anyhow::Context;
 use palpate_uq::anova::{analyse, Analysis, AnovaOptions, RunsTable};
-use palpate_uq::stats::blom_scores;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
 
@@ -32,7 +32,7 @@ pub struct Args {
     #[arg(long, value_delimiter = ',', required = true)]
     pub factors: Vec<String>,
     /// Highest interaction order in the model (default: all).
-    #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
+    #[arg(long, value_parser = crate::run::limits::parse_count::<usize>)]
     pub max_order: Option<usize>,
     /// Significance level of the Pareto reference line and Lenth's margins.
     #[arg(long, default_value_t = 0.05)]
@@ -48,10 +48,10 @@ pub struct Args {
 
 /// Runs `palpate anova`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    crate::output::check_outputs_and_dirs(
+    crate::run::output::check_outputs_and_dirs(
         &[&args.data],
-        &crate::output::given(&[("--json", &args.json)]),
-        &crate::output::given(&[("--plot", &args.plot)]),
+        &crate::run::output::given(&[("--json", &args.json)]),
+        &crate::run::output::given(&[("--plot", &args.plot)]),
     )?;
     check_alpha("--alpha", args.alpha)?;
     if let Some(f) = args.factors.iter().find(|f| f.trim() == args.response) {
@@ -68,7 +68,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map(|f| table.factor(f.trim()))
         .collect::<Result<Vec<_>, _>>()?;
     let y = table.numeric(&args.response)?;
-    crate::limits::check_anova("--max-order", args.max_order, factors.len(), y.len())?;
+    crate::run::limits::check_anova("--max-order", args.max_order, factors.len(), y.len())?;
     let options = AnovaOptions {
         max_order: args.max_order,
         alpha: args.alpha,
@@ -78,16 +78,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .with_context(|| format!("ANOVA of `{}` in {}", args.response, args.data.display()))?;
     print!("{}", format_analysis(&analysis));
     write_outputs(&analysis, args.json.as_deref(), args.plot.as_deref())
-}
-
-/// Checks a significance level (`what` names the option or field): a
-/// probability strictly between 0 and 1.
-pub fn check_alpha(what: &str, alpha: f64) -> anyhow::Result<()> {
-    anyhow::ensure!(
-        alpha > 0.0 && alpha < 1.0,
-        "{what} {alpha}: expected a significance level strictly between 0 and 1, such as 0.05"
-    );
-    Ok(())
 }
 
 /// Writes the JSON record and the plots where asked.
@@ -232,128 +222,4 @@ pub fn format_analysis(a: &Analysis) -> String {
         let _ = writeln!(s, "note: {n}");
     }
     s
-}
-
-/// The SVG plots of an analysis: (file name, SVG).
-pub fn plots(a: &Analysis) -> Vec<(String, String)> {
-    let mut out = Vec::new();
-    let t = &a.table;
-    if let Some(p) = &a.pareto {
-        let n = p.effects.len();
-        let names: Vec<String> = p.effects.iter().rev().map(|e| e.term.clone()).collect();
-        let y: Vec<f64> = (0..n).map(|i| i as f64).collect();
-        let x: Vec<f64> = p
-            .effects
-            .iter()
-            .rev()
-            .map(|e| e.standardised.abs())
-            .collect();
-        let label = if p.method == "lenth" {
-            "|effect| / Lenth PSE"
-        } else {
-            "|standardised effect| (t)"
-        };
-        let mut plot = Plot::new(
-            format!("Pareto chart of standardised effects ({})", t.response),
-            label,
-            "term",
-        )
-        .with(Series::line("", &x, &y).style(Style::HBars(0.6)))
-        .with(
-            Series::dashed(
-                format!("{:.3} (alpha = {})", p.reference, p.alpha),
-                &[p.reference, p.reference],
-                &[-0.5, n as f64 - 0.5],
-            )
-            .color("#d62728"),
-        );
-        plot.y_categories = Some(names);
-        out.push(("pareto.svg".to_string(), plot.to_svg()));
-    }
-    let grand = t.fitted.iter().sum::<f64>() / t.fitted.len().max(1) as f64;
-    let cells: Vec<Option<Plot>> = a
-        .main_effects
-        .iter()
-        .map(|m| {
-            let x: Vec<f64> = (0..m.levels.len()).map(|i| i as f64).collect();
-            let mut p = Plot::new(
-                m.factor.clone(),
-                m.factor.clone(),
-                format!("mean of {}", t.response),
-            )
-            .with(Series::line("", &x, &m.means))
-            .with(Series::markers("", &x, &m.means));
-            p.x_categories = Some(m.levels.clone());
-            p.hlines.push(grand);
-            p.width = 360.0;
-            p.height = 320.0;
-            Some(p)
-        })
-        .collect();
-    out.push((
-        "main_effects.svg".to_string(),
-        grid_svg(
-            &cells,
-            cells.len().min(4),
-            &format!("Main effects plot for {}", t.response),
-        ),
-    ));
-    if !a.interactions.is_empty() {
-        let cells: Vec<Option<Plot>> = a
-            .interactions
-            .iter()
-            .map(|im| {
-                let x: Vec<f64> = (0..im.levels_a.len()).map(|i| i as f64).collect();
-                let mut p = Plot::new(
-                    format!("{} x {}", im.factor_a, im.factor_b),
-                    im.factor_a.clone(),
-                    format!("mean of {}", t.response),
-                );
-                for (j, lb) in im.levels_b.iter().enumerate() {
-                    let y: Vec<f64> = im.means.iter().map(|row| row[j]).collect();
-                    p.push(Series::line(format!("{} = {lb}", im.factor_b), &x, &y));
-                }
-                p.x_categories = Some(im.levels_a.clone());
-                p.width = 420.0;
-                p.height = 340.0;
-                Some(p)
-            })
-            .collect();
-        out.push((
-            "interaction.svg".to_string(),
-            grid_svg(
-                &cells,
-                cells.len().min(3),
-                &format!("Interaction plot for {}", t.response),
-            ),
-        ));
-    }
-    if t.residual.df > 0 {
-        let mut r = t.residuals.clone();
-        r.sort_by(f64::total_cmp);
-        let z = blom_scores(r.len());
-        let n = r.len() as f64;
-        let mean = r.iter().sum::<f64>() / n;
-        let sd = (r.iter().map(|v| (v - mean) * (v - mean)).sum::<f64>() / (n - 1.0)).sqrt();
-        let (lo, hi) = (r[0], r[r.len() - 1]);
-        let line_x = [lo, hi];
-        let line_z = [(lo - mean) / sd, (hi - mean) / sd];
-        let p = Plot::new(
-            format!("Normal probability plot of residuals ({})", t.response),
-            "residual",
-            "normal score (Blom)",
-        )
-        .with(Series::markers("residuals", &r, &z))
-        .with(Series::line("normal fit", &line_x, &line_z));
-        out.push(("normal_probability.svg".to_string(), p.to_svg()));
-        let mut p = Plot::new(
-            format!("Residuals versus fits ({})", t.response),
-            "fitted value",
-            "residual",
-        )
-        .with(Series::markers("", &t.fitted, &t.residuals));
-        p.hlines.push(0.0);
-        out.push(("residuals_vs_fits.svg".to_string(), p.to_svg()));
-    }
-    out
 }

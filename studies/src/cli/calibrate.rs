@@ -1,13 +1,12 @@
 //! `palpate calibrate`: fit a hyperelastic law to homogeneous-test data or a
 //! C1 force record, print a table, optionally write JSON and an SVG plot.
 
-use crate::arrays::{record_for, ArrayRecord};
-use crate::calibration::{
-    calibrate, parse_method, Calibration, ReadOptions, Request, TestData, TestKind,
-};
-use crate::models::Viscous;
-use crate::output::{write_atomic, write_json};
+use crate::model::calibration::{calibrate, parse_method, Calibration, Request};
+use crate::model::Viscous;
+use crate::records::arrays::{record_for, ArrayRecord};
+use crate::records::{ReadOptions, TestData, TestKind};
 use crate::report::{calibration_table, fit_plot};
+use crate::run::output::{write_atomic, write_json};
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
@@ -165,7 +164,7 @@ pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec
 }
 
 /// Reads the `--data` options, a file part `<array:K>` taking the columns of
-/// `arrays[K]` instead of a file ([`crate::arrays`]).
+/// `arrays[K]` instead of a file ([`crate::records::arrays`]).
 pub fn read_data_with(
     data: &[String],
     benchmark: Option<&str>,
@@ -247,7 +246,7 @@ pub fn is_q1(args: &Args) -> bool {
 
 /// The fit of `palpate calibrate` (not Q1) without its outputs: what
 /// [`run`] prints and writes, for callers that hold the data in memory
-/// (`--data TEST=<array:K>` takes `arrays[K]`, [`crate::arrays`]). The
+/// (`--data TEST=<array:K>` takes `arrays[K]`, [`crate::records::arrays`]). The
 /// checks and messages are those of the command line.
 pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
     let law: Law = args
@@ -294,7 +293,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         }
         fixed.push((name.to_string(), v));
     }
-    crate::checks::check_fixed(&law, &fixed, "--fix")?;
+    crate::run::checks::check_fixed(&law, &fixed, "--fix")?;
     let viscous = args
         .viscoelastic
         .as_deref()
@@ -303,8 +302,8 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
     let data = read_data_with(&args.data, args.benchmark.as_deref(), arrays)?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
-    let outputs = crate::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
-    crate::output::check_outputs(&inputs, &outputs)?;
+    let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
+    crate::run::output::check_outputs(&inputs, &outputs)?;
     calibrate(Request {
         law,
         model: None,
@@ -319,9 +318,9 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
 }
 
 /// `palpate calibrate --benchmark Q1`: the staged inverse FE identification
-/// ([`crate::two_stage`]).
+/// ([`crate::apps::two_stage`]).
 fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
-    use crate::two_stage::{identify, report, Q1Record, TwoStageOptions};
+    use crate::apps::two_stage::{identify, report, Q1Record, TwoStageOptions};
     anyhow::ensure!(
         args.data.len() == 1,
         "--benchmark Q1: give one record (--data FILE), got {}",
@@ -376,8 +375,8 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
         .split_once('=')
         .filter(|(t, _)| t.eq_ignore_ascii_case("q1"))
         .map_or(args.data[0].as_str(), |(_, p)| p);
-    let outputs = crate::output::given(&[("--json", &args.json)]);
-    crate::output::check_outputs(&[Path::new(path)], &outputs)?;
+    let outputs = crate::run::output::given(&[("--json", &args.json)]);
+    crate::run::output::check_outputs(&[Path::new(path)], &outputs)?;
     let record = Q1Record::read(Path::new(path))?;
     let say = |s: &str| eprintln!("{s}");
     let result = identify(&record, &o, &say)?;

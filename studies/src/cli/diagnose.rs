@@ -2,11 +2,11 @@
 //! where the misfit lies, which unmodelled effect causes it, how far it
 //! shrinks once that effect is added (GAP.md).
 
-use crate::calibration::{TestData, TestKind};
 use crate::cli::calibrate::read_data;
-use crate::models::{build, default_effects, gap_base_for, parse_effects};
-use crate::output::{write_atomic, write_json};
+use crate::model::{build, default_effects, gap_base_for, parse_effects};
+use crate::records::{TestData, TestKind};
 use crate::report::{gap_summary, gap_svg};
+use crate::run::output::{write_atomic, write_json};
 use anyhow::Context;
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
@@ -74,7 +74,7 @@ pub struct Args {
     #[arg(long, default_value_t = GapOptions::default().alpha)]
     pub alpha: f64,
     /// Contiguous blocks for the blocked cross-validation.
-    #[arg(long, default_value_t = GapOptions::default().folds, value_parser = crate::limits::parse_count::<usize>)]
+    #[arg(long, default_value_t = GapOptions::default().folds, value_parser = crate::run::limits::parse_count::<usize>)]
     pub folds: usize,
     /// Write the diagnosis as JSON (GAP.md contract).
     #[arg(long, value_name = "OUT.json")]
@@ -126,7 +126,7 @@ pub fn diagnose_record(
         options.effects = default_effects(&spec, model.as_ref(), &record.loading);
     }
     if let Some(effects) = &options.effects {
-        crate::models::check_effects(model.as_ref(), effects)
+        crate::model::check_effects(model.as_ref(), effects)
             .map_err(|e| anyhow::anyhow!("--effects {e} ({} record)", record.name))?;
         if effects.is_empty() {
             anyhow::bail!(
@@ -158,9 +158,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         e => anyhow::anyhow!("{e}"),
     })?;
     let record = read_record(args.benchmark.as_deref(), &args.data)?;
-    crate::output::check_outputs(
+    crate::run::output::check_outputs(
         &[Path::new(&record.file)],
-        &crate::output::given(&[
+        &crate::run::output::given(&[
             ("--json", &args.json),
             ("--report", &args.report),
             ("--plot", &args.plot),

@@ -32,8 +32,9 @@
 //! benchmarks (`friction`, `space`, `mesh`) are not supported yet.
 
 use super::anova::{format_analysis, write_outputs};
-use crate::calibration::{calibrate, parse_method, Request, TestData, TestKind};
-use crate::output::write_atomic;
+use crate::model::calibration::{calibrate, parse_method, Request};
+use crate::records::{TestData, TestKind};
+use crate::run::output::write_atomic;
 use anyhow::Context;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
@@ -137,7 +138,7 @@ struct SimulationResponse {
     /// the N1 model's defaults, friction 0.8 and the medium mesh).
     law: Option<String>,
     friction: Option<f64>,
-    #[serde(default, deserialize_with = "crate::models::text_or_number")]
+    #[serde(default, deserialize_with = "crate::model::text_or_number")]
     mesh: Option<String>,
 }
 
@@ -183,7 +184,7 @@ pub fn read_design(path: &Path, text: &str) -> anyhow::Result<(Manifest, Design)
         .map(String::as_str)
         .collect();
     let levels: Vec<usize> = manifest.factors.iter().map(|f| f.levels.len()).collect();
-    crate::limits::check_runs(
+    crate::run::limits::check_runs(
         &format!(
             "{m}: [[factors]] and design.replicates = {}",
             manifest.design.replicates
@@ -198,14 +199,14 @@ pub fn read_design(path: &Path, text: &str) -> anyhow::Result<(Manifest, Design)
         Design::fractional(manifest.factors.clone(), &gens, manifest.design.replicates)
     }
     .map_err(|e| anyhow::anyhow!("{m}: {e}"))?;
-    crate::limits::check_anova(
+    crate::run::limits::check_anova(
         &format!("{m}: analysis.max_order ="),
         manifest.analysis.max_order,
         design.factors.len(),
         design.runs.len(),
     )?;
     if let Some(a) = manifest.analysis.alpha {
-        super::anova::check_alpha(&format!("{m}: analysis.alpha ="), a)?;
+        crate::run::checks::check_alpha(&format!("{m}: analysis.alpha ="), a)?;
     }
     if let Some(seed) = manifest.design.seed {
         design = design.randomised(seed);
@@ -269,7 +270,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             &out.join("design.csv"),
             design_csv(&design, &metric, response.as_deref()).as_bytes(),
         )?;
-        crate::output::write_json(&out.join("design.json"), &design_record(&design))?;
+        crate::run::output::write_json(&out.join("design.json"), &design_record(&design))?;
         println!("wrote {}", out.join("design.csv").display());
     }
     if let Some(y) = response {
@@ -315,7 +316,7 @@ fn check_out(out: &Path, path: &Path, manifest: &Manifest, base: &Path) -> anyho
         .map(|f| (format!("--out (its {f})"), out.join(f)))
         .collect();
     let plots = out.join("plots");
-    crate::output::check_outputs_and_dirs(
+    crate::run::output::check_outputs_and_dirs(
         &inputs,
         &files
             .iter()
@@ -521,7 +522,7 @@ fn prepare_simulations(
     spec: &SimulationResponse,
     base: &Path,
 ) -> anyhow::Result<SimulationPlan> {
-    use crate::models::{ModelSpec, N1NeedleSpec};
+    use crate::model::{ModelSpec, N1NeedleSpec};
     use palpate_core::{data::Table, Drive, ForwardModel, Loading};
     if !spec.benchmark.eq_ignore_ascii_case("n1") {
         anyhow::bail!(
@@ -640,7 +641,7 @@ fn run_simulations(
     plan: SimulationPlan,
 ) -> anyhow::Result<Vec<f64>> {
     let SimulationPlan { models, loading, y } = plan;
-    let bar = crate::limits::Progress::new(
+    let bar = crate::run::limits::Progress::new(
         d.runs.len() as u64,
         "N1 runs",
         "{bar:30} {pos}/{len} N1 runs [{elapsed_precise}, eta {eta}]",
@@ -658,7 +659,7 @@ fn run_simulations(
             };
             let f = model.predict(theta, &loading).with_context(at)?;
             bar.inc(1);
-            let (r2, rms) = crate::calibration::r2_rms(&y, &f);
+            let (r2, rms) = crate::model::calibration::r2_rms(&y, &f);
             Ok(if spec.metric == "r2" { r2 } else { rms })
         })
         .collect();

@@ -1,18 +1,18 @@
 //! `palpate localize --benchmark R2 --rd RD --data RECORD.csv`: the
 //! posterior of each nodule's position and depth from a rolled force
-//! record (`crate::localize`), on a surrogate of the FE model trained once
+//! record (`crate::apps::localize`), on a surrogate of the FE model trained once
 //! per RD and cached on disk.
 
 use std::path::PathBuf;
 
 use clap::Parser;
 
-use crate::localize::posterior::{localize, LocOptions, LocRun};
-use crate::localize::record::Record;
-use crate::localize::{LocModel, LocSetup};
-use crate::output::{check_outputs, given, write_atomic, write_json};
-use crate::plot::{grid_svg, Plot, Series};
-use crate::surrogate::default_cache_dir;
+pub use crate::apps::localize::plot::plot_svg;
+use crate::apps::localize::posterior::{localize, LocOptions, LocRun};
+use crate::apps::localize::record::Record;
+use crate::apps::localize::{LocModel, LocSetup};
+use crate::run::output::{check_outputs, given, write_atomic, write_json};
+use crate::run::surrogate::default_cache_dir;
 
 /// Locate nodules (x, depth, 94 % intervals) from an R2 rolled force record
 ///
@@ -208,7 +208,7 @@ pub fn report_model(model: &LocModel, elapsed: f64) {
     }
 }
 
-fn fmt_iv(i: &crate::localize::posterior::Interval) -> String {
+fn fmt_iv(i: &crate::apps::localize::posterior::Interval) -> String {
     format!(
         "{:.2} +- {:.2} [{:.2}, {:.2}]",
         i.mean, i.sd, i.hdi_3, i.hdi_97
@@ -256,77 +256,11 @@ pub fn summary_text(model: &LocModel, record: &Record, run: &LocRun) -> String {
 pub fn report_md(model: &LocModel, record: &Record, run: &LocRun) -> String {
     let mut s = String::from("# R2 tumour localisation\n\n");
     s.push_str(&format!(
-        "Record `{}`, RD {} mm. Model: F(p) = s [F0(p) + sum_n E(|p - x_n|; d_n)] on a surrogate of the FE scan of one nodule (studies/src/localize); depth box {:?} mm.\n\n```\n{}```\n",
+        "Record `{}`, RD {} mm. Model: F(p) = s [F0(p) + sum_n E(|p - x_n|; d_n)] on a surrogate of the FE scan of one nodule (studies/src/apps/localize); depth box {:?} mm.\n\n```\n{}```\n",
         record.file.display(),
         model.rd,
         model.depth_box,
         summary_text(model, record, run)
     ));
     s
-}
-
-/// Force against position with the fit and the nodules (posterior means,
-/// with their 94 % x intervals), plus one cell per nodule with its (x,
-/// depth) draws.
-pub fn plot_svg(
-    model: &LocModel,
-    record: &Record,
-    run: &LocRun,
-    truth: Option<&[(f64, f64)]>,
-) -> String {
-    let mut main = Plot::new(
-        format!("R2 record and fit, RD {} mm", model.rd),
-        "wheel position x (mm)",
-        "force (N)",
-    )
-    .with(Series::markers("record", &record.positions, &record.force))
-    .with(Series::line(
-        "posterior-mean fit",
-        &record.positions,
-        &run.fit,
-    ));
-    let lo = record.force.iter().cloned().fold(f64::INFINITY, f64::min);
-    let xs: Vec<f64> = run.result.nodules.iter().map(|n| n.x_mm.mean).collect();
-    main = main.with(Series::markers(
-        "nodules (posterior mean x)",
-        &xs,
-        &vec![lo; xs.len()],
-    ));
-    for n in &run.result.nodules {
-        main = main.with(Series::line("", &[n.x_mm.hdi_3, n.x_mm.hdi_97], &[lo, lo]));
-    }
-    if let Some(t) = truth {
-        let tx: Vec<f64> = t.iter().map(|p| p.0).collect();
-        main = main.with(Series::markers("true x", &tx, &vec![lo; tx.len()]));
-    }
-    let mut cells = vec![Some(main)];
-    let n = run.result.nodules.len();
-    for j in 0..n {
-        let xd = run.chains.param(2 * j);
-        let dd = run.chains.param(2 * j + 1);
-        let flat_x: Vec<f64> = xd.iter().flatten().copied().collect();
-        let flat_d: Vec<f64> = dd.iter().flatten().copied().collect();
-        let stride = (flat_x.len() / 600).max(1);
-        let px: Vec<f64> = flat_x.iter().step_by(stride).copied().collect();
-        let pd: Vec<f64> = flat_d.iter().step_by(stride).copied().collect();
-        let mut p = Plot::new(
-            format!(
-                "nodule {} posterior{}",
-                j + 1,
-                if run.result.nodules[j].identifiable {
-                    ""
-                } else {
-                    " (depth NI)"
-                }
-            ),
-            "x (mm)",
-            "depth (mm)",
-        )
-        .with(Series::markers("draws", &px, &pd));
-        if let Some(t) = truth.and_then(|t| t.get(j)) {
-            p = p.with(Series::markers("truth", &[t.0], &[t.1]));
-        }
-        cells.push(Some(p));
-    }
-    grid_svg(&cells, 2, "R2 localisation")
 }

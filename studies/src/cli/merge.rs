@@ -22,7 +22,7 @@ pub struct Args {
 /// Runs `palpate merge`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let observer = super::run::CliObserver::new();
-    let merged = crate::shard::merge(&args.run_dir, &observer);
+    let merged = crate::study::merge::merge(&args.run_dir, &observer);
     observer.finish();
     let m = merged?;
     println!(

@@ -48,14 +48,13 @@ pub struct Args {
     /// sharing the folder. Then `palpate merge DIR` writes the results,
     /// byte-identical to a run without shards. See docs/cluster.md.
     #[arg(long, value_name = "I/N")]
-    pub shard: Option<crate::shard::Shard>,
+    pub shard: Option<crate::run::shard::Shard>,
 }
 
 /// Runs `palpate run`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     if args.check {
-        let m = crate::manifest::Manifest::read(&args.manifest)?;
-        m.validate(&args.manifest)?;
+        let m = crate::study::manifest::Manifest::read(&args.manifest)?.validate(&args.manifest)?;
         let rows = check_data(&args.manifest, &m)?;
         println!(
             "{}: ok ({} data sets with {rows} rows, {} models, {} steps)",
@@ -68,12 +67,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     let observer = CliObserver::new();
     let bar = observer.bar.clone();
-    let options = crate::runner::RunOptions {
+    let options = crate::study::runner::RunOptions {
         out: args.out.clone(),
         fresh: args.fresh,
         shard: args.shard,
     };
-    let summary = crate::runner::run_study_counted(&args.manifest, &options, &observer);
+    let summary = crate::study::runner::run_study_counted(&args.manifest, &options, &observer);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -139,7 +138,7 @@ impl CliObserver {
 const SPINNER: &str = "{spinner} {msg}";
 const BAR: &str = "{msg} [{bar:30}] {pos}/{len} load steps ({elapsed}, eta {eta})";
 
-impl crate::runner::RunObserver for CliObserver {
+impl crate::study::runner::RunObserver for CliObserver {
     fn message(&self, text: &str) {
         match &self.bar {
             Some(b) => {
@@ -179,8 +178,8 @@ impl crate::runner::RunObserver for CliObserver {
 
 /// Reads every data file of a manifest as its test (the errors name the
 /// file, line and column, and the data set); returns the number of rows.
-fn check_data(path: &Path, m: &crate::manifest::Manifest) -> anyhow::Result<usize> {
-    use crate::calibration::{TestData, TestKind};
+fn check_data(path: &Path, m: &crate::study::manifest::Manifest) -> anyhow::Result<usize> {
+    use crate::records::{TestData, TestKind};
     let dir = path.parent().unwrap_or(Path::new("."));
     let mut rows = 0;
     for (name, spec) in &m.data {

@@ -5,7 +5,7 @@
 //! are sampled through a cached surrogate ([`super::sample_fe`]).
 
 use crate::cli::calibrate::read_data_with;
-use crate::output::{write_atomic, write_json};
+use crate::run::output::{write_atomic, write_json};
 use anyhow::Context;
 use palpate_material::Law;
 use palpate_uq::likelihood::{
@@ -91,19 +91,19 @@ pub struct Args {
     #[arg(long, default_value = "nuts")]
     pub sampler: String,
     /// Stored draws per chain of the first run (default: ensemble 2000 per walker, demc 5000, nuts 1000); doubled until converged.
-    #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
+    #[arg(long, value_parser = crate::run::limits::parse_count::<usize>)]
     pub draws: Option<usize>,
     /// Cap of the stored draws per chain when extending until R-hat < 1.01 and bulk ESS >= 400 [default: 16 x --draws]; equal to --draws: no extension.
-    #[arg(long, value_name = "N", value_parser = crate::limits::parse_count::<usize>)]
+    #[arg(long, value_name = "N", value_parser = crate::run::limits::parse_count::<usize>)]
     pub max_draws: Option<usize>,
     /// Warm-up iterations (default: ensemble 1000, demc 2000, nuts 1000).
-    #[arg(long, value_parser = crate::limits::parse_count::<usize>)]
+    #[arg(long, value_parser = crate::run::limits::parse_count::<usize>)]
     pub tune: Option<usize>,
     /// Parallel units: NUTS chains (4), ensembles (2) or DE-MCz populations (2).
-    #[arg(long = "parallel", value_parser = crate::limits::parse_count::<usize>)]
+    #[arg(long = "parallel", value_parser = crate::run::limits::parse_count::<usize>)]
     pub chains: Option<usize>,
     /// Seed of the random streams (results are identical for a seed whatever the thread count).
-    #[arg(long, default_value_t = 0, value_parser = crate::limits::parse_count::<u64>)]
+    #[arg(long, default_value_t = 0, value_parser = crate::run::limits::parse_count::<u64>)]
     pub seed: u64,
     /// Known noise SD of every data set (observable unit: N or MPa); inferred when absent.
     #[arg(long)]
@@ -188,7 +188,7 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
         "--draws {draws} x --parallel {units} ({} chains each)",
         per_unit
     );
-    crate::limits::check_count(
+    crate::run::limits::check_count(
         &what,
         draws as f64 * units as f64 * per_unit as f64,
         "stored draws",
@@ -199,7 +199,7 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
         cap >= draws,
         "--max-draws {cap}: below the {draws} draws per chain of the first run (--draws)"
     );
-    crate::limits::check_count(
+    crate::run::limits::check_count(
         &format!("--max-draws {cap} x --parallel {units} ({per_unit} chains each)"),
         cap as f64 * units as f64 * per_unit as f64,
         "stored draws",
@@ -241,9 +241,12 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// Runs `palpate sample` (printing its table and writing the outputs it is
 /// given) and returns the draws and the summary, for callers that want
 /// them in memory (the Python package). `--data TEST=<array:K>` takes the
-/// record `arrays[K]` ([`crate::arrays`]; not with the FE benchmarks N1,
+/// record `arrays[K]` ([`crate::records::arrays`]; not with the FE benchmarks N1,
 /// N3, Q1, whose record is read from a file).
-pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Result<Sampled> {
+pub fn draw(
+    args: &Args,
+    arrays: &[crate::records::arrays::ArrayRecord],
+) -> anyhow::Result<Sampled> {
     let law: Law = args
         .law
         .parse()
@@ -278,8 +281,9 @@ pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Resul
             },
         }
     };
-    let outputs = crate::output::given(&[("--json", &args.json), ("--chains", &args.chains_out)]);
-    let output_dirs = crate::output::given(&[("--plot", &args.plot)]);
+    let outputs =
+        crate::run::output::given(&[("--json", &args.json), ("--chains", &args.chains_out)]);
+    let output_dirs = crate::run::output::given(&[("--plot", &args.plot)]);
     let (sets, fe) = if let Some(kind) = fe_kind {
         anyhow::ensure!(
             arrays.is_empty(),
@@ -291,7 +295,7 @@ pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Resul
         );
         for d in &args.data {
             let p = d.split_once('=').map_or(d.as_str(), |x| x.1);
-            crate::output::check_outputs_and_dirs(&[Path::new(p)], &outputs, &output_dirs)?;
+            crate::run::output::check_outputs_and_dirs(&[Path::new(p)], &outputs, &output_dirs)?;
         }
         let fe = super::sample_fe::setup(kind, args)?;
         let set = DataSet {
@@ -305,13 +309,13 @@ pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Resul
     } else {
         let data = read_data_with(&args.data, args.benchmark.as_deref(), arrays)?;
         let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
-        crate::output::check_outputs_and_dirs(&inputs, &outputs, &output_dirs)?;
+        crate::run::output::check_outputs_and_dirs(&inputs, &outputs, &output_dirs)?;
         let sets: Vec<DataSet> = data
             .iter()
             .map(|t| -> anyhow::Result<DataSet> {
                 Ok(DataSet {
                     name: t.name.clone(),
-                    model: t.test.model(law)?,
+                    model: crate::model::test_model(t.test, law)?,
                     loading: t.loading.clone(),
                     observed: t.observed.clone(),
                     noise: noise_of(&t.observed),
@@ -381,7 +385,7 @@ pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Resul
         max_draws: max_draws(args, first_draws),
         ..Default::default()
     };
-    let bar = std::sync::RwLock::new(None::<crate::limits::Progress>);
+    let bar = std::sync::RwLock::new(None::<crate::run::limits::Progress>);
     let template = "{msg} [{bar:40}] {pos}/{len} iterations ({eta})";
     let tick = |n: u64| {
         if let Ok(b) = bar.read() {
@@ -404,7 +408,11 @@ pub fn draw(args: &Args, arrays: &[crate::arrays::ArrayRecord]) -> anyhow::Resul
                 if let Some(old) = b.take() {
                     old.finish();
                 }
-                *b = Some(crate::limits::Progress::new(total, &args.sampler, template));
+                *b = Some(crate::run::limits::Progress::new(
+                    total,
+                    &args.sampler,
+                    template,
+                ));
             }
         },
         &mut |w, next| {

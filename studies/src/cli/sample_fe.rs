@@ -1,6 +1,6 @@
 //! `palpate sample --benchmark N1|N3|Q1`: the record's finite-element model
 //! behind a surrogate (`palpate_uq::surrogate`, cached by
-//! [`crate::surrogate::load_or_build`]), whose held-out error is added to the
+//! [`crate::run::surrogate::load_or_build`]), whose held-out error is added to the
 //! likelihood as a variance ([`palpate_uq::likelihood::Posterior::with_model_error`]).
 //!
 //! The surrogate is trained on the record's own loading history (its
@@ -9,10 +9,10 @@
 //! surrogate does not extrapolate.
 
 use super::sample::Args;
-use crate::calibration::{TestData, TestKind};
-use crate::models::{ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
-use crate::surrogate::{default_cache_dir, load_or_build, CacheStatus};
-use palpate_core::ForwardModel;
+use crate::model::{ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
+use crate::records::{TestData, TestKind};
+use crate::run::surrogate::{default_cache_dir, load_or_build, parse_box, CacheStatus};
+
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -87,55 +87,6 @@ pub fn model_spec(kind: &str, args: &Args) -> ModelSpec {
             ..Default::default()
         }),
     }
-}
-
-/// Parses `--box NAME=LO,HI` for every parameter of `model`; the error names
-/// the option or the missing parameters (with a suggestion around the law's
-/// typical value).
-pub fn parse_box(boxes: &[String], model: &dyn ForwardModel) -> anyhow::Result<ParamBox> {
-    let space = model.space();
-    let mut lower = vec![f64::NAN; space.len()];
-    let mut upper = vec![f64::NAN; space.len()];
-    for b in boxes {
-        let (name, range) = super::calibrate::split_pair(b, "NAME=LO,HI, e.g. C10=0.0005,0.002")?;
-        let k = space.index_of(name).ok_or_else(|| {
-            anyhow::anyhow!(
-                "--box {b}: unknown parameter `{name}` (the model has {})",
-                space.names().join(", ")
-            )
-        })?;
-        if !lower[k].is_nan() {
-            anyhow::bail!("--box {b}: a box for {name} is given twice; give each parameter once");
-        }
-        let (lo, hi) = range
-            .split_once(',')
-            .and_then(|(l, h)| Some((l.trim().parse::<f64>().ok()?, h.trim().parse::<f64>().ok()?)))
-            .ok_or_else(|| anyhow::anyhow!("--box {b}: expected NAME=LO,HI with two numbers"))?;
-        lower[k] = lo;
-        upper[k] = hi;
-    }
-    let missing: Vec<String> = space
-        .params
-        .iter()
-        .zip(&lower)
-        .filter(|(_, l)| l.is_nan())
-        .map(|(p, _)| {
-            format!(
-                "{} (e.g. --box {}={},{})",
-                p.name,
-                p.name,
-                p.initial / 4.0,
-                p.initial * 4.0
-            )
-        })
-        .collect();
-    if !missing.is_empty() {
-        anyhow::bail!(
-            "--box: the surrogate is trained inside a box that must hold the posterior; give NAME=LO,HI for {}",
-            missing.join(", ")
-        );
-    }
-    ParamBox::new(space, &lower, &upper).map_err(|e| anyhow::anyhow!("--box: {e}"))
 }
 
 /// The record, its surrogate and where it came from.

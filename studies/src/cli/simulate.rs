@@ -17,11 +17,11 @@ use palpate_fe::{Bulk, Progress, Simulation};
 use palpate_material::Law;
 
 use super::simulate_estimate::estimate;
-use crate::models::{
+use crate::model::{
     C1FeSpec, Model, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec, R2Spec, Q1_STOP_HINT,
 };
-use crate::output::write_atomic;
-use crate::plot::{Plot, Series};
+use crate::report::plot::{Plot, Series};
+use crate::run::output::write_atomic;
 
 /// Run a finite-element forward model (N1, N3, C1, Q1, R2 of BENCHMARKS.md) and write its force curve
 ///
@@ -166,7 +166,7 @@ pub(crate) fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f6
     let shown: Vec<String> = given.iter().map(|g| format!("--param {g}")).collect();
     law.check(&p)
         .map_err(|e| anyhow!("{} ({law}): {e}", shown.join(" ")))?;
-    crate::checks::check_law_values(law, &p, |n, v| format!("--param {n}={v}"))?;
+    crate::run::checks::check_law_values(law, &p, |n, v| format!("--param {n}={v}"))?;
     Ok(p)
 }
 
@@ -424,9 +424,9 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         .parse()
         .map_err(|e| anyhow!("--law `{law_text}`: {e}"))?;
     let theta = parse_params(&law, &args.params)?;
-    crate::output::check_outputs(
+    crate::run::output::check_outputs(
         &[],
-        &crate::output::given(&[
+        &crate::run::output::given(&[
             ("--csv", &args.csv),
             ("--vtu", &args.vtu),
             ("--plot", &args.plot),
@@ -459,25 +459,25 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         }
     }
     // Each sample keeps its drive, time, force and estimate, and a solve.
-    let n = crate::limits::check_count(
+    let n = crate::run::limits::check_count(
         &format!(
             "--depth {} / --step {}",
-            crate::limits::fmt_value(depth),
-            crate::limits::fmt_value(step)
+            crate::run::limits::fmt_value(depth),
+            crate::run::limits::fmt_value(step)
         ),
         (depth / step).ceil() + 1.0,
         "samples",
         256.0,
     )? - 1;
-    crate::checks::check_travel("--depth", depth, &model)?;
-    crate::checks::check_tool(
+    crate::run::checks::check_travel("--depth", depth, &model)?;
+    crate::run::checks::check_tool(
         &format!("--tool {}", args.tool.as_deref().unwrap_or("needle")),
         &model,
     )?;
     let mut drive: Vec<f64> = (0..=n).map(|k| (k as f64 * step).min(depth)).collect();
     let time = timed_history(args, depth, &mut drive)?;
     if let Some(end) = time.as_ref().and_then(|t| t.last()) {
-        crate::checks::check_increments(&model, *end)?;
+        crate::run::checks::check_increments(&model, *end)?;
     }
     let loading = match &time {
         Some(t) => Loading::timed(Drive::DisplacementMm, t.clone(), drive.clone()),

@@ -9,7 +9,7 @@ use palpate_core::Loading;
 use palpate_fe::discretisation::{richardson, Coarser};
 
 use super::simulate::progress_bar;
-use crate::models::Model;
+use crate::model::Model;
 
 /// The discretisation error estimate: one line for the user and, when the
 /// coarse solve covered every sample, the error per sample.

@@ -15,9 +15,9 @@ use palpate_fe::{R2Rolling, System};
 use palpate_material::Law;
 
 use super::simulate::{parse_params, progress_bar, volumetric, Args};
-use crate::limits::Progress;
-use crate::output::write_atomic;
-use crate::plot::{Plot, Series};
+use crate::report::plot::{Plot, Series};
+use crate::run::limits::Progress;
+use crate::run::output::write_atomic;
 
 /// The parameters of one law: BENCHMARKS.md's when the law is Arruda-Boyce
 /// and none is given (`rtv6166-ab` or `rubber-ab`), else every one named.
@@ -61,9 +61,9 @@ pub fn run(args: &Args, model: R2Rolling) -> anyhow::Result<()> {
         "--nodule-param",
     )?);
     let press_csv = args.csv.as_deref().map(press_path);
-    crate::output::check_outputs(
+    crate::run::output::check_outputs(
         &[],
-        &crate::output::given(&[
+        &crate::run::output::given(&[
             ("--csv", &args.csv),
             ("--csv (pressing phase)", &press_csv),
             ("--vtu", &args.vtu),
@@ -80,8 +80,8 @@ pub fn run(args: &Args, model: R2Rolling) -> anyhow::Result<()> {
         bail!("--step {step}: must be a positive spacing of wheel positions in mm");
     }
     let span = model.roll_to - model.press_x;
-    crate::limits::check_count(
-        &format!("--step {}", crate::limits::fmt_value(step)),
+    crate::run::limits::check_count(
+        &format!("--step {}", crate::run::limits::fmt_value(step)),
         (span / step).ceil() + 1.0,
         "positions",
         256.0,

@@ -1,7 +1,7 @@
 //! Bad input to the source studies' benchmarks, as `bad_input.rs` (whose
 //! conventions these follow): Q1's viscoelastic options, two-stage
-//! identification and real-time surrogate (issue 13), and R2's geometry,
-//! `palpate localize` and the localize step (issue 11). Every case fails
+//! identification and real-time surrogate, and R2's geometry,
+//! `palpate localize` and the localize step. Every case fails
 //! with a non-zero exit, without a panic, naming the option, the manifest
 //! field or file:line.
 
@@ -9,7 +9,7 @@ use crate::bad_input::simulate;
 use crate::common;
 use common::*;
 
-// ---------- Q1 two-stage identification and the real-time surrogate (issue 13) ----------
+// ---------- Q1 two-stage identification and the real-time surrogate ----------
 
 /// `palpate surrogate build --benchmark BENCHMARK` of a neo-Hookean
 /// material into `rt.json` of `s`, with `--prony PRONY --depth-max DEPTH`

@@ -1,4 +1,4 @@
-//! Bad input, continued (issue 16, items 5 and 6): every refusal names the
+//! Bad input, continued: every refusal names the
 //! input (the option and its value, the manifest and its field, or
 //! file:line) and says what would be valid; values that would fail deep in a
 //! solver are refused before any work; an unwritable output is refused

@@ -8,9 +8,10 @@ use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_enrich::Viscoelastic;
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
-use palpate_studies::calibration::{calibrate, parse_method, Calibration, Request, TestData};
 use palpate_studies::cli::calibrate::{read_data, split_data};
-use palpate_studies::models::Viscous;
+use palpate_studies::model::calibration::{calibrate, parse_method, Calibration, Request};
+use palpate_studies::model::Viscous;
+use palpate_studies::records::TestData;
 use std::path::{Path, PathBuf};
 
 fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
@@ -101,7 +102,7 @@ fn equibiaxial_planar_and_general_biaxial() {
     .unwrap();
     assert_eq!(
         data[0].test,
-        palpate_studies::calibration::TestKind::Homogeneous(Mode::Equibiaxial)
+        palpate_studies::records::TestKind::Homogeneous(Mode::Equibiaxial)
     );
     let c = fit(law, &data, None);
     assert_params(&c, &[("C10", 0.2), ("C20", -0.01), ("C30", 0.002)], 1e-5);
@@ -120,7 +121,7 @@ fn equibiaxial_planar_and_general_biaxial() {
     let data = read(&format!("biaxial={}", f.display())).unwrap();
     assert_eq!(
         data[0].test,
-        palpate_studies::calibration::TestKind::GeneralBiaxial
+        palpate_studies::records::TestKind::GeneralBiaxial
     );
     assert_eq!(data[0].observed.len(), 32);
     let c = fit(law, &data, None);

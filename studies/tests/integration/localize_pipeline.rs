@@ -1,4 +1,4 @@
-//! The R2 localisation pipeline (studies/src/localize) on a stand-in for the
+//! The R2 localisation pipeline (studies/src/apps/localize) on a stand-in for the
 //! FE scan, cheap enough for `cargo test`: an analytic excess
 //! E(o; d) = A(d) exp(-o^2 / 2 w(d)^2) over a flat F0 = 9 N, with
 //! A(d) = 6 ((18 - d)/12)^2 for d < 18 and 0 deeper (a nodule below 18 mm
@@ -11,15 +11,15 @@
 //!   identifiable, the truth within 4 posterior SDs;
 //! * an invisible (deep) nodule's depth is `identifiable: false` (NI),
 //!   while the visible one beside it stays identifiable;
-//! * the JSON has exactly the keys of issue 11;
+//! * the JSON has exactly the documented keys;
 //! * NUTS (the default sampler) reaches R-hat < 1.01 within its cap.
 
 use palpate_core::{
     Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
-use palpate_studies::localize::posterior::{localize, LocOptions, LocSampler};
-use palpate_studies::localize::units::ModelUnits;
-use palpate_studies::localize::{Baseline, LocModel, LocSetup};
+use palpate_studies::apps::localize::posterior::{localize, LocOptions, LocSampler};
+use palpate_studies::apps::localize::units::ModelUnits;
+use palpate_studies::apps::localize::{Baseline, LocModel, LocSetup};
 use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequest};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
@@ -134,7 +134,7 @@ fn visible_nodules_are_located_within_the_targets() {
         run.result.noise_sd
     );
     // NUTS, the default, converges here (the ensemble sampler stopped at
-    // its cap near R-hat 1.03 on the FE records, session 8)
+    // its cap near R-hat 1.03 on the FE records)
     assert!(
         run.converged && run.result.rhat_max < 1.01,
         "{} {}",

@@ -1,4 +1,4 @@
-//! The units of a localize step's model (`palpate_studies::localize::units`,
+//! The units of a localize step's model (`palpate_studies::apps::localize::units`,
 //! what its shards compute one at a time) enumerate to the nodule-free pass
 //! plus one scan per design point, each with its own inputs, and assemble,
 //! computed in any order and read back from their cached JSON, to the model
@@ -12,8 +12,8 @@
 use palpate_core::{
     Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec,
 };
-use palpate_studies::localize::units::{ModelRun, ModelUnits};
-use palpate_studies::localize::{Baseline, LocModel, LocSetup};
+use palpate_studies::apps::localize::units::{ModelRun, ModelUnits};
+use palpate_studies::apps::localize::{Baseline, LocModel, LocSetup};
 use palpate_uq::surrogate::Surrogate;
 
 /// Force of one nodule at depth d at offset o, over a flat 9 N.
@@ -135,7 +135,7 @@ fn units_computed_apart_assemble_to_the_model_built_in_one_go() {
 /// (each a shifted, scaled copy of the centre model's excess).
 #[test]
 fn lean_scans_are_units_and_assemble_to_the_planted_lean() {
-    use palpate_studies::localize::lean;
+    use palpate_studies::apps::localize::lean;
     use std::sync::Arc;
     let centre = LocSetup::r2(6.0);
     let setup = LocSetup::r2_lean(6.0);
@@ -149,7 +149,7 @@ fn lean_scans_are_units_and_assemble_to_the_planted_lean() {
     let planted = |e: f64, d: f64| 0.6 * (50.0 - e) / 35.0 * (30.0 - d) / 22.0;
     let m = Arc::clone(&model);
     let offsets = setup.lean_offsets();
-    let stand_in: palpate_studies::localize::units::LeanScan = Box::new(move |(e, d)| {
+    let stand_in: palpate_studies::apps::localize::units::LeanScan = Box::new(move |(e, d)| {
         let mut grid = vec![0.0; m.scan.loading().len()];
         m.excess_grid(d, m.centre, &mut grid)
             .map_err(|e| e.to_string())?;

@@ -7,9 +7,10 @@
 //! * a generated valid manifest reads back to what was written;
 //! * a data file of arbitrary bytes is read or refused naming the file.
 
-use palpate_studies::calibration::{TestData, TestKind};
-use palpate_studies::manifest::{
-    CalibrateStep, DataSpec, Manifest, ModelEntry, ModelForm, Step, StudyMeta,
+use palpate_studies::records::{TestData, TestKind};
+use palpate_studies::steps::calibrate::CalibrateStep;
+use palpate_studies::study::manifest::{
+    DataSpec, Manifest, ModelEntry, ModelForm, StepEntry, StudyMeta,
 };
 use proptest::prelude::*;
 use std::collections::BTreeMap;
@@ -198,7 +199,7 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                 let sets: Vec<String> = data.keys().cloned().collect();
                 let steps = (0..steps)
                     .map(|k| {
-                        Step::Calibrate(CalibrateStep {
+                        StepEntry::Calibrate(CalibrateStep {
                             name: format!("step-{k}"),
                             models: models.keys().cloned().collect(),
                             fits: [("all".to_string(), sets.clone())].into_iter().collect(),
@@ -251,7 +252,7 @@ fn to_toml(m: &Manifest) -> String {
         t += "\n";
     }
     for s in &m.steps {
-        let Step::Calibrate(c) = s else { continue };
+        let StepEntry::Calibrate(c) = s else { continue };
         let fits: Vec<String> = c
             .fits
             .iter()

@@ -5,8 +5,8 @@
 //! every FE run taken from the cache, also after an edit of the anova step.
 //! The full study is `studies/mesa2011.toml` (README).
 
-use palpate_studies::manifest::Manifest;
-use palpate_studies::runner::{run_study, RunObserver};
+use palpate_studies::study::manifest::Manifest;
+use palpate_studies::study::runner::{run_study, RunObserver};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 

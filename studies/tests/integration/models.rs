@@ -5,8 +5,8 @@
 use clap::Parser;
 use palpate_core::{Drive, Loading};
 use palpate_studies::cli::{Cli, Command};
-use palpate_studies::manifest::{Manifest, ModelForm};
-use palpate_studies::models::{build, Model, ModelSpec};
+use palpate_studies::model::{build, Model, ModelSpec};
+use palpate_studies::study::manifest::{Manifest, ModelForm};
 use std::path::Path;
 
 fn models(body: &str) -> anyhow::Result<Manifest> {
@@ -129,7 +129,7 @@ fn mesh_zero_is_an_error_naming_the_field() {
             "{mesh}: {e}"
         );
     }
-    let o = palpate_studies::models::parse_mesh("c1_fe", Some("0")).unwrap_err();
+    let o = palpate_studies::model::parse_mesh("c1_fe", Some("0")).unwrap_err();
     assert_eq!(
         o.as_option(),
         "--mesh `0`: expected coarse, medium, fine or a level 1..12"

@@ -6,9 +6,10 @@
 
 use palpate_inverse::ResidualKind;
 use palpate_material::Law;
-use palpate_studies::calibration::{calibrate, parse_method, Request, TestData, TestKind};
 use palpate_studies::cli::calibrate::read_data;
-use palpate_studies::models::Viscous;
+use palpate_studies::model::calibration::{calibrate, parse_method, Request};
+use palpate_studies::model::Viscous;
+use palpate_studies::records::{TestData, TestKind};
 use std::path::{Path, PathBuf};
 
 fn real() -> PathBuf {
@@ -44,7 +45,7 @@ fn fit(
     law: Law,
     data: &[TestData],
     viscous: Option<Viscous>,
-) -> palpate_studies::calibration::Calibration {
+) -> palpate_studies::model::calibration::Calibration {
     calibrate(Request {
         law,
         model: None,

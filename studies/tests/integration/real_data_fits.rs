@@ -16,9 +16,10 @@
 
 use palpate_inverse::{fit, DataSet, FitOptions, FitReport, Objective, ResidualKind};
 use palpate_material::Law;
-use palpate_studies::calibration::{calibrate, parse_method, Request, TestData};
 use palpate_studies::cli::calibrate::read_data;
-use palpate_studies::models::{build, Viscous};
+use palpate_studies::model::calibration::{calibrate, parse_method, Request};
+use palpate_studies::model::{build, Viscous};
+use palpate_studies::records::TestData;
 use serde_json::Value;
 use std::path::Path;
 use std::sync::Arc;
@@ -58,7 +59,11 @@ fn best_fit(case: &Value, data: &[TestData], also: Vec<f64>) -> FitReport {
     let residual: ResidualKind = case["residual"].as_str().unwrap().parse().unwrap();
     let sets: Vec<DataSet> = data
         .iter()
-        .map(|d| d.dataset(Arc::from(build(&d.spec(law, viscous(case))).unwrap())))
+        .map(|d| {
+            d.dataset(Arc::from(
+                build(&palpate_studies::model::record_spec(d, law, viscous(case))).unwrap(),
+            ))
+        })
         .collect();
     let objective = Objective::new(sets, residual, &[]).unwrap();
     let mut best: Option<FitReport> = None;

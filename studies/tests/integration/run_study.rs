@@ -1,7 +1,7 @@
 //! A study manifest runs into a complete run folder, and running it again
 //! (also on another thread count) gives a byte-identical `results.json`.
 
-use palpate_studies::runner::run_study;
+use palpate_studies::study::runner::run_study;
 use std::path::{Path, PathBuf};
 
 fn manifest(dir: &Path) -> PathBuf {

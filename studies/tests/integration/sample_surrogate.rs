@@ -3,7 +3,7 @@
 //! to 3 mm, Q1 to 0.1 mm with a 10-sample history.
 
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_studies::models::{build, ModelSpec, N1NeedleSpec, Q1Spec};
+use palpate_studies::model::{build, ModelSpec, N1NeedleSpec, Q1Spec};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -306,7 +306,7 @@ fn q1_ramp_and_hold_through_the_surrogate() {
 }
 
 /// The ensemble sampler's defaults on the C1 reduced-polynomial record
-/// stopped at R-hat 1.03 (issue 13): now the draws are doubled, with a line
+/// stopped at R-hat 1.03: so the draws are doubled, with a line
 /// per extension, until R-hat < 1.01 and bulk ESS >= 400; with a cap below
 /// that, a warning says so and the JSON records it.
 #[test]

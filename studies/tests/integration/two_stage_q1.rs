@@ -1,4 +1,4 @@
-//! The staged inverse FE identification of Q1 (`palpate_studies::two_stage`)
+//! The staged inverse FE identification of Q1 (`palpate_studies::apps::two_stage`)
 //! on a small, short record: a 1 mm mesh under the punch, 0.5 mm depth,
 //! a 5 s hold, one Prony term. The record is the fit model's own prediction
 //! at known parameters plus a fixed pseudo-random noise (0.3 % of the peak),
@@ -12,7 +12,7 @@
 
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_material::Law;
-use palpate_studies::two_stage::{identify, report, Q1Record, TwoStageOptions};
+use palpate_studies::apps::two_stage::{identify, report, Q1Record, TwoStageOptions};
 
 /// C10 (MPa), g1, tau1 (s).
 const TRUTH: [f64; 3] = [0.0016, 0.4, 0.8];
@@ -143,10 +143,10 @@ fn stages_are_parsed_and_checked() {
 fn the_study_manifest_is_valid() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
     let edge1 = dir.join("two-stage-q1-5mm-edge1.toml");
-    let m = palpate_studies::manifest::Manifest::read(&edge1).unwrap();
+    let m = palpate_studies::study::manifest::Manifest::read(&edge1).unwrap();
     m.validate(&edge1).unwrap();
     let deep = dir.join("two-stage-q1-5mm.toml");
-    let m = palpate_studies::manifest::Manifest::read(&deep).unwrap();
+    let m = palpate_studies::study::manifest::Manifest::read(&deep).unwrap();
     m.validate(&deep).unwrap();
     let coarse = std::fs::read_to_string(&deep)
         .unwrap()
@@ -154,7 +154,7 @@ fn the_study_manifest_is_valid() {
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("coarse.toml");
     std::fs::write(&p, coarse).unwrap();
-    let e = palpate_studies::manifest::Manifest::read(&p)
+    let e = palpate_studies::study::manifest::Manifest::read(&p)
         .unwrap()
         .validate(&p)
         .unwrap_err()
@@ -164,14 +164,14 @@ fn the_study_manifest_is_valid() {
         "{e}"
     );
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("two-stage-q1.toml");
-    let m = palpate_studies::manifest::Manifest::read(&path).unwrap();
+    let m = palpate_studies::study::manifest::Manifest::read(&path).unwrap();
     m.validate(&path).unwrap();
     let mut bad = std::fs::read_to_string(&path).unwrap();
     bad = bad.replace("time_step = 1.0", "time_step = 0.0");
     let dir = tempfile::tempdir().unwrap();
     let p = dir.path().join("bad.toml");
     std::fs::write(&p, bad).unwrap();
-    let m = palpate_studies::manifest::Manifest::read(&p).unwrap();
+    let m = palpate_studies::study::manifest::Manifest::read(&p).unwrap();
     let e = m.validate(&p).unwrap_err().to_string();
     assert!(
         e.contains("steps[0].two_stage (\"q1-liver\").time_step = 0"),
@@ -192,7 +192,7 @@ fn fine_record_and_elastic_stage() -> (Q1Record, TwoStageOptions) {
 }
 
 /// Every estimate of `stage` within 2 of its standard errors of the truth.
-fn assert_within_2_se(stage: &palpate_studies::two_stage::StageResult) {
+fn assert_within_2_se(stage: &palpate_studies::apps::two_stage::StageResult) {
     for (k, e) in stage.fit.parameters.iter().enumerate() {
         let se = e.standard_error.expect("a standard error");
         assert!(

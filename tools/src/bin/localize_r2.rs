@@ -21,10 +21,10 @@
 use palpate_core::ForwardModel;
 use palpate_fe::{Nodule, R2Rolling};
 use palpate_material::Law;
-use palpate_studies::localize::posterior::{localize, LocOptions};
-use palpate_studies::localize::record::Record;
-use palpate_studies::localize::{LocModel, LocSetup};
-use palpate_studies::surrogate::{default_cache_dir, load_or_compute};
+use palpate_studies::apps::localize::posterior::{localize, LocOptions};
+use palpate_studies::apps::localize::record::Record;
+use palpate_studies::apps::localize::{LocModel, LocSetup};
+use palpate_studies::run::surrogate::{default_cache_dir, load_or_compute};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::path::PathBuf;
@@ -92,7 +92,7 @@ fn main() -> anyhow::Result<()> {
     let desc = format!("{:?}; positions {:?}", fe, positions);
     let t1 = Instant::now();
     let (force, status): (Vec<f64>, _) = load_or_compute("r2-record", &desc, &cache, || {
-        let bar = palpate_studies::limits::Progress::new(
+        let bar = palpate_studies::run::limits::Progress::new(
             positions.len() as u64,
             "finer-mesh FE record",
             "{msg} [{bar:40}] {pos}/{len} positions ({elapsed}, eta {eta})",
@@ -237,7 +237,7 @@ fn main() -> anyhow::Result<()> {
         }
         for (j, e) in run.result.nodules.iter().enumerate() {
             let (tx, td) = truth[j];
-            let inside = |i: &palpate_studies::localize::posterior::Interval, t: f64| {
+            let inside = |i: &palpate_studies::apps::localize::posterior::Interval, t: f64| {
                 i.hdi_3 <= t && t <= i.hdi_97
             };
             let c = [inside(&e.x_mm, tx), inside(&e.depth_mm, td)];

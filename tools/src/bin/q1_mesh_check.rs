@@ -9,8 +9,8 @@
 //!       0.06666666666666667 0.0015885,0.31586,0.41229,0.19992,9.6813 \
 //!       1.16e-5,7.56e-3,2.85e-2,7.36e-3,1.02 [ROUNDS]
 use palpate_material::Law;
-use palpate_studies::two_stage::{Q1Record, TwoStageOptions};
-use palpate_studies::two_stage_mesh_check::{check_estimate, report};
+use palpate_studies::apps::two_stage::mesh_check::{check_estimate, report};
+use palpate_studies::apps::two_stage::{Q1Record, TwoStageOptions};
 
 fn list(s: &str) -> Vec<f64> {
     s.split(',').map(|x| x.parse().expect("a number")).collect()

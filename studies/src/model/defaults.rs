@@ -1,0 +1,151 @@
+//! The default model and candidate effects of a test kind: which
+//! [`ModelSpec`] a record of a test is fitted with when the user names only
+//! a law (`--benchmark`, a manifest's `law = "..."`), the base model of the
+//! gap diagnosis, and the effects it looks for. Moved out of
+//! [`crate::model`] (the spec and its factory), which re-exports them.
+
+use crate::model::{C1Spec, HomogeneousSpec, ModelSpec, N1NeedleSpec};
+use crate::records::TestKind;
+use palpate_core::{Effect, ForwardModel};
+use palpate_material::Law;
+
+/// The model of a data set's test for a law (the legacy manifest form
+/// `law = "..."` and the commands' `--benchmark`): the analytic homogeneous
+/// test, analytic C1, or N1 with the BENCHMARKS.md needle (friction 0.8) on
+/// the coarse mesh, since every evaluation of a fit is a full FE run.
+pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
+    let law = law.to_string();
+    match test {
+        TestKind::Homogeneous(mode) => ModelSpec::Homogeneous(HomogeneousSpec {
+            law,
+            mode: mode.name().to_string(),
+            axial_stretch: None,
+            viscoelastic: None,
+        }),
+        TestKind::GeneralBiaxial | TestKind::SimpleShear => {
+            ModelSpec::Homogeneous(HomogeneousSpec {
+                law,
+                mode: if test == TestKind::SimpleShear {
+                    "simple_shear"
+                } else {
+                    "general_biaxial"
+                }
+                .to_string(),
+                axial_stretch: None,
+                viscoelastic: None,
+            })
+        }
+        TestKind::C1 => ModelSpec::C1(C1Spec { law }),
+        TestKind::N1 => ModelSpec::N1Needle(N1NeedleSpec {
+            law,
+            mesh: Some("coarse".into()),
+            ..Default::default()
+        }),
+    }
+}
+
+/// The base model of the gap diagnosis for a record of `test`: C1 analytic
+/// (lubricated platens), N1 with a frictionless needle on the coarse mesh
+/// and a bonded base, so that `friction` and `boundary_condition` are
+/// effects to find, or the analytic homogeneous test of the record's kind
+/// (elastic: viscoelasticity is an effect to find). A record's own options
+/// (a simple-shear record's axial stretch) are set by [`gap_base_for`].
+pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
+    let spec_law = law.to_string();
+    match test {
+        TestKind::C1 => Ok(ModelSpec::C1(C1Spec { law: spec_law })),
+        TestKind::N1 => Ok(ModelSpec::N1Needle(N1NeedleSpec {
+            law: spec_law,
+            friction: Some(0.0),
+            mesh: Some("coarse".into()),
+            ..Default::default()
+        })),
+        TestKind::Homogeneous(_) | TestKind::GeneralBiaxial | TestKind::SimpleShear => {
+            Ok(for_test(test, law))
+        }
+    }
+}
+
+/// [`gap_base`] for one record read by [`crate::records::TestData`]:
+/// a simple-shear record keeps the axial stretch it was read with.
+pub fn gap_base_for(record: &crate::records::TestData, law: Law) -> anyhow::Result<ModelSpec> {
+    if record.test.is_homogeneous() {
+        Ok(super::record_spec(record, law, None))
+    } else {
+        gap_base(record.test, law)
+    }
+}
+
+/// The default candidate effects of the gap diagnosis for a base model and
+/// the record it is diagnosed on (`None`: every effect the model offers).
+///
+/// - N1: GAP.md's `friction` and `boundary_condition`; the N1 model also
+///   offers `material_form` and `zero_offset`, but on one force-depth curve
+///   friction and a stiffening law are confounded (docs/gap-diagnosis.md),
+///   so they are candidates on request only.
+/// - Homogeneous records: those of the model's effects the record can show:
+///   `viscoelasticity` only on a timed record (a `time_s` column), and
+///   `tension_compression_asymmetry` only when the stretches lie on both
+///   sides of 1 (elsewhere its sensitivity is zero, [`spans_tension_and_compression`]).
+///   `material_form` and (stretch-driven tests) `zero_offset` always.
+/// - C1: every effect the model offers.
+pub fn default_effects(
+    base: &ModelSpec,
+    model: &dyn ForwardModel,
+    loading: &palpate_core::Loading,
+) -> Option<Vec<Effect>> {
+    match base {
+        ModelSpec::N1Needle(_) => Some(vec![Effect::Friction, Effect::BoundaryCondition]),
+        ModelSpec::Homogeneous(_) => Some(
+            palpate_core::enrichable::effects_of(model)
+                .into_iter()
+                .filter(|e| match e {
+                    Effect::Viscoelasticity => loading.time.is_some(),
+                    Effect::TensionCompressionAsymmetry => {
+                        spans_tension_and_compression(&loading.drive)
+                    }
+                    _ => true,
+                })
+                .collect(),
+        ),
+        _ => None,
+    }
+}
+
+/// Whether a stretch history has samples in compression (< 1) and in
+/// tension (> 1), two at least on each side (one sample is not a slope).
+pub fn spans_tension_and_compression(stretch: &[f64]) -> bool {
+    const EPS: f64 = 1e-9;
+    let below = stretch.iter().filter(|&&s| s < 1.0 - EPS).count();
+    let above = stretch.iter().filter(|&&s| s > 1.0 + EPS).count();
+    below >= 2 && above >= 2
+}
+
+/// Checks that a model offers every requested effect; the error (`E: ...`)
+/// names the first one it does not offer and lists those it does.
+pub fn check_effects(model: &dyn ForwardModel, effects: &[Effect]) -> Result<(), String> {
+    let offered = palpate_core::enrichable::effects_of(model);
+    match effects.iter().find(|e| !offered.contains(e)) {
+        None => Ok(()),
+        Some(e) => {
+            let names: Vec<String> = offered.iter().map(|e| e.to_string()).collect();
+            Err(format!(
+                "{e}: {} does not offer this effect (it offers: {})",
+                model.name(),
+                if names.is_empty() {
+                    "none".into()
+                } else {
+                    names.join(", ")
+                }
+            ))
+        }
+    }
+}
+
+/// Effect names (GAP.md) parsed, the error naming the bad one.
+pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
+    names
+        .iter()
+        .map(|e| e.parse::<Effect>().map_err(|m| anyhow::anyhow!("{m}")))
+        .collect()
+}

@@ -1,0 +1,257 @@
+//! The `diagnose` step of a study ([`DiagnoseStep`]): the gap diagnosis of
+//! each record, a unit of the run folder cached under its inputs, and its
+//! table and plots in the report.
+
+use crate::model::{ModelForm, ModelSpec};
+use crate::model::{build, default_effects, gap_base_for, parse_effects};
+use crate::run::output::write_atomic;
+use crate::report::{data_unit, gap_svg, gap_table_header};
+use crate::run::step::{duplicate, keys, At, Run, Step, StepResult, Study};
+use anyhow::Context;
+use palpate_material::Law;
+use serde::{Deserialize, Serialize};
+use std::fmt::Write;
+
+/// Diagnose the sim-to-real gap of a base model on C1 or N1 records.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiagnoseStep {
+    pub name: String,
+    /// Data set names (each diagnosed separately).
+    pub data: Vec<String>,
+    /// Base law, e.g. `neo-hookean`, in the base model of each record's test
+    /// ([`crate::model::gap_base`]: C1 analytic; N1 frictionless, coarse mesh).
+    #[serde(default)]
+    pub base: Option<String>,
+    /// Or the base model by name (a `[models.NAME.<kind>]` entry).
+    #[serde(default)]
+    pub model: Option<String>,
+    /// Candidate effects (GAP.md names); default: C1 every effect its model
+    /// offers, N1 `friction` and `boundary_condition`.
+    #[serde(default)]
+    pub effects: Option<Vec<String>>,
+}
+
+/// One diagnosed data set.
+#[derive(Debug, Clone, Serialize)]
+pub struct DiagnoseEntry {
+    pub data: String,
+    pub report: serde_json::Value,
+}
+
+impl Step for DiagnoseStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, study: &Study, site: &At) -> anyhow::Result<()> {
+        let where_ = &site.file;
+        let at = site.step(&self.name);
+        for s in &self.data {
+            match study.data.get(s) {
+                None => anyhow::bail!(
+                    "{where_}: {at}.data: unknown data set \"{s}\" (defined: {})",
+                    keys(study.data)
+                ),
+                Some(spec) if spec.test != "C1" && spec.test != "N1" => {
+                    anyhow::bail!("{where_}: {at}.data: \"{s}\" is a {} test; the gap diagnosis needs a C1 or N1 force record", spec.test)
+                }
+                _ => {}
+            }
+        }
+        match (&self.base, &self.model) {
+            (Some(base), None) => {
+                if let Err(e) = base.parse::<palpate_material::Law>() {
+                    anyhow::bail!("{where_}: {at}.base = \"{base}\": {e}");
+                }
+            }
+            (None, Some(m)) => match study.models.get(m).map(|e| &e.model) {
+                None => anyhow::bail!(
+                    "{where_}: {at}.model: unknown model \"{m}\" (defined: {})",
+                    keys(study.models)
+                ),
+                Some(ModelForm::Law(_)) => anyhow::bail!(
+                    "{where_}: {at}.model: \"{m}\" is a law alone; give the law as `base` or define models.{m}.c1 / models.{m}.n1_needle"
+                ),
+                Some(ModelForm::Spec(spec)) => {
+                    for s in &self.data {
+                        study.check_predicts(where_.to_string(), &at, m, spec, s)?;
+                    }
+                }
+            },
+            _ => anyhow::bail!(
+                "{where_}: {at}: give exactly one of `base` (a law) and `model` (a model name)"
+            ),
+        }
+        anyhow::ensure!(
+            !self.data.is_empty(),
+            "{where_}: {at}.data = []: give at least one record"
+        );
+        let mut effects = Vec::new();
+        for e in self.effects.iter().flatten() {
+            match e.parse::<palpate_core::Effect>() {
+                Ok(e) => effects.push(e),
+                Err(m) => anyhow::bail!("{where_}: {at}.effects: \"{e}\": {m}"),
+            }
+        }
+        if let Some(list) = &self.effects {
+            anyhow::ensure!(
+                !list.is_empty(),
+                "{where_}: {at}.effects = []: give at least one effect, or leave `effects` out for the default candidates"
+            );
+            if let Some(e) = duplicate(list) {
+                anyhow::bail!("{where_}: {at}.effects: \"{e}\" is listed twice");
+            }
+        }
+        for s in &self.data {
+            let Some(spec) = diagnose_model(study, self, s) else {
+                continue;
+            };
+            if let Ok(model) = crate::model::build(&spec) {
+                crate::model::check_effects(model.as_ref(), &effects)
+                    .map_err(|e| anyhow::anyhow!("{where_}: {at}.effects: {e}"))?;
+            }
+        }
+        Ok(())
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        _done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        run_diagnose(run, self, report)
+    }
+}
+
+/// The base model a diagnose step uses on data set `data` (None when
+/// the step or the data set is wrong: reported elsewhere).
+fn diagnose_model(study: &Study, d: &DiagnoseStep, data: &str) -> Option<ModelSpec> {
+    match (&d.base, &d.model) {
+        (Some(base), None) => {
+            let test = crate::records::TestKind::parse(&study.data.get(data)?.test).ok()?;
+            crate::model::gap_base(test, base.parse().ok()?).ok()
+        }
+        (None, Some(m)) => match &study.models.get(m)?.model {
+            ModelForm::Spec(s) => Some(s.clone()),
+            ModelForm::Law(_) => None,
+        },
+        _ => None,
+    }
+}
+
+
+
+/// A diagnosed record as cached.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+struct DiagnoseUnit {
+    entry: serde_json::Value,
+    row: String,
+    plot: String,
+}
+
+pub(crate) fn run_diagnose(
+    run: &Run,
+    step: &DiagnoseStep,
+    report: &mut String,
+) -> anyhow::Result<serde_json::Value> {
+    let (manifest, data) = (run.manifest, run.data);
+    // The base model: a named model spec, or the base law in the gap base
+    // model of each record's test (models::gap_base).
+    let (base_name, named) = match (&step.base, &step.model) {
+        (Some(base), _) => (base.clone(), None),
+        (None, Some(m)) => match &manifest.models[m].model {
+            ModelForm::Spec(s) => (m.clone(), Some(s)),
+            ModelForm::Law(_) => anyhow::bail!("step `{}`: model `{m}` is a law alone", step.name),
+        },
+        (None, None) => anyhow::bail!("step `{}`: no base model", step.name),
+    };
+    let mut cases = Vec::new();
+    let _ = writeln!(
+        report,
+        "## Gap diagnosis `{}` (base `{}`)\n",
+        step.name, base_name
+    );
+    let units: Vec<&str> = step.data.iter().map(|n| data_unit(data[n].test)).collect();
+    report.push_str(&gap_table_header(&units));
+    for name in &step.data {
+        let d = &data[name];
+        let spec = match named {
+            Some(s) => s.clone(),
+            None => {
+                let law: Law = base_name
+                    .parse()
+                    .map_err(|e| anyhow::anyhow!("step `{}`: base: {e}", step.name))?;
+                gap_base_for(d, law).with_context(|| format!("step `{}`: `{name}`", step.name))?
+            }
+        };
+        let label = format!("{}: diagnosing {name}", step.name);
+        let inputs = (
+            "diagnose",
+            &step.name,
+            &base_name,
+            &spec,
+            &step.effects,
+            name,
+            d,
+        );
+        let Some(unit): Option<DiagnoseUnit> = run.unit(&label, &inputs, || {
+            let model = build(&spec).map_err(|e| anyhow::anyhow!("step `{}`: {e}", step.name))?;
+            let options = palpate_uq::gap::GapOptions {
+                effects: match &step.effects {
+                    Some(list) => Some(
+                        parse_effects(list)
+                            .with_context(|| format!("step `{}`: effects", step.name))?,
+                    ),
+                    None => default_effects(&spec, model.as_ref(), &d.loading),
+                },
+                ..Default::default()
+            };
+            let gap = palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &options)
+                .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
+            let best = gap.ranking.first();
+            let row = format!(
+                "| {name} | **{}**{} | {:.4} | {:.4} | {} | {} | {} |",
+                gap.verdict,
+                if gap.confounded.is_empty() {
+                    String::new()
+                } else {
+                    let names: Vec<&str> = gap.confounded.iter().map(|e| e.name()).collect();
+                    format!(" (confounded with {})", names.join(", "))
+                },
+                gap.noise_sd,
+                gap.base.misfit,
+                best.map(|b| b.effect.to_string()).unwrap_or_default(),
+                best.map(|b| format!("{:.4}", b.misfit_after))
+                    .unwrap_or_default(),
+                best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))
+                    .unwrap_or_default(),
+            );
+            Ok(DiagnoseUnit {
+                row,
+                plot: gap_svg(&gap, name),
+                entry: serde_json::to_value(DiagnoseEntry {
+                    data: name.clone(),
+                    report: serde_json::to_value(&gap)?,
+                })?,
+            })
+        })?
+        else {
+            continue;
+        };
+        let _ = writeln!(report, "{}", unit.row);
+        write_atomic(
+            &run.out
+                .join("plots")
+                .join(format!("{}-{name}.svg", step.name)),
+            unit.plot.as_bytes(),
+        )?;
+        cases.push(unit.entry);
+    }
+    let _ = writeln!(report, "\nPlots: `plots/{}-<data>.svg` (data, base and enriched fits, residuals with the flagged windows).\n", step.name);
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "cases": cases,
+    }))
+}
