@@ -9,13 +9,13 @@ pub mod diagnose;
 pub mod doe;
 pub mod localize;
 pub mod merge;
+pub mod realtime;
 pub mod run;
 pub mod sample;
 pub mod sample_fe;
 pub mod simulate;
 mod simulate_estimate;
 pub mod simulate_r2;
-pub mod surrogate;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify
 /// their uncertainty and diagnose the gap between simulation and measurement.
@@ -54,8 +54,10 @@ pub enum Command {
     Run(run::Args),
     // Assemble a study's results from its shards (merge::Args).
     Merge(merge::Args),
-    // The real-time force surrogate (surrogate::Args).
-    Surrogate(surrogate::Args),
+    // The real-time force model (realtime::Args); `surrogate` is its former
+    // name, kept as a hidden alias.
+    #[command(alias = "surrogate")]
+    Realtime(realtime::Args),
     // Nodule localisation from an R2 record (localize::Args).
     Localize(localize::Args),
 }
@@ -101,7 +103,7 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Diagnose(a) => diagnose::run(a),
         Command::Run(a) => run::run(a),
         Command::Merge(a) => merge::run(a),
-        Command::Surrogate(a) => surrogate::run(a),
+        Command::Realtime(a) => realtime::run(a),
         Command::Localize(a) => localize::run(a),
     }
 }

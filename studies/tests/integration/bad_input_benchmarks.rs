@@ -11,7 +11,7 @@ use common::*;
 
 // ---------- Q1 two-stage identification and the real-time surrogate ----------
 
-/// `palpate surrogate build --benchmark BENCHMARK` of a neo-Hookean
+/// `palpate realtime build --benchmark BENCHMARK` of a neo-Hookean
 /// material into `rt.json` of `s`, with `--prony PRONY --depth-max DEPTH`
 /// and the `extra` options.
 fn surrogate_build(
@@ -23,7 +23,7 @@ fn surrogate_build(
 ) -> std::process::Output {
     let out = s.path("rt.json").display().to_string();
     let mut args = vec![
-        "surrogate",
+        "realtime",
         "build",
         "--benchmark",
         benchmark,
@@ -178,30 +178,36 @@ fn q1_viscoelastic_and_surrogate_bad_input_is_named() {
         "off",
     ]);
     refused(&o, &["--hold 0.000001", "shorter than one step"]);
-    // a history that leaves the surrogate's range: row and range named
+    // a history that leaves the real-time model's range: row and range named
     let curve =
-        palpate_uq::surrogate::MonotoneCubic::new(vec![0.0, 0.5, 1.0], vec![0.0, 0.01, 0.03])
-            .unwrap();
-    let rt = palpate_uq::surrogate::RealTimeSurrogate::new("test".into(), curve, vec![(0.3, 0.5)])
-        .unwrap();
+        palpate_realtime::MonotoneCubic::new(vec![0.0, 0.5, 1.0], vec![0.0, 0.01, 0.03]).unwrap();
+    let rt = palpate_realtime::RealTimeModel::new("test".into(), curve, vec![(0.3, 0.5)]).unwrap();
     let js = s.file("rt.json", &rt.to_json());
     let ok = s.file("ok.csv", "time_s,displacement_mm\n0.001,0.1\n0.002,0.2\n");
-    accepted(&s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &ok]));
+    let answer = s.run(&["realtime", "query", "--model", &js, "--csv", &ok]);
+    accepted(&answer);
+    // the command's and the option's former names are hidden aliases
+    let former = s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &ok]);
+    accepted(&former);
+    assert!(answer
+        .stdout
+        .starts_with(b"time_s,displacement_mm,force_N\n0.001,0.1,"));
+    assert_eq!(former.stdout, answer.stdout);
     let deep = s.file("deep.csv", "time_s,displacement_mm\n0.001,0.5\n0.002,1.5\n");
-    let o = s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &deep]);
+    let o = s.run(&["realtime", "query", "--model", &js, "--csv", &deep]);
     refused(
         &o,
         &[
             "deep.csv: row 3",
-            "depth 1.5 mm is outside the surrogate's trained range [0, 1] mm",
+            "depth 1.5 mm is outside the real-time model's trained range [0, 1] mm",
         ],
     );
     let back = s.file("back.csv", "time_s,displacement_mm\n0.002,0.5\n0.001,0.5\n");
-    let o = s.run(&["surrogate", "query", "--surrogate", &js, "--csv", &back]);
+    let o = s.run(&["realtime", "query", "--model", &js, "--csv", &back]);
     refused(&o, &["back.csv: line 3", "goes back"]);
     let not = s.file("not.json", "{\"a\": 1}");
-    let o = s.run(&["surrogate", "query", "--surrogate", &not, "--csv", &ok]);
-    refused(&o, &["--surrogate", "not a real-time surrogate"]);
+    let o = s.run(&["realtime", "query", "--model", &not, "--csv", &ok]);
+    refused(&o, &["--model", "not a real-time model"]);
     // the staged identification: a record without a hold, unknown stages
     let ramp = s.file(
         "ramp.csv",

@@ -504,9 +504,9 @@ fn every_subcommands_help_explains_itself() {
         (vec!["doe"], "design.csv"),
         (vec!["diagnose"], "candidates"),
         (vec!["run"], "INCOMPLETE"),
-        (vec!["surrogate"], "query"),
-        (vec!["surrogate", "build"], "held-out"),
-        (vec!["surrogate", "query"], "depth-max"),
+        (vec!["realtime"], "query"),
+        (vec!["realtime", "build"], "held-out"),
+        (vec!["realtime", "query"], "depth-max"),
         (vec!["localize"], "credible intervals"),
     ] {
         let mut args = cmd.clone();
@@ -534,6 +534,38 @@ fn every_subcommands_help_explains_itself() {
             );
         }
     }
+}
+
+/// `palpate realtime`'s help quotes no measured accuracy: it names the
+/// page that holds it; its former name `surrogate` is a hidden alias.
+#[test]
+fn realtime_help_links_to_its_accuracy_page() {
+    for cmd in [
+        vec!["realtime"],
+        vec!["realtime", "build"],
+        vec!["realtime", "query"],
+    ] {
+        let mut args = cmd.clone();
+        args.push("--help");
+        let help = String::from_utf8_lossy(&palpate(&args).stdout).to_string();
+        let measured = help
+            .char_indices()
+            .filter(|&(_, c)| c == '%')
+            .any(|(i, _)| help[..i].trim_end().ends_with(|c: char| c.is_ascii_digit()));
+        assert!(!measured, "{cmd:?} --help quotes a percentage:\n{help}");
+        if cmd.len() < 3 {
+            assert!(
+                help.contains("docs/validation/realtime.md"),
+                "{cmd:?}:\n{help}"
+            );
+        }
+    }
+    let top = String::from_utf8_lossy(&palpate(&["--help"]).stdout).to_string();
+    let listed = |name: &str| top.lines().any(|l| l.trim_start().starts_with(name));
+    assert!(listed("realtime") && !listed("surrogate"), "{top}");
+    let old = palpate(&["surrogate", "build", "--help"]);
+    assert!(old.status.success(), "{}", stderr(&old));
+    assert!(String::from_utf8_lossy(&old.stdout).contains("held-out"));
 }
 
 /// A parameter the fit leaves on a bound of its range is said to be there

@@ -50,20 +50,15 @@
 //! # Ok::<(), Box<dyn std::error::Error>>(())
 //! ```
 
-pub mod depth_history;
 pub mod design;
 pub mod gp;
-pub mod memory_kernel;
 pub mod model;
-pub mod realtime;
-pub mod realtime_build;
 
 pub use design::{halton_design, ParamBox};
 pub use model::{
     cpu_seconds, FailedRun, Surrogate, SurrogateOptions, SurrogateRequest, Validation,
     SURROGATE_FORMAT,
 };
-pub use realtime::{MonotoneCubic, RangeError, RealTimeSurrogate};
 
 use thiserror::Error;
 

@@ -272,7 +272,7 @@ fn viscoelastic_needle_relaxes_to_g_inf_times_the_elastic_force() {
 #[test]
 fn the_frictional_viscoelastic_history_passes_its_stall_stabilised() {
     use palpate_fe::Prony;
-    // the history's segment ends (palpate_uq::surrogate::random_history(1, 5.0, 6, 1e-3))
+    // the history's segment ends (palpate_realtime::random_history(1, 5.0, 6, 1e-3))
     let knots = [
         (0.0, 0.0),
         (2.6091274693905118, 4.92750688396699),

@@ -1,14 +1,14 @@
-//! The real-time surrogate's fitted memory (issue 13): a nonlinear
+//! The real-time model's fitted memory: a nonlinear
 //! single-integral force model whose memory is read through the present
 //! depth, fitted to FE histories by linear least squares.
 //!
 //! # Why
 //!
-//! QLV on the force ([`super::realtime`]'s default) assumes the force
+//! QLV on the force ([`crate::model`]'s default) assumes the force
 //! stored at an earlier depth relaxes as the elastic force does, whatever
-//! the depth is now: exact for a flat punch in the linear range, 5-12 % off
-//! (of the peak) for the rounded Q1 punch to 4 mm and the N1 needle, whose
-//! contact grows and shrinks (docs/guide.md). The FE material's Prony
+//! the depth is now: exact for a flat punch in the linear range, off by
+//! several per cent of the peak for the rounded Q1 punch and the N1 needle,
+//! whose contact grows and shrinks (docs/validation/realtime.md). The FE material's Prony
 //! series acts on the isochoric second Piola-Kirchhoff stress; the force of
 //! a stress stored at depth `b` and read at depth `a` is `K(a, b)`, not
 //! `F_e(b)`. This model keeps the recursion (O(modes x knots) a sample) and
@@ -64,7 +64,7 @@
 //! flat punch, whose contact is all or nothing in the linear range, and
 //! less so for a needle or a rounded edge at depth.
 //!
-//! Stop operators (`stops`, session 23): a rate-independent hysteresis
+//! Stop operators (`stops`): a rate-independent hysteresis
 //! beside the memory,
 //!
 //! ```text
@@ -97,7 +97,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::depth_history::History;
+use crate::depth_history::History;
 
 /// Present-depth functions `chi_j`.
 const PRESENT: usize = 2;
@@ -106,18 +106,12 @@ const LIFT_PASSES: usize = 3;
 /// Bisections of a surface depth (to `depth_max / 2^40`).
 const BISECTIONS: usize = 40;
 /// The compliant contacts the cross-validation tries besides the hard one:
-/// `[g0 / depth_max, A / peak force]` (session 20: on the 11 stored builds
-/// of the guide, the cross-validated choice among these four lowered the
-/// worst held-out error on 6, e.g. N1 frictionless to 10 mm 5.12 to 2.85
-/// %, Q1 to 5 mm on mesh 2 8.61 to 3.38 %, and raised it on 2: N1 with
-/// friction to 10 mm 3.71 to 3.94 %, to 4 mm 1.65 to 1.95 %).
+/// `[g0 / depth_max, A / peak force]`. What the choice among them gives on
+/// the builds measured: docs/validation/realtime.md.
 pub const COMPLIANT: [[f64; 2]; 4] = [[0.05, 0.03], [0.1, 0.03], [0.1, 0.1], [0.2, 0.03]];
-/// Thresholds of the stop operators, over `depth_max` (module doc).
-/// Session 23, on four fresh builds (12 histories each; docs/guide.md):
-/// chosen by the cross-validation on N1 frictionless to 10 mm (worst
-/// held-out 2.52 to 1.70 %) and on Q1 with the default edge to 5 mm on
-/// mesh 1 (15.8 to 13.2 %), not chosen on the other two; 0.01-0.3,
-/// 0.1-0.3 and 0.05/0.15 did no better, five thresholds over-fit.
+/// Thresholds of the stop operators, over `depth_max` (module doc); the
+/// cross-validation chooses whether a build uses them
+/// (docs/validation/realtime.md).
 pub const STOPS: [f64; 3] = [0.03, 0.1, 0.3];
 /// Folds of the cross-validation that chooses `lift_off`.
 const FOLDS: usize = 4;
@@ -238,7 +232,7 @@ impl MemoryKernel {
     /// QLV on the force as a kernel: `a_k = g_inf F_k`, `c_ik0 = c_ik1 =
     /// g_i F_k`, with `F_k` the elastic force at knot `k` (`knots` values,
     /// at `k depth_max / knots`, k = 1..knots) and the Prony terms
-    /// `(g_i, tau_i)`; it answers as [`super::RealTimeSurrogate`]'s QLV
+    /// `(g_i, tau_i)`; it answers as [`crate::RealTimeModel`]'s QLV
     /// wherever the elastic curve is linear between the knots.
     pub fn qlv(
         depth_max: f64,

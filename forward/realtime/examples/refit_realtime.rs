@@ -1,20 +1,34 @@
-//! Refits the memory of a stored real-time surrogate (no FE run) and prints
+//! Refits the memory of a stored real-time model (no FE run) and prints
 //! the held-out error table and the worst station of each held-out history:
-//! `cargo run --release -p palpate-uq --example refit_realtime -- SURROGATE.json [KNOTS]`
-//! (a file from `palpate surrogate build`, which stores its FE runs).
-//! For studying the kernel's form on FE data that took minutes to make.
-//! With env `OUT=FILE` the refitted surrogate is written there.
+//!
+//! `cargo run --release -p palpate-realtime --example refit_realtime -- MODEL.json [KNOTS] [--out FILE.json] [--stations]`
+//!
+//! (a file from `palpate realtime build`, which stores its FE runs). For
+//! studying the kernel's form on FE data that took minutes to make. With
+//! `--out` the refitted model is written there; with `--stations` each
+//! station's time, depth, FE force, model force and error is printed.
 
-use palpate_uq::surrogate::realtime::{History, RealTimeSurrogate};
+use palpate_realtime::{History, RealTimeModel};
+
+const USAGE: &str = "usage: refit_realtime MODEL.json [KNOTS] [--out FILE.json] [--stations]";
 
 fn main() {
+    let mut path = None;
+    let mut knots = 10usize;
+    let mut out = None;
+    let mut stations = false;
     let mut args = std::env::args().skip(1);
-    let path = args
-        .next()
-        .expect("usage: refit_realtime SURROGATE.json [KNOTS]");
-    let knots: usize = args.next().map_or(10, |k| k.parse().expect("KNOTS"));
-    let text = std::fs::read_to_string(&path).expect("read the surrogate");
-    let mut s = RealTimeSurrogate::from_json(&text).expect("a real-time surrogate");
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--out" => out = Some(args.next().expect(USAGE)),
+            "--stations" => stations = true,
+            _ if path.is_none() => path = Some(a),
+            _ => knots = a.parse().expect(USAGE),
+        }
+    }
+    let path = path.expect(USAGE);
+    let text = std::fs::read_to_string(&path).expect("read the model");
+    let mut s = RealTimeModel::from_json(&text).expect("a real-time model");
     s.refit(knots).expect("refit");
     let k = s.kernel.as_ref().expect("a kernel");
     println!(
@@ -41,10 +55,10 @@ fn main() {
             100.0 * v.rms_relative_error.unwrap_or(f64::NAN)
         );
     }
-    if let Ok(out) = std::env::var("OUT") {
-        std::fs::write(&out, s.to_json()).expect("write the refitted surrogate");
+    if let Some(out) = out {
+        std::fs::write(&out, s.to_json()).expect("write the refitted model");
     }
-    if std::env::var("STATIONS").is_ok() {
+    if stations {
         for r in s.runs.clone() {
             let h = History::from_knots(r.knots.clone(), 1e-3);
             let f = s.run(&h.time, &h.depth).expect("in range");

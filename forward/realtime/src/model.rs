@@ -1,17 +1,5 @@
-//! A real-time surrogate of an indentation force response (BENCHMARKS.md
-// Negated comparisons (`!(x > 0.0)`) deliberately treat NaN as failure.
-#![allow(clippy::neg_cmp_op_on_partial_ord)]
-//! Q1, N1 with `--prony`): the force for an arbitrary depth history, sample
-//! by sample, fast enough for haptic rendering at 1 kHz and more (issue 13).
-//!
-//! Why here: this module family (`palpate_uq::surrogate`) is where reduced
-//! models of FE responses live; like the parametric surrogate of
-//! [`super::model`], it is built from runs of any
-//! [`palpate_core::ForwardModel`] (the FE models behind the trait) and needs
-//! no FE code, so it sits beside it rather than in `palpate-fe`. The two
-//! answer different questions: [`super::Surrogate`] maps parameters to the
-//! force on one fixed history (for posteriors), [`RealTimeSurrogate`] maps a
-//! depth history to the force at fixed parameters (for rendering).
+//! The real-time model and its recursion: the force for an arbitrary depth
+//! history, sample by sample.
 //!
 //! # Model
 //!
@@ -31,16 +19,14 @@
 //! sample. For the flat punch under displacement control it is exact in the
 //! linear range (correspondence principle: `F = 8 a int G(t - s) dG d`);
 //! at finite depth the FE material (Prony series on the isochoric second
-//! Piola-Kirchhoff stress) differs from it: within 2 % of the peak for Q1
-//! to 0.8 mm, 5-12 % for the rounded Q1 punch to 4 mm and 4-14 % for the
-//! N1 needle to 10 mm (docs/guide.md).
+//! Piola-Kirchhoff stress) differs from it, the more so where the contact
+//! grows and shrinks (the rounded Q1 punch, the N1 needle).
 //!
 //! So a build with training histories (`RealTimeRequest::training_histories`)
-//! replaces QLV's memory by a fitted one ([`super::memory_kernel`]): the
+//! replaces QLV's memory by a fitted one ([`crate::memory_kernel`]): the
 //! memory read through the present depth, its coefficients from FE runs by
-//! least squares, the same recursion. Held-out errors (docs/guide.md): Q1
-//! within 1.1 % to 4 mm (the 1 mm edge), N1 within 1.6 % to 4 mm and up to
-//! 3.5 % (frictionless) or 4.5 % (friction 0.8, to 7 mm) deeper.
+//! least squares, the same recursion. The held-out errors of both, build by
+//! build, are in `docs/validation/realtime.md`.
 //!
 //! Loss of contact: a punch withdrawn faster than the tissue recovers
 //! leaves it; the force cannot pull (`F >= 0`). When the trial force of a
@@ -54,11 +40,12 @@
 //! Range: depths in `[0, depth_max]` of the elastic FE ramp, `dt >= 0`;
 //! anything else is refused ([`RangeError`]), never extrapolated.
 
+// Negated comparisons (`!(x > 0.0)`) deliberately treat NaN as failure.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use serde::{Deserialize, Serialize};
 
-pub use super::depth_history::{random_history, History};
-use super::memory_kernel::MemoryKernel;
-pub use super::realtime_build::RealTimeRequest;
+use crate::memory_kernel::MemoryKernel;
 
 /// A monotone piecewise-cubic Hermite interpolant (Fritsch & Carlson 1980,
 /// SIAM J. Numer. Anal. 17, 238; the slopes of Fritsch & Butland 1984, as
@@ -128,19 +115,19 @@ impl MonotoneCubic {
     }
 }
 
-/// A query the surrogate refuses.
+/// A query the real-time model refuses.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum RangeError {
-    #[error("depth {depth} mm is outside the surrogate's trained range [0, {max}] mm (it does not extrapolate; rebuild it with a larger --depth-max)")]
+    #[error("depth {depth} mm is outside the real-time model's trained range [0, {max}] mm (it does not extrapolate; rebuild it with a larger --depth-max)")]
     Depth { depth: f64, max: f64 },
     #[error("time step {dt} s: must be finite and >= 0")]
     TimeStep { dt: f64 },
 }
 
-/// What the surrogate was checked against: per held-out FE history, the
+/// What the model was checked against: per held-out FE history, the
 /// largest force error relative to the history's peak force (the measure
-/// the 2 % target of issue 13 is read by), and the RMS error over its
-/// stations relative to the same peak.
+/// a build's `--target` is read by), and the RMS error over its stations
+/// relative to the same peak.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct HistoryError {
     pub history: String,
@@ -149,7 +136,7 @@ pub struct HistoryError {
     pub max_abs_error_n: f64,
     pub max_relative_error: f64,
     /// `sqrt(mean((F - F_FE)^2)) / peak` over the stations; none in files
-    /// written before session 21.
+    /// written before it was stored.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rms_relative_error: Option<f64>,
     /// Where that error is: the station's `(time_s, depth_mm)`; none in
@@ -168,9 +155,9 @@ pub struct StoredRun {
     pub stations: Vec<(f64, f64)>,
 }
 
-/// The stored surrogate and its state (the state is not stored).
+/// The stored real-time model and its state (the state is not stored).
 #[derive(Debug, Clone, Serialize, Deserialize)]
-pub struct RealTimeSurrogate {
+pub struct RealTimeModel {
     /// What it stands for (model name and parameters).
     pub model: String,
     /// Largest depth of the elastic curve (mm).
@@ -182,7 +169,7 @@ pub struct RealTimeSurrogate {
     /// Held-out FE histories and the error on each.
     pub validation: Vec<HistoryError>,
     /// The fitted memory that replaces QLV's when present
-    /// ([`super::memory_kernel`]); built from FE training histories.
+    /// ([`crate::memory_kernel`]); built from FE training histories.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kernel: Option<MemoryKernel>,
     /// With a kernel: plain QLV's errors on the same held-out histories.
@@ -198,7 +185,7 @@ pub struct RealTimeSurrogate {
     pub validation_failures: Vec<String>,
     /// The FE histories of the build (training first, then held out) with
     /// their FE forces, so the memory can be refitted without FE
-    /// ([`RealTimeSurrogate::refit`]); empty in files of older builds.
+    /// ([`RealTimeModel::refit`]); empty in files of older builds.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub runs: Vec<StoredRun>,
     /// FE runs and wall time of the build.
@@ -217,11 +204,8 @@ struct State {
     phi: Vec<f64>,
 }
 
-/// The name the issue gives it: `Surrogate::force(depth, dt)`.
-pub type Surrogate = RealTimeSurrogate;
-
-impl RealTimeSurrogate {
-    /// A surrogate from its elastic curve and relaxation terms; checks the
+impl RealTimeModel {
+    /// A model from its elastic curve and relaxation terms; checks the
     /// terms (`g_i >= 0`, `sum g_i < 1`, `tau_i > 0`) and the curve (depths
     /// from 0, forces not decreasing).
     pub fn new(
@@ -245,7 +229,7 @@ impl RealTimeSurrogate {
             ));
         }
         let depth_max = *elastic.x.last().expect("two points");
-        let mut s = RealTimeSurrogate {
+        let mut s = RealTimeModel {
             model,
             depth_max,
             elastic,
@@ -349,22 +333,22 @@ impl RealTimeSurrogate {
             .collect()
     }
 
-    /// JSON text of the stored surrogate.
+    /// JSON text of the stored model.
     pub fn to_json(&self) -> String {
-        serde_json::to_string_pretty(self).expect("a surrogate serialises")
+        serde_json::to_string_pretty(self).expect("a real-time model serialises")
     }
 
-    /// Reads a stored surrogate, checked as [`RealTimeSurrogate::new`].
+    /// Reads a stored model, checked as [`RealTimeModel::new`].
     pub fn from_json(text: &str) -> Result<Self, String> {
-        let s: RealTimeSurrogate = serde_json::from_str(text).map_err(|e| e.to_string())?;
+        let s: RealTimeModel = serde_json::from_str(text).map_err(|e| e.to_string())?;
         let elastic = MonotoneCubic::new(s.elastic.x.clone(), s.elastic.y.clone())?;
-        let mut out = RealTimeSurrogate::new(s.model, elastic, s.prony)?;
+        let mut out = RealTimeModel::new(s.model, elastic, s.prony)?;
         out.validation = s.validation;
         if let Some(k) = &s.kernel {
             k.check()?;
             if k.depth_max != out.depth_max {
                 return Err(format!(
-                    "memory kernel on [0, {}] mm for a surrogate on [0, {}] mm",
+                    "memory kernel on [0, {}] mm for a model on [0, {}] mm",
                     k.depth_max, out.depth_max
                 ));
             }
@@ -405,11 +389,12 @@ fn check_prony(prony: &[(f64, f64)]) -> Result<(), String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::depth_history::random_history;
 
-    fn linear_surrogate(prony: Vec<(f64, f64)>) -> RealTimeSurrogate {
+    fn linear_model(prony: Vec<(f64, f64)>) -> RealTimeModel {
         let x: Vec<f64> = (0..=10).map(|k| 0.1 * k as f64).collect();
         let y = x.iter().map(|d| 2.0 * d).collect();
-        RealTimeSurrogate::new("linear".into(), MonotoneCubic::new(x, y).unwrap(), prony).unwrap()
+        RealTimeModel::new("linear".into(), MonotoneCubic::new(x, y).unwrap(), prony).unwrap()
     }
 
     /// The monotone cubic interpolates, reproduces a line, and does not
@@ -439,7 +424,7 @@ mod tests {
     /// A step to depth d then hold: F = F_e(d) G(t) exactly.
     #[test]
     fn step_and_hold_follows_the_relaxation_function() {
-        let mut s = linear_surrogate(vec![(0.3, 0.5), (0.2, 10.0)]);
+        let mut s = linear_model(vec![(0.3, 0.5), (0.2, 10.0)]);
         let f0 = s.force(0.5, 0.0).unwrap();
         assert!((f0 - 1.0).abs() < 1e-12);
         let mut t = 0.0;
@@ -456,7 +441,7 @@ mod tests {
     /// after the surface has recovered towards it.
     #[test]
     fn unloading_loses_and_regains_contact() {
-        let mut s = linear_surrogate(vec![(0.5, 1.0)]);
+        let mut s = linear_model(vec![(0.5, 1.0)]);
         s.force(1.0, 0.0).unwrap();
         for _ in 0..100 {
             s.force(1.0, 0.1).unwrap();
@@ -486,23 +471,23 @@ mod tests {
     /// Outside the range: refused, state untouched.
     #[test]
     fn refuses_outside_the_range() {
-        let mut s = linear_surrogate(vec![(0.3, 0.5)]);
+        let mut s = linear_model(vec![(0.3, 0.5)]);
         let a = s.force(0.5, 0.1).unwrap();
         let e = s.force(1.2, 0.1).unwrap_err();
         assert!(
             e.to_string()
-                .contains("outside the surrogate's trained range [0, 1] mm"),
+                .contains("outside the real-time model's trained range [0, 1] mm"),
             "{e}"
         );
         assert!(s.force(-0.1, 0.1).is_err());
         assert!(s.force(f64::NAN, 0.1).is_err());
         let e = s.force(0.5, -0.1).unwrap_err();
         assert!(e.to_string().contains("time step -0.1 s"), "{e}");
-        let mut t = linear_surrogate(vec![(0.3, 0.5)]);
+        let mut t = linear_model(vec![(0.3, 0.5)]);
         t.force(0.5, 0.1).unwrap();
         assert_eq!(s.force(0.5, 0.1).unwrap(), t.force(0.5, 0.1).unwrap());
         assert!(a > 0.0);
-        let bad = RealTimeSurrogate::new(
+        let bad = RealTimeModel::new(
             "x".into(),
             MonotoneCubic::new(vec![0.0, 1.0], vec![0.0, 1.0]).unwrap(),
             vec![(0.6, 1.0), (0.4, 2.0)],
@@ -510,7 +495,7 @@ mod tests {
         .unwrap_err();
         assert!(bad.contains("sum to 1"), "{bad}");
         let json = t.to_json();
-        assert!(RealTimeSurrogate::from_json(&json).is_ok());
+        assert!(RealTimeModel::from_json(&json).is_ok());
     }
 
     /// With a memory kernel (here QLV's own coefficients): the same answers
@@ -519,7 +504,7 @@ mod tests {
     #[test]
     fn a_memory_kernel_answers_and_is_stored() {
         let prony = vec![(0.3, 0.5), (0.2, 10.0)];
-        let mut plain = linear_surrogate(prony.clone());
+        let mut plain = linear_model(prony.clone());
         let mut with = plain.clone();
         let at_knots: Vec<f64> = (1..=10).map(|k| 0.2 * k as f64).collect();
         with.kernel = Some(MemoryKernel::qlv(1.0, &at_knots, &prony, true));
@@ -534,12 +519,12 @@ mod tests {
         assert!(worst < 1e-9, "{worst}");
         assert!(with.force(1.2, 0.1).is_err());
         assert!(with.force(0.5, -1.0).is_err());
-        let mut back = RealTimeSurrogate::from_json(&with.to_json()).unwrap();
+        let mut back = RealTimeModel::from_json(&with.to_json()).unwrap();
         assert!(back.kernel.is_some());
         assert_eq!(back.run(&h.time, &h.depth).unwrap(), b);
         let mut other = with.clone();
         other.kernel = Some(MemoryKernel::qlv(2.0, &at_knots, &prony, true));
-        let e = RealTimeSurrogate::from_json(&other.to_json()).unwrap_err();
+        let e = RealTimeModel::from_json(&other.to_json()).unwrap_err();
         assert!(e.contains("memory kernel on [0, 2] mm"), "{e}");
     }
 }

@@ -1,4 +1,4 @@
-//! Tests of the real-time surrogate's fitted memory ([`super`]).
+//! Tests of the real-time model's fitted memory ([`super`]).
 
 use super::*;
 
@@ -9,12 +9,7 @@ fn histories(depth_max: f64, n: usize) -> Vec<History> {
         1e-2,
     )];
     for k in 1..n {
-        h.push(super::super::realtime::random_history(
-            500 + k as u64,
-            depth_max,
-            5,
-            1e-2,
-        ));
+        h.push(crate::random_history(500 + k as u64, depth_max, 5, 1e-2));
     }
     h
 }
@@ -211,7 +206,7 @@ fn the_cross_validation_finds_a_compliant_contact() {
 /// The special case that is QLV: the same forces as the product's QLV.
 #[test]
 fn qlv_coefficients_answer_as_qlv() {
-    use super::super::realtime::{MonotoneCubic, RealTimeSurrogate};
+    use crate::{MonotoneCubic, RealTimeModel};
     let (dmax, knots) = (1.0, 10);
     let prony = vec![(0.3, 0.5), (0.2, 10.0)];
     let x: Vec<f64> = (0..=knots)
@@ -219,14 +214,14 @@ fn qlv_coefficients_answer_as_qlv() {
         .collect();
     // an elastic curve linear between the knots, so the hats are exact
     let y: Vec<f64> = x.iter().map(|d| 2.0 * d).collect();
-    let mut qlv = RealTimeSurrogate::new(
+    let mut qlv = RealTimeModel::new(
         "q".into(),
         MonotoneCubic::new(x.clone(), y.clone()).unwrap(),
         prony.clone(),
     )
     .unwrap();
     let mut k = MemoryKernel::qlv(dmax, &y[1..], &prony, true);
-    let h = super::super::realtime::random_history(3, dmax, 6, 1e-3);
+    let h = crate::random_history(3, dmax, 6, 1e-3);
     let a = qlv.run(&h.time, &h.depth).unwrap();
     let (b, _) = k.run(&h);
     let worst = a

@@ -1,23 +1,20 @@
-//! Building the real-time surrogate from FE runs (issue 13): one elastic
-//! ramp for the force curve, training histories for its fitted memory
-//! ([`super::memory_kernel`]) and held-out histories for its error table,
+//! Building the real-time model from FE runs: one elastic ramp for the
+//! force curve, training histories for its fitted memory
+//! ([`crate::memory_kernel`]) and held-out histories for its error table,
 //! all through the forward trait ([`palpate_core::ForwardModel`]), in
 //! parallel, with the histories the FE model cannot finish left out and
 //! named.
 
-use super::depth_history::{random_history, History};
-use super::memory_kernel::{MemoryKernel, TrainingRun};
-use super::realtime::{HistoryError, MonotoneCubic, RealTimeSurrogate, StoredRun};
+use crate::depth_history::{random_history, History};
+use crate::memory_kernel::{MemoryKernel, TrainingRun};
+use crate::model::{HistoryError, MonotoneCubic, RealTimeModel, StoredRun};
 
 /// FE stations inside each ramp and each hold of a held-out history, where
-/// the error table compares the surrogate with the FE. Session 25: 16 and
-/// 12 (about 0.06 s apart on a 1 s ramp, near the FE's own step of
-/// tau_min / 10) instead of 4 and 3: the sparser ones missed the largest
-/// errors (N1 frictionless to 10 mm: 1.70 % worst at the sparse stations,
-/// 2.18 % at the dense ones; docs/guide.md), and cost about the same FE
-/// time, since a viscoelastic FE run steps by at most tau_min / 10 between
-/// stations anyway (N1 with friction to 4 mm: a build in 171 s against
-/// 164 s).
+/// the error table compares the model with the FE: about 0.06 s apart on a
+/// 1 s ramp, near the FE's own step of tau_min / 10, so that the table
+/// sees where the force turns quickly; they cost about as much FE time as
+/// fewer would, since a viscoelastic FE run steps by at most tau_min / 10
+/// between stations anyway.
 pub const HELD_OUT_STATIONS: (usize, usize) = (16, 12);
 
 /// FE stations inside each ramp and each hold of a training history, where
@@ -32,7 +29,7 @@ pub struct RealTimeRequest<'a> {
     pub elastic_theta: &'a [f64],
     pub viscoelastic: &'a dyn palpate_core::ForwardModel,
     pub viscoelastic_theta: &'a [f64],
-    /// The material's Prony terms (the surrogate's relaxation terms).
+    /// The material's Prony terms (the model's relaxation terms).
     pub prony: Vec<(f64, f64)>,
     pub depth_max: f64,
     /// Samples of the elastic ramp 0..depth_max.
@@ -43,7 +40,7 @@ pub struct RealTimeRequest<'a> {
     /// Segments per held-out history.
     pub segments: usize,
     /// FE training histories for the memory kernel
-    /// ([`super::memory_kernel`]): a ramp to `depth_max` in 1 s held 20 s,
+    /// ([`crate::memory_kernel`]): a ramp to `depth_max` in 1 s held 20 s,
     /// then random histories of seeds 1001.. (never a held-out seed); 0
     /// (or fewer than 5): QLV with the material's terms, nothing fitted.
     pub training_histories: usize,
@@ -51,16 +48,16 @@ pub struct RealTimeRequest<'a> {
     pub kernel_knots: usize,
 }
 
-impl RealTimeSurrogate {
-    /// Builds the surrogate: one elastic FE ramp (the curve), then the
-    /// held-out FE histories in parallel, each compared with the surrogate
+impl RealTimeModel {
+    /// Builds the model: one elastic FE ramp (the curve), then the
+    /// held-out FE histories in parallel, each compared with the model
     /// run at 1 kHz along the same piecewise-linear depth history (the
     /// error at the FE stations, relative to the history's peak FE force).
     /// `tick(done, total)` reports FE runs.
     pub fn build(
         req: &RealTimeRequest<'_>,
         tick: Option<&(dyn Fn(usize, usize) + Sync)>,
-    ) -> Result<RealTimeSurrogate, String> {
+    ) -> Result<RealTimeModel, String> {
         use palpate_core::{Drive, Loading};
         use rayon::prelude::*;
         let t0 = std::time::Instant::now();
@@ -93,7 +90,7 @@ impl RealTimeSurrogate {
         let mut y = vec![0.0];
         y.extend(f);
         let elastic = MonotoneCubic::new(x, y)?;
-        let mut s = RealTimeSurrogate::new(
+        let mut s = RealTimeModel::new(
             format!(
                 "{} at {:?}",
                 req.viscoelastic.name(),
@@ -160,7 +157,7 @@ impl RealTimeSurrogate {
         }
         if req.validation_histories > 0 && held_failed.len() == req.validation_histories {
             return Err(format!(
-                "no held-out FE history ran, so the surrogate cannot be checked; first: {}",
+                "no held-out FE history ran, so the real-time model cannot be checked; first: {}",
                 held_failed[0]
             ));
         }
@@ -232,7 +229,7 @@ impl RealTimeSurrogate {
             .map(|r| (hist(r), r))
             .collect();
         if training.is_empty() {
-            return Err("the surrogate file holds no FE training runs to refit to (built before they were stored, or with --train 0)".into());
+            return Err("the real-time model's file holds no FE training runs to refit to (built before they were stored, or with --train 0)".into());
         }
         let runs: Vec<TrainingRun<'_>> = training
             .iter()
@@ -264,7 +261,7 @@ impl RealTimeSurrogate {
 
     /// Runs `history` through the FE model (stations: the segment ends and
     /// [`HELD_OUT_STATIONS`] points inside each ramp and hold) and through the
-    /// surrogate at its 1 kHz samples; the error at the stations.
+    /// model at its 1 kHz samples; the error at the stations.
     pub fn compare(
         &mut self,
         model: &dyn palpate_core::ForwardModel,
@@ -277,7 +274,7 @@ impl RealTimeSurrogate {
         self.error_on(&format!("random {seed}"), history, &st)
     }
 
-    /// The surrogate's largest error at the FE `stations` `(time_s,
+    /// The model's largest error at the FE `stations` `(time_s,
     /// force_n)` of `history`, run from rest at the history's samples.
     pub fn error_on(
         &mut self,
@@ -381,7 +378,7 @@ mod tests {
             knots.extend(time.iter().copied().zip(loading.drive.iter().copied()));
             let mut prev = (0.0, 0.0);
             for (o, &(t, d)) in out.iter_mut().zip(&knots[1..]) {
-                // 1 ms steps (as the surrogate's), the depth linear in time
+                // 1 ms steps (as the model's), the depth linear in time
                 let n = ((t - prev.0) / 1e-3).round().max(1.0) as usize;
                 let mut f = 0.0;
                 for j in 1..=n {
@@ -470,7 +467,7 @@ mod tests {
             assert_eq!(total, 16);
             ticks.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         };
-        let s = RealTimeSurrogate::build(&req, Some(&tick)).unwrap();
+        let s = RealTimeModel::build(&req, Some(&tick)).unwrap();
         assert_eq!(ticks.into_inner(), 16);
         assert_eq!(s.fe_runs, 16);
         let k = s.kernel.as_ref().expect("a fitted memory");
@@ -487,7 +484,7 @@ mod tests {
         // the stored FE runs come back from the file and refit the same
         // memory without an FE run
         assert_eq!(s.runs.len(), 15);
-        let mut back = RealTimeSurrogate::from_json(&s.to_json()).unwrap();
+        let mut back = RealTimeModel::from_json(&s.to_json()).unwrap();
         assert_eq!(back.runs, s.runs);
         back.refit(10).unwrap();
         for (a, b) in back.validation.iter().zip(&s.validation) {
@@ -498,9 +495,9 @@ mod tests {
         }
         // without training histories: plain QLV, as before
         let plain =
-            RealTimeSurrogate::build(&tissue_request(&elastic, &viscoelastic, 0), None).unwrap();
+            RealTimeModel::build(&tissue_request(&elastic, &viscoelastic, 0), None).unwrap();
         assert!(plain.kernel.is_none() && plain.qlv_validation.is_empty());
-        let mut none = RealTimeSurrogate::from_json(&plain.to_json()).unwrap();
+        let mut none = RealTimeModel::from_json(&plain.to_json()).unwrap();
         assert!(none.refit(10).unwrap_err().contains("no FE training runs"));
         for (p, q) in plain.validation.iter().zip(&s.qlv_validation) {
             assert_eq!(p.max_relative_error, q.max_relative_error);
@@ -508,7 +505,7 @@ mod tests {
     }
 
     /// The error table's two measures on stations whose "FE" force is the
-    /// surrogate's own plus known offsets: 0.003 N at one station gives that
+    /// model's own plus known offsets: 0.003 N at one station gives that
     /// over the peak as the largest error and that over the peak and
     /// `sqrt(n)` as the RMS error; a file without the RMS still loads.
     #[test]
@@ -516,7 +513,7 @@ mod tests {
         let elastic = tissue(false, Vec::new());
         let viscoelastic = tissue(true, Vec::new());
         let mut s =
-            RealTimeSurrogate::build(&tissue_request(&elastic, &viscoelastic, 0), None).unwrap();
+            RealTimeModel::build(&tissue_request(&elastic, &viscoelastic, 0), None).unwrap();
         let h = random_history(5, 1.0, 6, 1e-3);
         let f = s.run(&h.time, &h.depth).unwrap();
         let times = h.stations(4, 3).0;
@@ -549,7 +546,7 @@ mod tests {
 
     /// Histories the model cannot finish are left out and named, from the
     /// fit and from the error table, and the build still stores a
-    /// surrogate; with none of the held-out histories run, it is an error.
+    /// model; with none of the held-out histories run, it is an error.
     #[test]
     fn a_build_leaves_out_histories_the_model_cannot_run() {
         // the first station of training history k (k >= 1) and of held-out seed k
@@ -558,7 +555,7 @@ mod tests {
         let held = |k: u64| first(random_history(k, 1.0, 6, 1e-3), HELD_OUT_STATIONS.0);
         let elastic = tissue(false, Vec::new());
         let failing = tissue(true, vec![train(3), train(7), held(2)]);
-        let s = RealTimeSurrogate::build(&tissue_request(&elastic, &failing, 12), None).unwrap();
+        let s = RealTimeModel::build(&tissue_request(&elastic, &failing, 12), None).unwrap();
         assert_eq!(s.training_failures.len(), 2);
         assert_eq!(s.validation_failures.len(), 1);
         assert!(
@@ -569,11 +566,11 @@ mod tests {
         );
         assert_eq!(s.validation.len(), 2);
         assert_eq!(s.kernel.as_ref().unwrap().training.histories, 10);
-        let back = RealTimeSurrogate::from_json(&s.to_json()).unwrap();
+        let back = RealTimeModel::from_json(&s.to_json()).unwrap();
         assert_eq!(back.validation_failures, s.validation_failures);
         assert_eq!(back.training_failures, s.training_failures);
         let none = tissue(true, vec![held(1), held(2), held(3)]);
-        let e = RealTimeSurrogate::build(&tissue_request(&elastic, &none, 0), None).unwrap_err();
+        let e = RealTimeModel::build(&tissue_request(&elastic, &none, 0), None).unwrap_err();
         assert!(e.contains("no held-out FE history ran"), "{e}");
     }
 }

@@ -1,4 +1,4 @@
-//! Depth histories for the real-time surrogate (issue 13): piecewise-linear
+//! Depth histories for the real-time model: piecewise-linear
 //! punch depth against time, sampled at a fixed step, with the FE stations
 //! of each segment; and the seeded random histories (ramps, holds,
 //! unloadings) its builds train on and are checked against.
