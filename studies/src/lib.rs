@@ -27,7 +27,3 @@ pub mod report;
 pub mod run;
 pub mod steps;
 pub mod study;
-
-// Paths still used by `cli/surrogate.rs` (renamed `cli/realtime.rs` on
-// another branch): its imports move to `crate::run::...` at the merge.
-pub(crate) use run::{limits, output};

@@ -5,8 +5,8 @@
 //! bar, stored as a JSON file, queried on a CSV of depths. `palpate
 //! surrogate` is a hidden alias of the command (its former name).
 
-use crate::limits::Progress;
-use crate::output::{check_outputs, given, write_atomic};
+use crate::run::limits::Progress;
+use crate::run::output::{check_outputs, given, write_atomic};
 use anyhow::{anyhow, bail, Context};
 use palpate_core::ForwardModel;
 use palpate_fe::{N1Needle, Prony, Q1Punch};
