@@ -13,7 +13,7 @@ use super::*;
 use palpate_core::{Drive, Loading};
 
 #[test]
-#[ignore]
+#[ignore = "a diagnostic at a chosen depth (env Q1_DEPTH); cargo test -p palpate-fe --lib q1_tangent -- --ignored"]
 fn q1_tangent_near_the_stop_equals_finite_differences() {
     let depth: f64 = std::env::var("Q1_DEPTH")
         .ok()

@@ -222,7 +222,7 @@ fn near_half_space_is_within_3_percent_of_hertz_up_to_0_1_r() {
 /// CalculiX on a 0.025 mm CAX8R mesh agrees.
 /// (20 s: `cargo test -p palpate-fe --test integration hertz:: -- --ignored`.)
 #[test]
-#[ignore]
+#[ignore = "20 s; cargo test -p palpate-fe --test integration hertz:: -- --ignored"]
 fn sphere_force_tends_to_hertz_at_small_depth() {
     let depths = [0.005, 0.01, 0.02, 0.04];
     let mut m = sphere_model(0.008, 0.4, 1.0, depths[0]);

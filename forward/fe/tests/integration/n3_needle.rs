@@ -94,7 +94,7 @@ fn quadratic_hexahedra_against_sneddon() {
 /// finite-block deviations of tests/integration/hertz.rs). ~40 s of CPU:
 /// `cargo test -p palpate-fe --test integration n3_needle:: -- --ignored`.
 #[test]
-#[ignore]
+#[ignore = "~40 s of CPU; cargo test -p palpate-fe --test integration n3_needle:: -- --ignored"]
 fn sphere_on_level_1_like_mesh_within_2_percent() {
     let (f, dev) = sphere(0.4, 1.5, &[0.25, 0.5]);
     eprintln!("N3 sphere: {f:?}, / Sneddon - 1 = {dev:?}");
@@ -109,7 +109,7 @@ fn sphere_on_level_1_like_mesh_within_2_percent() {
 /// converged mesh (N1 on the same 0.8 mm grading is -1.2 / +3.9 % from
 /// level 2, so roughly that much again). ~60 s of CPU: `-- --ignored`.
 #[test]
-#[ignore]
+#[ignore = "~60 s of CPU; cargo test -p palpate-fe --test integration n3_needle:: -- --ignored"]
 fn n3_against_n1() {
     let depths = [1.0, 2.0];
     let f3 = N3Needle::new(nh())
