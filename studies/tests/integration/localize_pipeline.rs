@@ -5,7 +5,7 @@
 //! is invisible), w(d) = 3 + 0.4 d. The surrogate is palpate's one
 //! (`Surrogate::build` on this model, 10 + 3 runs), the model and sampler
 //! the ones `palpate localize` uses. The full FE accuracy and coverage are
-//! measured by `examples/localize_r2.rs` (release).
+//! measured by `tools/src/bin/localize_r2.rs` (release).
 //!
 //! * two visible nodules are found within 1 mm in x and 0.5 mm in depth,
 //!   identifiable, the truth within 4 posterior SDs;
@@ -176,7 +176,7 @@ fn an_invisible_deep_nodule_is_not_identifiable() {
 }
 
 /// The lean of the analytic excess towards the nearer block end (mm), as
-/// the FE excess leans (examples/r2_excess_shape.rs): a nodule at x peaks
+/// the FE excess leans (tools/src/bin/r2_excess_shape.rs): a nodule at x peaks
 /// at x - lean(x) left of the centre, mirrored right of it.
 fn lean(x: f64) -> f64 {
     let d = x.min(150.0 - x);

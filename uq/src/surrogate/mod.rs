@@ -5,9 +5,9 @@
 //! hashes everything defining it.
 //!
 //! The one surrogate of palpate: `palpate sample --benchmark N1|N3|Q1` and
-//! `palpate localize` both use it (through `palpate_studies::surrogate`,
+//! `palpate localize` both use it (through `palpate_studies::run::surrogate`,
 //! which adds the on-disk cache). How to put a new model behind it:
-//! docs/architecture.md, "A surrogate for a new FE model".
+//! docs/architecture.md, "a surrogate for a new FE model".
 //!
 //! ```
 //! use palpate_core::{Drive, Evaluator, ForwardError, ForwardModel, Loading, Observable, ParamSpace, ParamSpec};

@@ -14,7 +14,7 @@
 //! (side `s = rho_n`), ring `k` sits at `rho_k`. The square-to-circle blend
 //! makes the diagonal radius grow linearly from `sqrt(2) s` at ring `n` to
 //! `3 s` (the blend radius, as CalculiX's N1 deck `gen_n1.py` of
-//! `../shared/reference/calculix`), so no cell is squeezed at the corner of
+//! `tests/data/calculix`), so no cell is squeezed at the corner of
 //! the core. Sets as [`Mesh::graded_box`]: node and Quad4 facet sets `x0`,
 //! `x1`, `y0`, `y1`, `bottom`, `top`, facets facing out; region `body`.
 

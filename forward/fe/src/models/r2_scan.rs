@@ -22,7 +22,7 @@
 //!
 //! Near the block's ends translation invariance fails (the end is more
 //! compliant: one nodule's excess leans towards the nearer end by up to
-//! ~0.3 mm within 25 mm of it, `examples/r2_excess_shape.rs`), so
+//! ~0.3 mm within 25 mm of it, `tools/src/bin/r2_excess_shape.rs`), so
 //! [`R2NoduleScan::along_block`] adds the nodule's position as a second
 //! parameter, `ln_x` = ln(x_n / 1 mm) on [ln(press_x), ln(centre)] (the
 //! logarithm spreads a space-filling design towards the end, where the

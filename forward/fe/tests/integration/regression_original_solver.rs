@@ -1,6 +1,7 @@
 //! The forward models built on the composable FE layer reproduce the forces
 //! of the original axisymmetric solver (commit 55dd440, recorded with
-//! `forward/fe/examples/regress_forces.rs` there) to 1e-9 relative: N1 on the
+//! `forward/fe/examples/regress_forces.rs` there, now
+//! `tools/src/bin/regress_forces.rs`) to 1e-9 relative: N1 on the
 //! coarse mesh (friction 0.8 exactly incompressible neo-Hookean; K = 1000 mu
 //! reduced polynomial) at 0.5..6 mm, C1 frictionless and bonded, exact and
 //! K = 1000 mu, on a ramp-and-unload.

@@ -2,7 +2,7 @@
 //! lean`): near the block's ends translation invariance fails and one
 //! nodule's excess E(p - x_n; d) peaks a little away from x_n, towards the
 //! nearer end for shallow nodules and away from it for deep ones
-//! (docs/validation/r2-localisation.md, `examples/r2_excess_shape.rs`). The
+//! (docs/validation/r2-localisation.md, `tools/src/bin/r2_excess_shape.rs`). The
 //! centre model, which assumes the excess the same everywhere, then reads
 //! shallow nodules 25-45 mm from an end ~0.16 mm towards it, twice their
 //! posterior SD.
