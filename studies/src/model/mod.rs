@@ -657,7 +657,7 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
             "mesh",
             mesh,
             format!(
-                "R2 accepts levels 1..{R2_MAX_LEVEL} (elements of 2, 1, 0.67 mm); finer meshes are for examples/convergence_r2"
+                "R2 accepts levels 1..{R2_MAX_LEVEL} (elements of 2, 1, 0.67 mm); finer meshes are for the mesh study `cargo run --release -p palpate-tools --bin convergence_r2`"
             ),
         ));
     }
