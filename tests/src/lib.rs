@@ -5,7 +5,7 @@
 //! Helpers shared by those tests live here.
 
 /// The R2 development experiment of the gap diagnosis:
-/// a shorter, thinner block than BENCHMARKS.md R2 so that one rolled pass
+/// a shorter, thinner block than docs/benchmarks.md R2 so that one rolled pass
 /// costs seconds, not minutes — 80 mm long, 20 mm high, 50 mm thick,
 /// neo-Hookean tissue, no nodule, bonded bottom, frictionless wheel of
 /// diameter 8 mm rolled at RD 3 mm from x = 28 to 52 mm in steps of at most

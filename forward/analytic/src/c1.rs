@@ -12,7 +12,7 @@ use palpate_material::{homogeneous, Law};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
 
-/// Cylinder of benchmark C1 (BENCHMARKS.md): diameter 38 mm, height 9 mm.
+/// Cylinder of benchmark C1 (docs/benchmarks.md): diameter 38 mm, height 9 mm.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct C1Geometry {
     pub diameter_mm: f64,

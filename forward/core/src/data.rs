@@ -1,4 +1,4 @@
-//! Reading the project's CSV data files (BENCHMARKS.md, "Data files").
+//! Reading the project's CSV data files (docs/benchmarks.md, "Data files").
 //!
 //! A header line names the columns with their unit (`time_s`,
 //! `displacement_mm`, `force_N`, `stretch`, `stress_MPa`, ...); lines

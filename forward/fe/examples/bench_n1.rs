@@ -1,4 +1,4 @@
-//! Benchmark: N1 (BENCHMARKS.md) neo-Hookean `ecoflex-nh`,
+//! Benchmark: N1 (docs/benchmarks.md) neo-Hookean `ecoflex-nh`,
 //! friction 0.8, bonded base, exact incompressibility, needle to 10 mm with
 //! the force every 0.25 mm, on 1 and 2 threads, against CalculiX on the
 //! reference deck `tests/data/calculix/n1/n1_nh_f0.8_k1000_n6.inp`.

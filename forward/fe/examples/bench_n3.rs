@@ -1,4 +1,4 @@
-//! Benchmark: N3 (BENCHMARKS.md), the 3D quarter block with the
+//! Benchmark: N3 (docs/benchmarks.md), the 3D quarter block with the
 //! N1 needle, to `--depth` (default 10 mm) with the force every 0.25 mm, on
 //! the given mesh levels (default 1), for neo-Hookean `ecoflex-nh` and
 //! reduced polynomial `ecoflex-rp2`, friction 0 and 0.8. Each row prints

@@ -1,5 +1,5 @@
 //! R2 speed bench (goal: a full pass in 30 s or less on 2 cores): the
-//! BENCHMARKS.md R2 rolled pass, x 10 -> 140 mm every 0.5 mm, RD 6, the
+//! docs/benchmarks.md R2 rolled pass, x 10 -> 140 mm every 0.5 mm, RD 6, the
 //! three default nodules, frictionless, at the accuracy-level mesh (level 1,
 //! h = 2 mm: within 0.63 % of h = 1 at the RD 3 presses of
 //! docs/validation/fe.md R2), solved by `R2Rolling::rolled_pass` in

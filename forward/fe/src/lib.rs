@@ -38,7 +38,7 @@
 //!   discretisation error from one coarser solve; [`vtu`] — a solved
 //!   system's fields for ParaView; [`error`] — [`FeError`].
 //!
-//! The models (`BENCHMARKS.md`), each a [`Setup`] behind an alias of
+//! The models (`docs/benchmarks.md`), each a [`Setup`] behind an alias of
 //! [`FeModel`] unless said otherwise:
 //!
 //! * [`N1Needle`] — needle indentation of a cylinder (axisymmetric);

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 #[serde(rename_all = "snake_case")]
 pub enum ToolShape {
     /// Hemispherical tip of radius `tip_radius` tangent to a cone of
-    /// half-angle `half_angle_deg` (BENCHMARKS.md N1: 2.5 mm, 15 degrees; the
+    /// half-angle `half_angle_deg` (docs/benchmarks.md N1: 2.5 mm, 15 degrees; the
     /// cap ends `90 - half_angle` degrees from the pole).
     Needle {
         tip_radius: f64,
@@ -23,7 +23,7 @@ pub enum ToolShape {
     /// A sphere of the given radius (Hertz).
     Sphere { radius: f64 },
     /// A flat-ended cylindrical punch whose edge is rounded with `edge_radius`
-    /// (BENCHMARKS.md Q1: radius 2 mm).
+    /// (docs/benchmarks.md Q1: radius 2 mm).
     FlatPunch { radius: f64, edge_radius: f64 },
     /// An infinite flat platen.
     Platen,
@@ -121,7 +121,7 @@ fn line(p: [f64; 2], a: [f64; 2], n: [f64; 2], xi0: f64) -> Projection {
 }
 
 impl ToolShape {
-    /// The N1 needle of BENCHMARKS.md.
+    /// The N1 needle of docs/benchmarks.md.
     pub fn n1_needle() -> Self {
         ToolShape::Needle {
             tip_radius: 2.5,

@@ -3,7 +3,7 @@
 //!
 //! The viscoelastic isochoric second Piola-Kirchhoff stress is the
 //! hereditary integral of the elastic one with the reduced relaxation
-//! function of BENCHMARKS.md Q1 (and of the force-level QLV wrapper,
+//! function of docs/benchmarks.md Q1 (and of the force-level QLV wrapper,
 //! `palpate_enrich::Viscoelastic`):
 //!
 //! ```text

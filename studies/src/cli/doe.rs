@@ -128,7 +128,7 @@ struct SimulationResponse {
     reference: String,
     /// Material parameters of each law level, by law spelling, e.g.
     /// `{ "neo-hookean" = { C10 = 1.101295e-3 } }` (MPa). Defaults: the
-    /// ecoflex-nh and ecoflex-rp2 materials of BENCHMARKS.md.
+    /// ecoflex-nh and ecoflex-rp2 materials of docs/benchmarks.md.
     #[serde(default)]
     params: BTreeMap<String, BTreeMap<String, f64>>,
     /// Score only the reference samples up to this depth (mm); default: the
@@ -158,7 +158,7 @@ struct CalibrationResponse {
 
 const FE_FACTORS: [&str; 4] = ["friction", "space", "mesh", "benchmark"];
 
-/// The BENCHMARKS.md material of a law for the N1 design (MPa).
+/// The docs/benchmarks.md material of a law for the N1 design (MPa).
 fn default_params(law: &Law) -> Option<Vec<(String, f64)>> {
     match law.to_string().as_str() {
         "neo-hookean" => Some(vec![("C10".into(), 1.101295e-3)]),

@@ -30,7 +30,7 @@ use crate::run::surrogate::default_cache_dir;
 #[derive(Debug, Parser)]
 #[command(verbatim_doc_comment)]
 pub struct Args {
-    /// The benchmark (R2: the rolled block of BENCHMARKS.md).
+    /// The benchmark (R2: the rolled block of docs/benchmarks.md).
     #[arg(long, value_parser = ["R2", "r2"])]
     pub benchmark: String,
     /// Rolling depth of the record (mm); one surrogate per RD.

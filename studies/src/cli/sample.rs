@@ -33,7 +33,7 @@ use std::path::{Path, PathBuf};
 /// (--cache) under a hash of the model, mesh, code version, record, box and
 /// design, so a second run reuses it. Its error on held-out FE runs is
 /// printed and added to the likelihood as a variance per sample. The FE model
-/// is the BENCHMARKS.md set-up on the coarse mesh unless --mesh.
+/// is the docs/benchmarks.md set-up on the coarse mesh unless --mesh.
 ///
 /// Convergence: the draws per chain are doubled (the run repeated from the
 /// same seed and continued) until every R-hat < 1.01 and every bulk ESS >=

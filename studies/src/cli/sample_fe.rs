@@ -59,7 +59,7 @@ pub fn check_options(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The model spec of the record: the BENCHMARKS.md set-up with the
+/// The model spec of the record: the docs/benchmarks.md set-up with the
 /// options given (mesh coarse unless `--mesh`).
 pub fn model_spec(kind: &str, args: &Args) -> ModelSpec {
     let mesh = Some(args.mesh.clone().unwrap_or_else(|| "coarse".into()));

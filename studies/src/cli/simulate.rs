@@ -1,6 +1,6 @@
 //! `palpate simulate`: run a finite-element forward model (N1 needle
 //! indentation, N3 needle indentation in 3D, C1 compression, Q1 flat-punch
-//! ramp-and-hold or R2 rolling over nodules, BENCHMARKS.md) and write its
+//! ramp-and-hold or R2 rolling over nodules, docs/benchmarks.md) and write its
 //! force curve, with the volumetric treatment used and, unless `--error-estimate off`, an
 //! estimate of its discretisation error from one coarser solve (Richardson
 //! extrapolation with the model's documented order of convergence,
@@ -23,10 +23,10 @@ use crate::model::{
 use crate::report::plot::{Plot, Series};
 use crate::run::output::write_atomic;
 
-/// Run a finite-element forward model (N1, N3, C1, Q1, R2 of BENCHMARKS.md) and write its force curve
+/// Run a finite-element forward model (N1, N3, C1, Q1, R2 of docs/benchmarks.md) and write its force curve
 ///
 /// The benchmark's geometry, boundary conditions and loading are those of
-/// BENCHMARKS.md; the material is --law with one --param per parameter
+/// docs/benchmarks.md; the material is --law with one --param per parameter
 /// (MPa), optionally viscoelastic (--prony, with --ramp and --hold). The
 /// force curve is printed and written with --csv (and --plot, --vtu).
 ///
@@ -77,7 +77,7 @@ pub struct Args {
     /// N1: bottom face free to slide radially instead of fixed.
     #[arg(long)]
     pub sliding_base: bool,
-    /// N1, N3 tool: needle (BENCHMARKS.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
+    /// N1, N3 tool: needle (docs/benchmarks.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
     /// N1 and Q1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4]. N3: hex8 (8-node, constant pressure, on the graded box) or hex27 (27-node, linear discontinuous pressure, on the quarter O-grid with cells of 1.6/N mm: the accurate choice with friction; accuracy and cost: docs/validation/fe.md "N3") [default: hex8].
@@ -107,7 +107,7 @@ pub struct Args {
     /// N1, C1 and Q1: viscoelastic material, a Prony series g1=..,tau1=..,g2=..,tau2=.. on the law's isochoric stress (G(t) = 1 - sum g_i (1 - exp(-t/tau_i)), tau in s); the history becomes timed: ramp to --depth in --ramp seconds, then hold --hold seconds.
     #[arg(long, value_name = "g1=..,tau1=..")]
     pub prony: Option<String>,
-    /// With --prony (N1, C1) or Q1: duration of the ramp to --depth in s [default: C1 1; N1 depth / 0.4 mm/s (BENCHMARKS.md); Q1 0.5].
+    /// With --prony (N1, C1) or Q1: duration of the ramp to --depth in s [default: C1 1; N1 depth / 0.4 mm/s (docs/benchmarks.md); Q1 0.5].
     #[arg(long, value_name = "SECONDS")]
     pub ramp: Option<f64>,
     /// With --prony (N1, C1) or Q1: hold at --depth for this many seconds after the ramp, in 200 samples [default: 0; Q1: 60].
@@ -442,7 +442,7 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
     } else {
         2.0
     });
-    // Q1: at least 100 samples in the ramp (BENCHMARKS.md)
+    // Q1: at least 100 samples in the ramp (docs/benchmarks.md)
     let step = args.step.unwrap_or(if n1 {
         0.25
     } else if q1 {
@@ -623,7 +623,7 @@ pub(crate) fn progress_bar(len: usize, prefix: &str) -> (ProgressBar, impl FnMut
 }
 
 /// The sample times of a viscoelastic (`--prony`) run or of any Q1 run
-/// (ramp-and-hold, BENCHMARKS.md): the drive samples spread over `--ramp`
+/// (ramp-and-hold, docs/benchmarks.md): the drive samples spread over `--ramp`
 /// seconds, then `--hold` seconds at `depth` in 200 samples appended to
 /// `drive`; `None` for an elastic C1 or N1 run.
 fn timed_history(
@@ -644,7 +644,7 @@ fn timed_history(
     {
         bail!("--prony: only N1, C1 and Q1 have the viscoelastic material so far");
     }
-    // N1: the needle's 0.4 mm/s (BENCHMARKS.md), C1: 1 s, Q1: 0.5 s
+    // N1: the needle's 0.4 mm/s (docs/benchmarks.md), C1: 1 s, Q1: 0.5 s
     let ramp = args.ramp.unwrap_or(if q1 {
         0.5
     } else if args.benchmark.eq_ignore_ascii_case("n1") {

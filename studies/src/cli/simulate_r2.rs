@@ -19,7 +19,7 @@ use crate::report::plot::{Plot, Series};
 use crate::run::limits::Progress;
 use crate::run::output::write_atomic;
 
-/// The parameters of one law: BENCHMARKS.md's when the law is Arruda-Boyce
+/// The parameters of one law: docs/benchmarks.md's when the law is Arruda-Boyce
 /// and none is given (`rtv6166-ab` or `rubber-ab`), else every one named.
 fn law_params(
     law: &Law,

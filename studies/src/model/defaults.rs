@@ -11,7 +11,7 @@ use palpate_material::Law;
 
 /// The model of a data set's test for a law (the legacy manifest form
 /// `law = "..."` and the commands' `--benchmark`): the analytic homogeneous
-/// test, analytic C1, or N1 with the BENCHMARKS.md needle (friction 0.8) on
+/// test, analytic C1, or N1 with the docs/benchmarks.md needle (friction 0.8) on
 /// the coarse mesh, since every evaluation of a fit is a full FE run.
 pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
     let law = law.to_string();

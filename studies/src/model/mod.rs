@@ -91,7 +91,7 @@ pub use defaults::{
 use fields::{parse_bulk, parse_element, parse_mode, parse_prony, parse_tool};
 pub use fields::{parse_mesh, text_or_number};
 
-/// Default Coulomb friction between the N1 needle and the material (BENCHMARKS.md).
+/// Default Coulomb friction between the N1 needle and the material (docs/benchmarks.md).
 pub const DEFAULT_FRICTION: f64 = 0.8;
 /// Default mesh of the FE models (level 2: N1 0.2 mm elements under the
 /// tool, C1 38 x 18 elements).
@@ -133,7 +133,7 @@ pub struct R2Spec {
     pub nodule_law: Option<String>,
     /// Rolling depth (mm).
     pub rd: f64,
-    /// `X:DEPTH,...` (mm) or `none`; default BENCHMARKS.md's three nodules.
+    /// `X:DEPTH,...` (mm) or `none`; default docs/benchmarks.md's three nodules.
     #[serde(default)]
     pub nodules: Option<String>,
     /// Coulomb friction between wheel and block (default 0).
@@ -152,7 +152,7 @@ fn arruda_boyce() -> String {
     "arruda-boyce".into()
 }
 
-/// BENCHMARKS.md's default R2 nodules.
+/// docs/benchmarks.md's default R2 nodules.
 pub const R2_DEFAULT_NODULES: &str = "37.5:10,75:15,112.5:20";
 /// The finest R2 level accepted: level 4 (0.5 mm elements) has ~150,000
 /// unknowns, a rolled pass of hours on 2 cores.

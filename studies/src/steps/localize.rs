@@ -70,7 +70,7 @@ fn default_noise() -> f64 {
     0.01
 }
 
-/// R2-1's depths (BENCHMARKS.md).
+/// R2-1's depths (docs/benchmarks.md).
 pub const R2_1_DEPTHS: [f64; 8] = [8.0, 10.0, 12.0, 15.0, 18.0, 20.0, 22.0, 24.0];
 
 /// Which localisation model a localize step builds per RD.

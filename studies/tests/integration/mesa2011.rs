@@ -150,7 +150,7 @@ fn the_chain_runs_reruns_byte_identical_and_caches_the_fe_runs() {
         "the first run computes"
     );
 
-    // The calibrated parameters reach the predictions: ecoflex of BENCHMARKS.md.
+    // The calibrated parameters reach the predictions: ecoflex of docs/benchmarks.md.
     let json: serde_json::Value = serde_json::from_slice(&results).unwrap();
     let runs = json["steps"][1]["predict"]["runs"].as_array().unwrap();
     assert_eq!(runs.len(), 4);

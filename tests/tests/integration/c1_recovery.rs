@@ -1,4 +1,4 @@
-//! C1 parameter recovery (BENCHMARKS.md C1, materials `ecoflex-nh` and
+//! C1 parameter recovery (docs/benchmarks.md C1, materials `ecoflex-nh` and
 //! `ecoflex-rp2`): synthetic force-displacement curves from the analytic C1
 //! model, 0..2 mm at 0.4 mm/s, 200 samples, fitted back by
 //! Levenberg-Marquardt through `dyn ForwardModel`.

@@ -1,4 +1,4 @@
-//! N1 mesh convergence on a cheap pair (palpate-fe, BENCHMARKS.md N1,
+//! N1 mesh convergence on a cheap pair (palpate-fe, docs/benchmarks.md N1,
 //! neo-Hookean `ecoflex-nh`, friction 0.8): the coarse (level 1, 864
 //! elements) and medium (level 2, 3286 elements) meshes agree within 0.5 %
 //! at 2 mm (0.36 %), and both agree with the CalculiX reference within its error budget

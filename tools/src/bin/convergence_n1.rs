@@ -1,4 +1,4 @@
-//! Mesh convergence of N1 (BENCHMARKS.md): neo-Hookean `ecoflex-nh`,
+//! Mesh convergence of N1 (docs/benchmarks.md): neo-Hookean `ecoflex-nh`,
 //! friction 0.8, bonded base, exact incompressibility, force at 2, 5 and
 //! 10 mm on mesh levels 1, 2, 3 (element size 0.4 / level mm under the
 //! needle). Prints the forces, the differences between successive meshes,

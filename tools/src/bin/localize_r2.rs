@@ -8,7 +8,7 @@
 //! 1. Builds (or loads from the cache) the localisation model of RD: the
 //!    FE scan surrogate (h = 2 mm) and the nodule-free pass; prints the
 //!    build time (wall and CPU) and the surrogate's held-out error.
-//! 2. Runs the FE model of BENCHMARKS.md R2 (three nodules 37.5:10, 75:15,
+//! 2. Runs the FE model of docs/benchmarks.md R2 (three nodules 37.5:10, 75:15,
 //!    112.5:20) at a FINER mesh (`--h-record`, default 1.5 mm) every
 //!    `--step-record` mm (cached too), and prints the error of the
 //!    localisation model at the true nodules against it: translation

@@ -1,5 +1,5 @@
 //! Writes the synthetic N1 withheld-effect records of `tests/data/gap-n1/`
-//! (used by `tests/integration/gap_n1.rs`): N1 needle indentation (BENCHMARKS.md) to
+//! (used by `tests/integration/gap_n1.rs`): N1 needle indentation (docs/benchmarks.md) to
 //! 6 mm, every 0.25 mm, simulated on the MEDIUM mesh (so the coarse-mesh base
 //! model of the diagnosis does not share its discretisation), plus Gaussian
 //! noise of a stated fraction of the largest force, from a fixed seed.

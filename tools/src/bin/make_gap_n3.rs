@@ -1,6 +1,6 @@
 //! Writes the `modelling_space` development records of `tests/data/gap-n3/`
 //! (used by `gap_fe_effects -- n3` and
-//! `tests/integration/gap_fe_effects.rs`): needle indentation (BENCHMARKS.md N1/N3
+//! `tests/integration/gap_fe_effects.rs`): needle indentation (docs/benchmarks.md N1/N3
 //! needle, neo-Hookean C10 1e-3 MPa, frictionless, bonded base) to 6 mm
 //! every 0.25 mm (25 samples), plus Gaussian noise of a fraction of the
 //! largest force from a fixed seed:

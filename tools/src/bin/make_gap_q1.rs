@@ -1,5 +1,5 @@
 //! Writes the synthetic Q1 withheld-effect records of `tests/data/gap-q1/`
-//! (used by `gap_fe_effects`): the Q1 flat punch (BENCHMARKS.md Q1,
+//! (used by `gap_fe_effects`): the Q1 flat punch (docs/benchmarks.md Q1,
 //! radius 2 mm, edge 0.2 mm, frictionless) ramped to 0.5 mm in 0.25 s and
 //! held 4 s — a short protocol so that one viscoelastic run of the base
 //! costs seconds and a diagnosis minutes (the first records, 1 mm and a 10 s

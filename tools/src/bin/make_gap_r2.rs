@@ -43,7 +43,7 @@ fn main() {
         Case {
             name: "r2-inclusion",
             c10: 2.5e-3,
-            // rubber in RTV 6166 (BENCHMARKS.md R2: mu 73.4 / 4.98 kPa)
+            // rubber in RTV 6166 (docs/benchmarks.md R2: mu 73.4 / 4.98 kPa)
             effect: Some((Effect::Inclusion, &[14.7, 44.0, 11.0])),
             noise_fraction: 0.01,
             seed: 41,

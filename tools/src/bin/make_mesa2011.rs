@@ -3,7 +3,7 @@
 //!
 //! * `c1-compression.csv`: benchmark C1 (38 x 9 mm cylinder, lubricated,
 //!   2 mm at 0.4 mm/s, sampled at 100 Hz: every 0.004 mm, 501 rows) made
-//!   with `ecoflex-rp2` of BENCHMARKS.md (reduced polynomial N=2,
+//!   with `ecoflex-rp2` of docs/benchmarks.md (reduced polynomial N=2,
 //!   C10 = 686.428 Pa, C20 = 1929.606 Pa; analytic, exact for lubricated
 //!   platens) plus Gaussian noise of 0.5 % of the largest force. The
 //!   neo-Hookean `ecoflex-nh` (C10 = 1101.295 Pa) is the least-squares
@@ -42,7 +42,7 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
 
-/// ecoflex-rp2 (BENCHMARKS.md), MPa.
+/// ecoflex-rp2 (docs/benchmarks.md), MPa.
 const RP2: [f64; 2] = [686.428e-6, 1929.606e-6];
 /// The phantom's Yeoh C30 (MPa).
 const C30: f64 = 100e-6;

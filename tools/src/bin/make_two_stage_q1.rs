@@ -2,12 +2,12 @@
 //! (`studies/two-stage-q1.toml`, `palpate calibrate --benchmark Q1 --stages
 //! elastic,relaxation`) into `tests/data/two-stage-q1/`:
 //!
-//! * `record.csv` (`time_s,displacement_mm,force_N`): BENCHMARKS.md Q1's
+//! * `record.csv` (`time_s,displacement_mm,force_N`): docs/benchmarks.md Q1's
 //!   flat punch (radius 2 mm, edge 0.2 mm, cylinder 50 x 60 mm,
 //!   frictionless), neo-Hookean C10 = 0.0016 MPa with the Prony series
 //!   g = 0.3 / 0.2, tau = 0.5 / 10 s on the isochoric stress, ramped to
 //!   **1.0 mm** in 0.5 s and held 60 s. The depth is 1.0 mm, not the 5 mm of
-//!   BENCHMARKS.md: with the 0.2 mm punch edge the FE model stalls near
+//!   docs/benchmarks.md: with the 0.2 mm punch edge the FE model stalls near
 //!   2 mm (the surface creases round the edge; docs/validation/fe.md Q1).
 //!   Samples: 21 in the ramp (every 0.025 s), 40 in the hold, spaced
 //!   geometrically from 0.02 s to 60 s after the ramp (the relaxation is
@@ -21,7 +21,7 @@
 //! The record is committed; rerun only to change it:
 //! `cargo run --release -p palpate-tools --bin make_two_stage_q1`.
 //! With env `Q1_RECORD_DEPTH=D` (mm) the ramp goes to D instead, into
-//! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of BENCHMARKS.md; its fit is a
+//! `tests/data/two-stage-q1-Dmm/` (the 5 mm record of docs/benchmarks.md; its fit is a
 //! study, not a test).
 //! With env `Q1_RECORD_LEVEL=L` the record is made on mesh level L instead
 //! of 2 (the 5 mm record is level 3, finer than the level-2 mesh that

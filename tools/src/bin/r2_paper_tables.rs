@@ -1,4 +1,4 @@
-//! The source paper's depth analysis from our FE (BENCHMARKS.md
+//! The source paper's depth analysis from our FE (docs/benchmarks.md
 //! R2-1): peak force against depth per RD, the empirical quadratic
 //! depth = a F^2 + b F + c per RD (the paper's Table III), and the Table IV
 //! exercise (the depth the quadratic predicts for the three nodules of R2,

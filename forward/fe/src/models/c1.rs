@@ -1,4 +1,4 @@
-//! `C1Fe`: the C1 compression benchmark (BENCHMARKS.md) by finite elements —
+//! `C1Fe`: the C1 compression benchmark (docs/benchmarks.md) by finite elements —
 //! a cylinder of diameter 38 mm and height 9 mm between rigid platens that
 //! are frictionless (the deformation is homogeneous, the analytic C1 model is
 //! exact) or bonded (no slip, barrelling).
@@ -60,7 +60,7 @@ pub struct C1Parts {
 }
 
 impl C1Fe {
-    /// BENCHMARKS.md C1 geometry, 19 x 9 elements, exact incompressibility.
+    /// docs/benchmarks.md C1 geometry, 19 x 9 elements, exact incompressibility.
     pub fn new(law: Law, platens: Platens) -> Self {
         FeModel::from_setup(C1Setup {
             law,

@@ -1,5 +1,5 @@
 //! The forward models built on the layer, one [`crate::model::Setup`] each
-//! (the reference problems of BENCHMARKS.md) and the models made of them:
+//! (the reference problems of docs/benchmarks.md) and the models made of them:
 //!
 //! * [`n1`] — N1, needle indentation of a cylinder (axisymmetric);
 //! * [`n3`] — N3, the same needle on a block in 3D (quarter model);

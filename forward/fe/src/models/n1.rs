@@ -1,4 +1,4 @@
-//! `N1Needle`: needle indentation of a cylinder (BENCHMARKS.md N1) —
+//! `N1Needle`: needle indentation of a cylinder (docs/benchmarks.md N1) —
 //! diameter 70 mm, height 80 mm, bottom fixed, a rigid needle (hemispherical
 //! tip 2.5 mm tangent to a 15 degree cone) pressed on the axis with Coulomb
 //! friction 0.8. The force is the needle reaction for the whole body,
@@ -149,7 +149,7 @@ pub struct N1Parts {
 }
 
 impl N1Needle {
-    /// BENCHMARKS.md N1 with the given law: friction 0.8, bonded base, exact
+    /// docs/benchmarks.md N1 with the given law: friction 0.8, bonded base, exact
     /// incompressibility, medium mesh, contact at the edge Gauss points with
     /// the multipliers updated once per increment.
     pub fn new(law: Law) -> Self {
@@ -431,7 +431,7 @@ impl N1Setup {
     }
 
     /// The `modelling_space` enrichment: the same needle, law, bulk
-    /// treatment and friction in 3D ([`crate::N3Needle`], BENCHMARKS.md N3:
+    /// treatment and friction in 3D ([`crate::N3Needle`], docs/benchmarks.md N3:
     /// the quarter of a 70 x 80 x 80 mm block, 8-node mixed hexahedra, mesh
     /// level 1, 25-41 s of CPU to 10 mm against N1's ~1.5 s on the coarse
     /// mesh). A discrete switch like `boundary_condition`: the same

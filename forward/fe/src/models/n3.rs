@@ -1,4 +1,4 @@
-//! `N3Needle`: needle indentation of a block in 3D (BENCHMARKS.md N3) —
+//! `N3Needle`: needle indentation of a block in 3D (docs/benchmarks.md N3) —
 //! 70 x 80 x 80 mm (x, y, z up), bottom fixed, the N1 needle (hemispherical
 //! tip 2.5 mm tangent to a 15 degree cone, [`ToolShape::n1_needle`] revolved
 //! about z, [`Revolution3d`]) pressed into the centre of the top face with
@@ -152,7 +152,7 @@ pub struct N3Parts {
 }
 
 impl N3Needle {
-    /// BENCHMARKS.md N3 with the given law: friction 0.8, exact
+    /// docs/benchmarks.md N3 with the given law: friction 0.8, exact
     /// incompressibility, the box of mesh level 1, contact at the facet
     /// Gauss points, multipliers updated once per increment (as N1), each
     /// Newton system solved by GMRES on the LDL^T of the tangent's

@@ -1,5 +1,5 @@
 //! `R2Rolling`: rolling indentation of a silicone block with bonded stiff
-//! nodules (BENCHMARKS.md R2 and R2-1), 2D plane stress — a block 150 mm
+//! nodules (docs/benchmarks.md R2 and R2-1), 2D plane stress — a block 150 mm
 //! long and 30 mm high, 50 mm thick out of plane (the forces are for the
 //! whole thickness), bottom fixed, circular nodules of diameter 10 mm
 //! perfectly bonded (a conforming mesh, [`InclusionBlock`]), and a rigid
@@ -65,7 +65,7 @@ pub struct Nodule {
 }
 
 impl Nodule {
-    /// BENCHMARKS.md R2's three nodules.
+    /// docs/benchmarks.md R2's three nodules.
     pub fn r2_default() -> Vec<Nodule> {
         vec![
             Nodule {
@@ -142,7 +142,7 @@ pub struct R2Setup {
     pub press_x: f64,
     pub roll_to: f64,
     pub friction: f64,
-    /// Bottom support: bonded (both components fixed, BENCHMARKS.md R2) or
+    /// Bottom support: bonded (both components fixed, docs/benchmarks.md R2) or
     /// sliding (vertical component fixed, horizontal free except at the
     /// bottom node nearest mid-block, which removes the rigid translation).
     pub base: Support,
@@ -183,7 +183,7 @@ pub struct R2Parts {
 }
 
 impl R2Rolling {
-    /// BENCHMARKS.md R2 with the given laws (`rtv6166-ab` and `rubber-ab`
+    /// docs/benchmarks.md R2 with the given laws (`rtv6166-ab` and `rubber-ab`
     /// are Arruda-Boyce for both): three nodules, RD `rd`, frictionless,
     /// exact incompressibility, mesh level 1.
     pub fn new(law: Law, nodule_law: Law, rd: f64) -> Self {
@@ -233,7 +233,7 @@ impl R2Rolling {
         })
     }
 
-    /// BENCHMARKS.md's materials: `rtv6166-ab` (mu 4.98 kPa, lambda_m 1.05)
+    /// docs/benchmarks.md's materials: `rtv6166-ab` (mu 4.98 kPa, lambda_m 1.05)
     /// for the tissue, `rubber-ab` (mu 73.40 kPa, lambda_m 1.01) for the
     /// nodules, in the model's parameter order (MPa).
     pub const BENCHMARK_PARAMS: [f64; 4] = [4.98e-3, 1.05, 73.40e-3, 1.01];

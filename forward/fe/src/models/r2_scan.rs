@@ -35,7 +35,7 @@
 //! in x_n (a mirror or nearest-offset fill jumps where the path's end
 //! crosses an offset, which a surrogate cannot fit).
 //!
-//! The material parameters are fixed (`material`, BENCHMARKS.md's by
+//! The material parameters are fixed (`material`, docs/benchmarks.md's by
 //! default); a common scale of both moduli scales every force exactly
 //! (Arruda-Boyce energies are linear in mu, and the contact penalty is
 //! proportional to the tissue's mu), so a tissue-modulus nuisance needs no

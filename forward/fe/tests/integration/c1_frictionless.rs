@@ -1,5 +1,5 @@
 //! C1 with frictionless platens: the FE force equals the analytic
-//! (homogeneous, incompressible) C1 force, BENCHMARKS.md materials.
+//! (homogeneous, incompressible) C1 force, docs/benchmarks.md materials.
 
 use palpate_analytic::C1Compression;
 use palpate_core::{Drive, ForwardModel, Loading};

@@ -1,4 +1,4 @@
-//! N1 needle indentation (BENCHMARKS.md) on the coarse mesh:
+//! N1 needle indentation (docs/benchmarks.md) on the coarse mesh:
 //! all four {neo-Hookean, reduced polynomial} x {friction 0, 0.8} cases reach
 //! 10 mm, and the neo-Hookean curves agree with the CalculiX reference
 //! (tests/data/calculix/n1) within its stated uncertainty plus 2 %.

@@ -1,4 +1,4 @@
-//! N3 (BENCHMARKS.md): the 3D quarter block with the needle. Fast checks on
+//! N3 (docs/benchmarks.md): the 3D quarter block with the needle. Fast checks on
 //! coarse meshes at small depth (docs/validation/fe.md, "N3").
 
 use palpate_core::{Drive, ForwardModel, Loading};

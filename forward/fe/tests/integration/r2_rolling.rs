@@ -1,6 +1,6 @@
 //! R2 rolling model (forward/fe/src/models/r2.rs) on a cheap model: a block
 //! shortened to 60 mm (same height, thickness, wheel and laws as
-//! BENCHMARKS.md R2), 2 mm elements (level 1), one nodule at x = 30 mm,
+//! docs/benchmarks.md R2), 2 mm elements (level 1), one nodule at x = 30 mm,
 //! depth 10 mm (the shallowest of R2, so its peak is the clearest), RD 3,
 //! short paths of 1 mm steps.
 //!

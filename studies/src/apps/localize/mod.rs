@@ -84,7 +84,7 @@ pub struct LocSetup {
 }
 
 impl LocSetup {
-    /// BENCHMARKS.md R2 at rolling depth `rd`: mesh level 1 (h = 2 mm, the
+    /// docs/benchmarks.md R2 at rolling depth `rd`: mesh level 1 (h = 2 mm, the
     /// accuracy level of docs/validation/fe.md R2), offsets 0..30 mm every
     /// 2 mm, 6 training + 2 held-out scans of depth at the block's centre
     /// (a scan is ~35 s of CPU at RD 6, so this fits the 10-minute budget

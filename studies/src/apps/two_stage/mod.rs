@@ -1,5 +1,5 @@
 //! The two-stage identification of a quasi-linear viscoelastic material by
-//! inverse finite elements on a Q1 ramp-and-hold record (BENCHMARKS.md Q1,
+//! inverse finite elements on a Q1 ramp-and-hold record (docs/benchmarks.md Q1,
 //! the third source study): Levenberg-Marquardt on the FE model
 //! (`palpate_fe::Q1Punch`), in stages,
 //!

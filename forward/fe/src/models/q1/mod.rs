@@ -1,5 +1,5 @@
 //! `Q1Punch`: ramp-and-hold indentation by a flat-ended punch
-//! (BENCHMARKS.md Q1), axisymmetric stand-in — a cylinder of radius 50 mm and
+//! (docs/benchmarks.md Q1), axisymmetric stand-in — a cylinder of radius 50 mm and
 //! height 60 mm, bottom fixed, a rigid flat-ended cylindrical punch of radius
 //! 2 mm pressed on the axis without friction. The punch edge is rounded with
 //! 0.2 mm ([`Q1Setup::edge_radius`]; `ToolShape::FlatPunch` needs
@@ -40,7 +40,7 @@ use crate::viscoelastic::Prony;
 use crate::FeError;
 
 /// The default radius of the punch's rounded edge (mm): the flat punch
-/// BENCHMARKS.md names, rounded just enough for contact to follow it (F /
+/// docs/benchmarks.md names, rounded just enough for contact to follow it (F /
 /// 8Gad 0.943 at 0.1 mm; docs/validation/fe.md "Q1").
 pub const DEFAULT_EDGE_RADIUS: f64 = 0.2;
 
@@ -123,7 +123,7 @@ pub struct Q1Parts {
 }
 
 impl Q1Punch {
-    /// BENCHMARKS.md Q1 with the given law: punch radius 2 mm (edge 0.2 mm),
+    /// docs/benchmarks.md Q1 with the given law: punch radius 2 mm (edge 0.2 mm),
     /// cylinder 50 x 60 mm, exact incompressibility, mesh level 2 (0.1 mm
     /// elements under the punch), Q1/P0, elastic.
     pub fn new(law: Law) -> Self {
