@@ -117,6 +117,7 @@ pub struct BuildArgs {
 ///
 /// Writes time_s,displacement_mm,force_N; a depth beyond the model's
 /// --depth-max is refused, naming its row (it does not extrapolate).
+/// How far a model's forces are from the FE's: docs/validation/realtime.md.
 ///
 /// Example: palpate realtime query --model q1-rt.json --csv depths.csv --out forces.csv
 #[derive(Debug, clap::Args)]
