@@ -4,6 +4,7 @@ unless asked, and palpate's own messages for values it refuses."""
 from __future__ import annotations
 
 import inspect
+import os
 from pathlib import Path
 
 import numpy as np
@@ -122,6 +123,14 @@ def test_nothing_is_printed_unless_asked(name, capfd):
         call(True)
         out, err = capfd.readouterr()
         assert out or err
+
+
+def test_output_comes_back_after_a_quiet_call_fails(capfd):
+    with pytest.raises(palpate.PalpateError):
+        palpate.calibrate("yeoh", {"uniaxial": TRELOAR}, estimator="newton")
+    os.write(1, b"out\n")
+    os.write(2, b"err\n")
+    assert capfd.readouterr() == ("out\n", "err\n")
 
 
 def test_a_study_run_is_quiet_and_an_object(tmp_path, capfd, monkeypatch):
