@@ -56,8 +56,9 @@ C1 = dict(law="neo-hookean", params={"C10": 0.2}, mesh="coarse", depth=1.0, step
 def test_simulate_moves_the_curve_out_and_equals_the_csv(tmp_path):
     c = palpate.simulate("C1", **C1)
     for k in ("displacement_mm", "force_N"):
-        assert c[k].dtype == np.float64 and c[k].shape == (5,)
-        assert_moved_from_rust(c[k])
+        a = getattr(c, k)
+        assert a.dtype == np.float64 and a.shape == (5,)
+        assert_moved_from_rust(a)
     # The file path: the command line's CSV (forces to 10 significant
     # digits, displacements to 6 decimals), the same numbers as text.
     csv = tmp_path / "c1.csv"
@@ -65,10 +66,10 @@ def test_simulate_moves_the_curve_out_and_equals_the_csv(tmp_path):
                 "--mesh", "coarse", "--depth", "1.0", "--step", "0.25", "--error-estimate", "off", "--csv", csv)
     rows = [r.split(",") for r in csv.read_text().splitlines() if r and not r.startswith("#")][1:]
     # (Rust writes 1.7e2 where Python writes 1.7e+02: compare the numbers.)
-    assert [float(f"{d:.6f}") for d in c["displacement_mm"]] == [float(r[0]) for r in rows]
-    assert [float(f"{f:.9e}") for f in c["force_N"]] == [float(r[1]) for r in rows]
-    assert c["force_N"][-1] > 0
-    assert c["comments"] == [line[2:] for line in csv.read_text().splitlines() if line.startswith("# ")]
+    assert [float(f"{d:.6f}") for d in c.displacement_mm] == [float(r[0]) for r in rows]
+    assert [float(f"{f:.9e}") for f in c.force_N] == [float(r[1]) for r in rows]
+    assert c.force_N[-1] > 0
+    assert c.comments == [line[2:] for line in csv.read_text().splitlines() if line.startswith("# ")]
 
 
 def test_calibrate_hands_the_callers_arrays_to_palpate_and_fits_as_from_the_file(monkeypatch):
@@ -86,8 +87,8 @@ def test_calibrate_hands_the_callers_arrays_to_palpate_and_fits_as_from_the_file
     assert names == ["stretch", "stress_MPa"]
     assert cols[0] is stretch and cols[1] is stress, "the arrays were copied before palpate"
     from_file = palpate.calibrate("yeoh", {"uniaxial": TRELOAR})
-    assert fit["params"] == from_file["params"] and fit["sse"] == from_file["sse"]
-    assert np.array_equal(fit["predictions"][0]["predicted"], from_file["predictions"][0]["predicted"])
+    assert fit.params == from_file.params and fit.sse == from_file.sse
+    assert np.array_equal(fit.predictions[0].predicted, from_file.predictions[0].predicted)
 
 
 def test_other_dtypes_and_strided_views_are_converted_and_fit_the_same():
@@ -98,9 +99,9 @@ def test_other_dtypes_and_strided_views_are_converted_and_fit_the_same():
     wide[:, 0] = stress
     strided = palpate.calibrate("neo-hookean", {"uniaxial": (stretch, wide[:, 0])})
     assert not wide[:, 0].flags.c_contiguous
-    assert strided["params"] == base["params"]
+    assert strided.params == base.params
     f32 = palpate.calibrate("neo-hookean", {"uniaxial": (stretch.astype(np.float32), stress)})
-    assert f32["converged"]
+    assert f32.converged
 
 
 def test_sample_moves_the_draws_out_and_equals_the_files(tmp_path, monkeypatch):
@@ -108,7 +109,7 @@ def test_sample_moves_the_draws_out_and_equals_the_files(tmp_path, monkeypatch):
     stretch, stress = treloar()
     opts = dict(sampler="nuts", draws=60, max_draws=60, tune=60, parallel=2, seed=3)
     post = palpate.sample("neo-hookean", {"uniaxial": (stretch, stress)}, arviz=False, **opts)
-    c10 = post["draws"]["C10"]
+    c10 = post.draws["C10"]
     assert c10.shape == (2, 60)
     assert_moved_from_rust(c10)
     # The file path: the command line reading the CSV, writing the draws as JSON.
@@ -118,9 +119,9 @@ def test_sample_moves_the_draws_out_and_equals_the_files(tmp_path, monkeypatch):
                 "--chains", chains)
     ch = json.loads(chains.read_text())
     values = np.asarray(ch["values"]).reshape(ch["n_chains"], ch["n_draws"], len(ch["names"]))
-    assert list(post["draws"]) == ch["names"]
+    assert list(post.draws) == ch["names"]
     for j, name in enumerate(ch["names"]):
-        assert np.array_equal(post["draws"][name], values[:, :, j]), name
+        assert np.array_equal(post.draws[name], values[:, :, j]), name
 
 
 def message(call) -> str:
@@ -152,9 +153,9 @@ def test_a_c1_force_record_as_arrays_fits_and_samples_as_the_file():
     d, f = np.loadtxt(rows[1:], delimiter=",", unpack=True)
     a = palpate.calibrate("neo-hookean", (d, f), benchmark="C1")
     b = palpate.calibrate("neo-hookean", path, benchmark="C1")
-    assert a["params"] == b["params"] and a["sse"] == b["sse"]
+    assert a.params == b.params and a.sse == b.sse
     kw = dict(benchmark="C1", sampler="demc", draws=50, max_draws=50, tune=50, parallel=1, seed=2, arviz=False)
     x = palpate.sample("neo-hookean", {"displacement_mm": d, "force_N": f}, **kw)
     y = palpate.sample("neo-hookean", path, **kw)
-    assert np.array_equal(x["draws"]["C10"], y["draws"]["C10"])
-    assert_moved_from_rust(x["draws"]["C10"])
+    assert np.array_equal(x.draws["C10"], y.draws["C10"])
+    assert_moved_from_rust(x.draws["C10"])

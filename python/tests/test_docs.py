@@ -83,7 +83,7 @@ def test_errors_carry_the_message_of_the_command_line(tmp_path):
 def test_bad_options_are_named():
     with pytest.raises(palpate.PalpateError, match="--law"):
         palpate.cli("calibrate", "--law", "no-such-law", "--data", "uniaxial=x.csv")
-    with pytest.raises(palpate.PalpateError, match="unexpected argument '--no-such-option'"):
+    with pytest.raises(TypeError, match="no_such_option"):
         palpate.simulate("C1", law="neo-hookean", params={"C10": 0.1}, no_such_option=1)
     with pytest.raises(palpate.PalpateError, match="shard index 3 is not below the shard count 2"):
         palpate.run_study("studies/treloar-laws.toml", shard="3/2")
@@ -119,7 +119,7 @@ def test_numpy_records_read_as_the_files_do(tmp_path):
     a = palpate.calibrate("mooney-rivlin", {"uniaxial": path})
     b = palpate.calibrate("mooney-rivlin", {"uniaxial": (x, y)})
     c = palpate.calibrate("mooney-rivlin", {"uniaxial": {"stretch": x, "stress_MPa": y}})
-    assert a["param_values"] == b["param_values"] == c["param_values"]
+    assert a.params == b.params == c.params
 
 
 
@@ -131,5 +131,5 @@ def test_sample_returns_inference_data_with_the_same_draws():
     idata = palpate.sample("neo-hookean", {"uniaxial": path}, **kw)
     c10 = idata.posterior["C10"].values
     assert c10.shape == (4, 100)
-    assert np.array_equal(c10, plain["draws"]["C10"])
+    assert np.array_equal(c10, plain.draws["C10"])
     assert "C10" in str(az.summary(idata))

@@ -1,10 +1,13 @@
 """palpate from Python: calibrate, simulate, sample, diagnose and run studies.
 
-Every function runs palpate's own Rust implementation in this process (the
-code behind the ``palpate`` command line, with its options, defaults and
-checks), with the GIL released while it runs. Arrays go in as numpy arrays
-(or file paths) and come out as numpy arrays; an error is raised as
-:class:`PalpateError` carrying the message the command line prints.
+Every function runs palpate's own Rust implementation in this process, with
+the GIL released while it runs. Each takes its options as keywords checked
+by Python (a misspelt one raises ``TypeError``); a value palpate refuses
+raises :class:`PalpateError` carrying the message the command line prints.
+Arrays go in as numpy arrays (or file paths) and come out as numpy arrays
+in result objects (:class:`Calibration`, :class:`Curve`,
+:class:`Posterior`, :class:`Diagnosis`, :class:`StudyRun`; ``to_dict()``
+gives JSON-like data). The functions print nothing unless ``verbose=True``.
 ``calibrate``, ``simulate`` and ``sample`` pass arrays in memory (no copy
 at the boundary, docs/python.md says where); ``diagnose`` goes through
 temporary files.
@@ -27,6 +30,8 @@ from ._native import PalpateError, __version__
 from ._native import merge as _merge
 from ._native import run_cli as _run_cli
 from ._native import run_study as _run_study
+from ._quiet import quiet as _quiet
+from ._results import Calibration, Curve, Diagnosis, Posterior, Prediction, StudyRun
 
 __all__ = [
     "PalpateError",
@@ -38,6 +43,12 @@ __all__ = [
     "run_study",
     "merge",
     "cli",
+    "Calibration",
+    "Curve",
+    "Diagnosis",
+    "Posterior",
+    "Prediction",
+    "StudyRun",
 ]
 
 # The columns of a record given as (x, y) arrays, per test (the reader's names).
@@ -174,58 +185,109 @@ def _flags(options: Mapping[str, Any]) -> list[str]:
     return out
 
 
-def calibrate(law: str, data: Any, *, benchmark: str | None = None, fix: Mapping[str, float] | None = None, **options: Any) -> dict:
-    """Fits ``law`` to ``data`` (``palpate calibrate``).
+def calibrate(
+    law: str,
+    data: Any,
+    *,
+    benchmark: str | None = None,
+    residual: str = "absolute",
+    estimator: str = "lm",
+    fix: Mapping[str, float] | None = None,
+    viscoelastic: str | None = None,
+    stages: str | None = None,
+    prony_terms: int | None = None,
+    fit_mesh: float | None = None,
+    correct_mesh: float | None = None,
+    time_step: float | None = None,
+    edge_radius: float | None = None,
+    fit_edge_radius: float | None = None,
+    mesh_check: float | None = None,
+    compare: bool = False,
+    profile: bool = False,
+    verbose: bool = False,
+) -> Calibration:
+    """Fits ``law`` to ``data`` (as ``palpate calibrate``).
 
     ``data``: ``{test: record}`` for homogeneous tests (test = uniaxial,
     biaxial, planar, simple_shear, with reading options in brackets as on
-    the command line), or one force record with ``benchmark="C1"``. A
-    record is a CSV path, ``(x, y)`` arrays or ``{column: array}``.
-    Options as ``palpate calibrate --help``: ``residual``, ``estimator``,
-    ``viscoelastic``, ...; ``fix={"C01": 0.0}``.
+    the command line, e.g. ``"simple_shear[weight=0.5]"``), or one force
+    record with ``benchmark="C1"`` (or ``"Q1"``, the staged FE
+    identification). A record is a CSV path, ``(x, y)`` arrays or
+    ``{column: array}``.
 
-    Returns the JSON of ``--json`` as a dict, with ``params`` (name ->
-    value) and, per data set in ``predictions``, numpy arrays.
+    ``residual``: absolute, relative or normalised; ``estimator``: lm, bfgs
+    or lbfgs; ``fix``: parameters held, e.g. ``{"C01": 0.0}``;
+    ``viscoelastic``: ``"qlv:N"`` or ``"finite:N"`` for timed records. The
+    options ``stages`` to ``profile`` are those of ``benchmark="Q1"``
+    (``palpate calibrate --help`` says what each does). ``verbose``: print
+    palpate's progress and report.
+
+    Returns a :class:`Calibration` (``params``, ``standard_errors``, ``r2``,
+    ``converged``, ``predictions`` with numpy arrays, ``report``).
 
     Records given as float64 arrays go to palpate in memory (read there as
-    borrowed slices); ``benchmark="Q1"`` (the staged FE identification)
-    reads files, so its record is written to a temporary CSV.
+    borrowed slices); ``benchmark="Q1"`` reads files, so its record is
+    written to a temporary CSV.
     """
-    flags = _flags({"benchmark": benchmark, "fix": fix, **options})
+    options = dict(benchmark=benchmark, residual=residual, estimator=estimator, fix=fix,
+                   viscoelastic=viscoelastic, stages=stages, prony_terms=prony_terms, fit_mesh=fit_mesh,
+                   correct_mesh=correct_mesh, time_step=time_step, edge_radius=edge_radius,
+                   fit_edge_radius=fit_edge_radius, mesh_check=mesh_check, compare=compare, profile=profile)
+    flags = _flags(options)
     if (benchmark or "").lower() != "q1":
         data_args, records = _data_in_memory(data, benchmark)
-        result = json.loads(_native.calibrate_arrays(["--law", law, *data_args, *flags], records))
-        _arrays(result)
-        return result
+        with _quiet(not verbose):
+            report = json.loads(_native.calibrate_arrays(["--law", law, *data_args, *flags], records))
+        return Calibration.from_report(report)
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "fit.json")
         args = ["calibrate", "--law", law, *_data_options(data, benchmark, tmp), "--json", out]
-        _run_cli(args + flags)
-        result = json.loads(Path(out).read_text())
-    _arrays(result)
-    return result
+        with _quiet(not verbose):
+            _run_cli(args + flags)
+        report = json.loads(Path(out).read_text())
+    return Calibration.from_report(report)
 
 
-def _arrays(result: dict) -> None:
-    """Lists of numbers in a result as numpy arrays; ``params`` by value."""
-    params = result.get("params")
-    if isinstance(params, dict):
-        result["param_values"] = {k: v.get("value") if isinstance(v, dict) else v for k, v in params.items()}
-    for p in result.get("predictions", []) or []:
-        for k in ("stretch_or_displacement", "time", "observed", "predicted"):
-            if k in p and isinstance(p[k], list):
-                p[k] = np.asarray(p[k], dtype=float)
+def simulate(
+    benchmark: str,
+    law: str | None = None,
+    params: Mapping[str, float] | None = None,
+    *,
+    mesh: str | int | None = None,
+    depth: float | None = None,
+    step: float | None = None,
+    friction: float | None = None,
+    tool: str | None = None,
+    element: str | None = None,
+    bulk: str | float | None = None,
+    bonded: bool = False,
+    sliding_base: bool = False,
+    edge_radius: float | None = None,
+    prony: str | None = None,
+    ramp: float | None = None,
+    hold: float | None = None,
+    error_estimate: str = "on",
+    order: float | None = None,
+    rd: float | None = None,
+    nodules: str | None = None,
+    nodule_law: str | None = None,
+    nodule_params: Mapping[str, float] | None = None,
+    verbose: bool = False,
+) -> Curve:
+    """Runs a finite-element benchmark (as ``palpate simulate``).
 
+    ``params``: the law's parameters by name (MPa). ``mesh``: coarse,
+    medium, fine or a level; ``depth`` and ``step`` in mm; ``friction``,
+    ``tool``, ``element``, ``bulk``, ``bonded`` (C1), ``sliding_base`` (N1),
+    ``edge_radius`` (Q1); ``prony="g1=..,tau1=.."`` with ``ramp`` and
+    ``hold`` in s; ``error_estimate`` ``"on"``/``"off"`` and ``order``; R2:
+    ``rd``, ``nodules``, ``nodule_law``, ``nodule_params``.
+    ``palpate simulate --help`` says what each does and its default.
+    ``verbose``: print the FE summary and the error estimate.
 
-def simulate(benchmark: str, law: str | None = None, params: Mapping[str, float] | None = None, **options: Any) -> dict:
-    """Runs a finite-element benchmark (``palpate simulate``).
-
-    ``params``: the law's parameters by name (MPa); options as ``palpate
-    simulate --help`` (``mesh``, ``depth``, ``step``, ``friction``,
-    ``error_estimate="off"``, ``prony``, ...). Returns the curve's columns as
-    numpy arrays (``displacement_mm``, ``force_N`` and, when present,
-    ``time_s``, ``error_estimate_N``; R2: ``position_mm``, ``force_N``,
-    ``force_x_N``) and the ``comments`` the CSV carries.
+    Returns a :class:`Curve`: ``displacement_mm``, ``force_N`` and, when
+    present, ``time_s``, ``error_estimate_N`` (R2: ``position_mm``,
+    ``force_N``, ``force_x_N``), and ``comments``.
 
     N1, N3, C1, Q1: the arrays are palpate's own vectors, moved into numpy
     (no copy, full precision). R2 (a scan) goes through a CSV file (values
@@ -236,15 +298,21 @@ def simulate(benchmark: str, law: str | None = None, params: Mapping[str, float]
         args += ["--law", law]
     for k, v in (params or {}).items():
         args += ["--param", f"{k}={float(v)!r}"]
-    args += _flags(options)
+    for k, v in (nodule_params or {}).items():
+        args += ["--nodule-param", f"{k}={float(v)!r}"]
+    args += _flags(dict(mesh=mesh, depth=depth, step=step, friction=friction, tool=tool, element=element,
+                        bulk=bulk, bonded=bonded, sliding_base=sliding_base, edge_radius=edge_radius,
+                        prony=prony, ramp=ramp, hold=hold, error_estimate=error_estimate, order=order,
+                        rd=rd, nodules=nodules, nodule_law=nodule_law))
     if benchmark.lower() != "r2":
-        curve = _native.simulate_arrays(args)
-        del curve["title"]
-        return curve
+        with _quiet(not verbose):
+            curve = _native.simulate_arrays(args)
+        return Curve(**curve)
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "curve.csv")
-        _run_cli(["simulate", *args, "--csv", out])
-        return _read_curve(out)
+        with _quiet(not verbose):
+            _run_cli(["simulate", *args, "--csv", out])
+        return Curve(**_read_curve(out))
 
 
 def _read_curve(path: str) -> dict:
@@ -258,35 +326,68 @@ def _read_curve(path: str) -> dict:
     return out
 
 
-def sample(law: str, data: Any, *, benchmark: str | None = None, seed: int = 0, arviz: bool | None = None, **options: Any):
-    """Samples the posterior of ``law``'s parameters (``palpate sample``).
+def sample(
+    law: str,
+    data: Any,
+    *,
+    benchmark: str | None = None,
+    sampler: str = "nuts",
+    draws: int | None = None,
+    max_draws: int | None = None,
+    tune: int | None = None,
+    parallel: int | None = None,
+    seed: int = 0,
+    sigma: float | None = None,
+    ar1: bool = False,
+    prior: Mapping[str, str] | None = None,
+    box: Mapping[str, tuple[float, float]] | None = None,
+    mesh: str | int | None = None,
+    bulk: str | float | None = None,
+    friction: float | None = None,
+    prony: str | None = None,
+    edge_radius: float | None = None,
+    design: int | None = None,
+    holdout: int | None = None,
+    cache: str | os.PathLike | None = None,
+    arviz: bool | None = None,
+    verbose: bool = False,
+):
+    """Samples the posterior of ``law``'s parameters (as ``palpate sample``).
 
-    ``data`` as for :func:`calibrate`; options as ``palpate sample --help``
-    (``sampler``, ``draws``, ``max_draws``, ``tune``, ``parallel``,
-    ``sigma``, ``prior={"C10": "lognormal:-7,1"}``, ``box`` for FE
-    benchmarks, ...).
+    ``data`` as for :func:`calibrate`. ``sampler``: nuts, ensemble or demc;
+    ``draws``, ``max_draws``, ``tune``, ``parallel`` (chains), ``seed``;
+    ``sigma`` (noise, estimated when None), ``ar1``; ``prior={"C10":
+    "lognormal:-7,1"}``. FE benchmarks (N1, N3, Q1): ``box={"C10": (lo,
+    hi)}``, ``mesh``, ``bulk``, ``friction``, ``prony``, ``edge_radius``,
+    ``design``, ``holdout``, ``cache`` (the surrogate's). ``palpate sample
+    --help`` says what each does and its default. ``verbose``: print the
+    sampler's progress and summary.
 
-    Returns an ArviZ ``InferenceData`` (posterior draws per parameter,
-    dims chain x draw; the summary in ``attrs``) when arviz is importable
-    (``arviz=False`` refuses it), else a dict: ``draws`` (name -> array
-    chains x draws), ``summary`` (the ``--json`` of the command line).
+    Returns an ArviZ ``InferenceData`` (posterior draws per parameter, dims
+    chain x draw; the summary in ``attrs``) when arviz is importable
+    (``arviz=False`` refuses it), else a :class:`Posterior` (``draws``:
+    name -> array chains x draws; ``summary``).
 
     The draws are palpate's own vector moved into numpy (no copy): each
     parameter's array is a strided view of it. Records given as float64
     arrays go to palpate in memory; for the FE benchmarks (N1, N3, Q1) the
     record is written to a temporary CSV (their surrogate reads files).
     """
-    flags = _flags({"benchmark": benchmark, **options})
+    flags = _flags(dict(benchmark=benchmark, sampler=sampler, draws=draws, max_draws=max_draws, tune=tune,
+                        parallel=parallel, seed=seed, sigma=sigma, ar1=ar1, prior=prior, box=box, mesh=mesh,
+                        bulk=bulk, friction=friction, prony=prony, edge_radius=edge_radius, design=design,
+                        holdout=holdout, cache=None if cache is None else os.fspath(cache)))
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         if (benchmark or "").lower() in ("n1", "n3", "q1"):
             data_args, records = _data_options(data, benchmark, tmp), []
         else:
             data_args, records = _data_in_memory(data, benchmark)
-        args = ["--law", law, *data_args, "--seed", str(seed), *flags]
-        names, flat, n_chains, n_draws, summary = _native.sample_arrays(args, records)
+        args = ["--law", law, *data_args, *flags]
+        with _quiet(not verbose):
+            names, flat, n_chains, n_draws, summary = _native.sample_arrays(args, records)
     summary = json.loads(summary)
     values = flat.reshape(n_chains, n_draws, len(names))  # a view of palpate's vector
-    draws = {name: values[:, :, j] for j, name in enumerate(names)}
+    drawn = {name: values[:, :, j] for j, name in enumerate(names)}
     if arviz is not False:
         try:
             import arviz as az  # noqa: PLC0415
@@ -295,21 +396,34 @@ def sample(law: str, data: Any, *, benchmark: str | None = None, seed: int = 0, 
                 raise
         else:
             try:
-                idata = az.from_dict(posterior=draws)  # arviz < 1: InferenceData
+                idata = az.from_dict(posterior=drawn)  # arviz < 1: InferenceData
             except TypeError:
-                idata = az.from_dict({"posterior": draws})  # arviz >= 1: an xarray DataTree
+                idata = az.from_dict({"posterior": drawn})  # arviz >= 1: an xarray DataTree
             idata.posterior.attrs["palpate_summary"] = json.dumps(summary)
             return idata
-    return {"draws": draws, "summary": summary}
+    return Posterior(drawn, summary)
 
 
-def diagnose(data: Any, *, benchmark: str | None = None, base: str = "neo-hookean", effects: list[str] | None = None, **options: Any) -> dict:
-    """Diagnoses the gap between a base model and a record (``palpate diagnose``).
+def diagnose(
+    data: Any,
+    *,
+    benchmark: str | None = None,
+    base: str = "neo-hookean",
+    effects: list[str] | None = None,
+    alpha: float | None = None,
+    folds: int | None = None,
+    verbose: bool = False,
+) -> Diagnosis:
+    """Diagnoses the gap between a base model and a record (as ``palpate diagnose``).
 
     ``data``: one record, ``{test: record}`` with one entry for a homogeneous
-    test, or a force record with ``benchmark="C1"`` / ``"N1"``. Options as
-    ``palpate diagnose --help`` (``alpha``, ``folds``). Returns the JSON of
-    ``--json`` (the GAP.md contract) as a dict.
+    test, or a force record with ``benchmark="C1"`` / ``"N1"``. ``base``:
+    the base law; ``effects``: the candidate effects (all by default);
+    ``alpha`` and ``folds`` as ``palpate diagnose --help``. ``verbose``:
+    print the report.
+
+    Returns a :class:`Diagnosis`: ``verdict``, ``ranking`` and ``report``
+    (the GAP.md contract as a dict).
     """
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "gap.json")
@@ -319,34 +433,39 @@ def diagnose(data: Any, *, benchmark: str | None = None, base: str = "neo-hookea
         args = ["diagnose", *data_args, "--base", base, "--json", out]
         if effects:
             args += ["--effects", ",".join(effects)]
-        args += _flags({"benchmark": benchmark, **options})
-        _run_cli(args)
-        return json.loads(Path(out).read_text())
+        args += _flags(dict(benchmark=benchmark, alpha=alpha, folds=folds))
+        with _quiet(not verbose):
+            _run_cli(args)
+        report = json.loads(Path(out).read_text())
+    return Diagnosis(report.get("verdict"), report.get("ranking") or [], report)
 
 
-def run_study(manifest: str | os.PathLike, out: str | os.PathLike | None = None, *, shard: str | None = None, fresh: bool = False, verbose: bool = False) -> dict:
+def run_study(manifest: str | os.PathLike, out: str | os.PathLike | None = None, *, shard: str | None = None, fresh: bool = False, verbose: bool = False) -> StudyRun:
     """Runs a study manifest (``palpate run``) into its run folder.
 
     With ``shard="I/N"`` computes only that slice of the study's units into
     the folder's cache (docs/cluster.md); :func:`merge` then assembles the
-    results. Returns ``folder`` (a Path), the unit counts (``computed``,
-    ``cached``, ``others``), ``deferred_steps`` and, for a whole run,
-    ``results`` (results.json as a dict).
+    results. Returns a :class:`StudyRun`: ``folder`` (a Path), the unit
+    counts (``computed``, ``cached``, ``others``), ``deferred_steps`` and,
+    for a whole run, ``results`` (results.json as a dict).
     """
-    s = _run_study(os.fspath(manifest), None if out is None else os.fspath(out), shard, fresh, verbose)
-    s["folder"] = Path(s["folder"])
-    if shard is None:
-        s["results"] = json.loads((s["folder"] / "results.json").read_text())
-    return s
+    with _quiet(not verbose):
+        s = _run_study(os.fspath(manifest), None if out is None else os.fspath(out), shard, fresh, verbose)
+    folder = Path(s["folder"])
+    results = json.loads((folder / "results.json").read_text()) if shard is None else None
+    return StudyRun(folder, s["computed"], s["cached"], others=s["others"],
+                    deferred_steps=list(s["deferred_steps"]), results=results)
 
 
-def merge(run_dir: str | os.PathLike, *, verbose: bool = False) -> dict:
+def merge(run_dir: str | os.PathLike, *, verbose: bool = False) -> StudyRun:
     """Assembles a study's results from its shards (``palpate merge``).
 
-    Returns ``folder``, ``shards``, the units taken from the cache
-    (``cached``) and computed by the merge (``computed``), and ``results``.
+    Returns a :class:`StudyRun`: ``folder``, ``shards``, the units taken from
+    the cache (``cached``) and computed by the merge (``computed``), and
+    ``results``.
     """
-    m = _merge(os.fspath(run_dir), verbose)
-    m["folder"] = Path(m["folder"])
-    m["results"] = json.loads((m["folder"] / "results.json").read_text())
-    return m
+    with _quiet(not verbose):
+        m = _merge(os.fspath(run_dir), verbose)
+    folder = Path(m["folder"])
+    results = json.loads((folder / "results.json").read_text())
+    return StudyRun(folder, m["computed"], m["cached"], shards=m["shards"], results=results)
