@@ -101,7 +101,7 @@ class Calibration(_Result):
         for p in report.get("predictions") or []:
             arr = {k: np.asarray(p[k], dtype=float) for k in ("stretch_or_displacement", "observed", "predicted")}
             time = np.asarray(p["time"], dtype=float) if p.get("time") is not None else None
-            preds.append(Prediction(p.get("data"), p.get("test"), p.get("fitted"), p.get("r2"), p.get("rms"),
+            preds.append(Prediction(p.get("data"), _test_name(p.get("test")), p.get("fitted"), p.get("r2"), p.get("rms"),
                                     time=time, **arr))
         return cls(report.get("law", ""), values, ses, report.get("r2"), report.get("rms"), report.get("sse"),
                    report.get("converged"), report.get("identifiable"), preds, report)
@@ -162,3 +162,11 @@ class StudyRun(_Result):
     results: dict | None = None
 
     _repr_skip = ("results",)
+
+
+def _test_name(test):
+    """The test kind as its name: the library writes a homogeneous test as
+    ``{"homogeneous": "uniaxial"}`` and the others as a plain string."""
+    if isinstance(test, dict) and len(test) == 1:
+        return str(next(iter(test.values())))
+    return test
