@@ -68,6 +68,7 @@ pub mod contribution;
 pub mod discretisation;
 pub mod dofs;
 pub mod error;
+pub mod experiment;
 pub mod gmres;
 pub mod kernel;
 pub mod kinematics;
