@@ -35,12 +35,14 @@
 //! the surface, a parameter named twice, a protocol deeper than the
 //! specimen) is refused by [`Experiment::check`], naming the field.
 
+pub mod build;
 pub mod params;
 
 use std::collections::BTreeMap;
 
 use serde::{Deserialize, Serialize};
 
+pub use build::ExperimentModel;
 pub use params::Parameter;
 
 /// One experiment: what is tested, with what, how, and meshed how finely.

@@ -448,3 +448,15 @@ impl N1Setup {
         m
     }
 }
+
+impl N1Setup {
+    /// The axisymmetric cylinder of an experiment description (specimen,
+    /// materials, tool, supports, mesh) as this setup.
+    pub fn from_experiment(e: &crate::experiment::Experiment) -> Result<N1Setup, FeError> {
+        let _ = e;
+        Err(FeError::InvalidConfig {
+            field: "specimen".into(),
+            reason: "an axisymmetric cylinder cannot be built from a description yet".into(),
+        })
+    }
+}
