@@ -8,16 +8,19 @@
 //! 1. each material in the order the specimen first uses it (the specimen's
 //!    `material`, its layers from the top down, then its inclusions): the
 //!    law's parameters (`C10`, `C01`, `mu1`, `alpha1`, ...), then its Prony
-//!    terms (`g1`, `tau1_s`, `g2`, ...). With one material the names are the
-//!    law's; with several, each is prefixed by the material's name
+//!    terms (`g1`, `tau1_s`, `g2`, ...) when at least one of them is given
+//!    as a parameter (`{ start = .. }`). With one material the names are
+//!    the law's; with several, each is prefixed by the material's name
 //!    (`skin_C10`, `fat_C10`, `nodule_g1`).
-//! 2. `friction`, the tool's Coulomb coefficient, when it is a number or a
-//!    parameter (not when bonded);
-//! 3. `base_friction`, the support's, when the support is `{ friction = .. }`.
+//! 2. `friction`, the tool's Coulomb coefficient, when it is a parameter;
+//! 3. `base_friction`, the support's, when it is a parameter.
 //!
-//! A parameter is fitted unless the description gives it as a number or
-//! with `fit = false`; one not named in a material starts at the law's
-//! default and is fitted. Friction coefficients given as numbers are fixed.
+//! A law parameter is always in the space; it is fitted unless the
+//! description gives it as a number or with `fit = false` (then the
+//! estimators hold it: [`Experiment::fixed_parameters`]); one not named
+//! starts at the law's default and is fitted. A friction coefficient or a
+//! Prony series given as numbers is part of the model, not a parameter
+//! (as `friction = 0.8` is part of N1).
 
 use palpate_core::{ParamRole, ParamSpace, ParamSpec};
 use palpate_enrich::prony_params;
@@ -287,7 +290,10 @@ fn material_parameters(
         .iter()
         .map(|n| (format!("materials.{name}.{n}"), m.params.get(n)))
         .collect();
-    if !m.prony.is_empty() {
+    if m.prony
+        .iter()
+        .any(|t| matches!(t.g, Value::Param(_)) || matches!(t.tau, Value::Param(_)))
+    {
         specs.extend(prony_params(m.prony.len()));
         for (i, t) in m.prony.iter().enumerate() {
             values.push((format!("materials.{name}.prony[{i}].g"), Some(&t.g)));
@@ -351,7 +357,8 @@ fn apply_value(
     Ok((spec, fit, nuisance))
 }
 
-/// A friction coefficient as a parameter, or `None` when bonded.
+/// A friction coefficient as a parameter, or `None` when it is a number
+/// (part of the model) or bonded.
 fn friction_parameter(
     name: &str,
     field: &str,
@@ -366,6 +373,12 @@ fn friction_parameter(
                 format!("`{k}`: expected a number >= 0, {{ start = .. }}, \"frictionless\" or \"bonded\""),
             )),
         };
+    }
+    if let Value::Fixed(v) = value {
+        if !(*v >= 0.0 && v.is_finite()) {
+            return Err(bad(field, format!("{v}: a friction coefficient is >= 0")));
+        }
+        return Ok(None);
     }
     let base = ParamSpec {
         name: name.into(),
