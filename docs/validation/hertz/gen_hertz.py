@@ -28,7 +28,11 @@ import argparse
 import math
 import os
 
-from ccxgen import C10_NH, Mesh, geometric_sizes
+import sys
+
+# the deck generator shared with the N1 references
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "../../../tests/data/calculix"))
+from ccxgen import C10_NH, Mesh, geometric_sizes  # noqa: E402
 
 RCYL, HCYL = 35.0, 80.0
 CZ = HCYL

@@ -9,7 +9,7 @@ rings blending to circles, then to the rectangle; z graded from the top)
 with 20-node reduced-integration hexahedra C3D20R (straight edges; `--etype
 C3D8I` for the incompatible-mode hexahedra of BENCHMARKS.md's attempt), neo-Hookean C10 =
 1101.295 Pa (ecoflex-nh) with K = 1000 mu (CalculiX has no exactly
-incompressible solid; ../shared/reference/calculix/README.md).
+incompressible solid; tests/data/calculix/README.md).
 
 The needle (hemispherical tip R = 2.5 mm tangent to a 15 degree cone) is a
 graph z = f(r) over the plane, so its quarter surface is the same kind of
@@ -41,7 +41,7 @@ import sys
 import time
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-REF = os.path.normpath(os.path.join(HERE, "../../../../shared/reference/calculix"))
+REF = os.path.normpath(os.path.join(HERE, "../../../tests/data/calculix"))
 sys.path.insert(0, REF)
 from ccxgen import material_card  # noqa: E402
 

@@ -3,9 +3,9 @@
 
 With a frictionless wheel the state depends on the wheel position only, so
 a press at x equals the rolled force at x (CalculiX checked it: 3.370553 vs
-3.370548 N, ../shared/reference/calculix/README.md). Each case presses the
+3.370548 N, tests/data/calculix/README.md). Each case presses the
 wheel to RD at x with the shared production generator
-(../shared/reference/calculix/r2/gen_r2.py: CPS8R, 0.1 mm section, node-to-
+(tests/data/calculix/r2/gen_r2.py: CPS8R, 0.1 mm section, node-to-
 surface penalty contact), on the 1 mm top mesh, at two contact penalties
 (1 and 10 MPa/mm); the penalty bias is removed by extrapolating
 F = F_inf - c / k (the form press_x10.csv shows). Writes ccx_presses.csv
@@ -21,7 +21,7 @@ import subprocess
 import sys
 
 HERE = os.path.dirname(os.path.abspath(__file__))
-REF = os.path.normpath(os.path.join(HERE, "../../../../shared/reference/calculix/r2"))
+REF = os.path.normpath(os.path.join(HERE, "../../../tests/data/calculix/r2"))
 NODULES = "37.5:10,75:15,112.5:20"
 POSITIONS = [37.5, 56.25, 75.0, 93.75, 112.5]
 RDS = [3.0, 6.0]
