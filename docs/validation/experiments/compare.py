@@ -7,7 +7,8 @@ usage: compare.py PALPATE.csv CALCULIX.csv --tol 0.02 [--floor 0.05]
 Both files are CSV with columns displacement_mm and force_N (force
 positive in compression, whole body). A header line naming the columns is
 optional (without one the first two columns are taken); lines starting
-with '#' are comments; other columns are ignored.
+with '#' are comments; other columns are ignored. A curve that does not
+start at zero displacement is taken to start at (0, 0): the touch.
 
 At every CalculiX sample inside the displacement range of palpate's curve
 the palpate force is interpolated linearly in displacement and the
@@ -50,9 +51,11 @@ def read_curve(path):
         except (ValueError, IndexError):
             raise ValueError(f"{path}:{no}: expected numbers in columns {cols[0] + 1} and "
                              f"{cols[1] + 1}, found: {line}")
-    if len(rows) < 2:
-        raise ValueError(f"{path}: fewer than two samples")
+    if not rows:
+        raise ValueError(f"{path}: no samples")
     rows.sort()
+    if rows[0][0] > 0:
+        rows.insert(0, (0.0, 0.0))      # no force before the touch
     return rows
 
 
@@ -88,6 +91,8 @@ def main(argv=None):
     print(f"{'displacement_mm':>15} {'calculix_N':>13} {'palpate_N':>13} {'rel_diff':>9}")
     worst, worst_at, judged, outside = 0.0, None, 0, 0
     for d, fc in ccx:
+        if d <= 0:
+            continue
         fp = interpolate(pal, d)
         if fp is None:
             outside += 1

@@ -66,7 +66,7 @@ def main():
           + ",change_last,F_extrapolated,order,error_finest")
     for d in at:
         f = [interpolate(c, d) for c in curves]
-        if any(x is None for x in f):
+        if d <= 0 or any(x is None for x in f):
             continue
         fx, p = richardson(f, sizes)
         change = (f[-1] - f[-2]) / f[-1]

@@ -32,7 +32,7 @@ R, H = 25.0, 30.0
 C10, BULK = 2e-2, 1000.0
 TRAVEL = 12.0                      # platen travel, whole body (40 %)
 N_OUT = 24                         # curve samples (every 0.5 mm)
-PLATEN_R0, PLATEN_R = 24.0, 40.0   # the platen strip (its face over the edge too)
+PLATEN_R0, PLATEN_R = 25.0, 40.0   # the platen strip beyond the bonded face
 
 
 def base_grid():
