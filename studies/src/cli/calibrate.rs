@@ -44,10 +44,13 @@ pub struct Args {
     pub law: String,
     /// Data to fit: TEST=FILE or TEST[key=value,...]=FILE for homogeneous
     /// tests (TEST = uniaxial, biaxial, planar, simple_shear; keys weight,
-    /// axial_stretch, stress_unit), or just FILE with --benchmark C1. Repeat
+    /// axial_stretch, stress_unit, compression, skip_rows, or a column chosen
+    /// by name such as force=Load), or just FILE with --benchmark C1. Repeat
     /// to fit jointly.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
+    #[command(flatten)]
+    pub reading: crate::cli::reading::ReadingArgs,
     /// Viscoelastic homogeneous tests (timed records, column time_s):
     /// qlv:N (quasi-linear viscoelasticity, N Prony terms on the nominal
     /// stress) or finite:N (uniaxial only: Prony terms on the isochoric second
@@ -130,7 +133,17 @@ pub fn split_pair<'a>(s: &'a str, what: &str) -> anyhow::Result<(&'a str, &'a st
 /// Splits `TEST=FILE` or `TEST[key=value,...]=FILE` into the test, its
 /// reading options and the file.
 pub fn split_data(d: &str) -> anyhow::Result<(&str, ReadOptions, &str)> {
-    let mut options = ReadOptions::default();
+    split_data_with(d, &ReadOptions::default())
+}
+
+/// [`split_data`] starting from `defaults` (the options of `--column`,
+/// `--compression`, `--skip-rows`), which the options in brackets override.
+pub fn split_data_with<'a>(
+    d: &'a str,
+    defaults: &ReadOptions,
+) -> anyhow::Result<(&'a str, ReadOptions, &'a str)> {
+    let mut options = defaults.clone();
+    let mut chosen = Vec::new();
     if let Some(open) = d.find('[').filter(|&i| !d[..i].contains('=')) {
         let close = d[open..]
             .find(']')
@@ -146,6 +159,13 @@ pub fn split_data(d: &str) -> anyhow::Result<(&str, ReadOptions, &str)> {
         {
             let (k, v) = split_pair(kv, "key=value inside [...], e.g. weight=0.5")
                 .with_context(|| format!("--data {d}"))?;
+            // A column chosen here replaces the one --column chose.
+            if let Some(role) = crate::records::Role::parse(k) {
+                if !chosen.contains(&role) {
+                    options.columns.retain(|(r, _)| *r != role);
+                    chosen.push(role);
+                }
+            }
             options.set(k, v).with_context(|| format!("--data {d}"))?;
         }
         return Ok((&d[..open], options, path));
@@ -170,6 +190,17 @@ pub fn read_data_with(
     benchmark: Option<&str>,
     arrays: &[ArrayRecord],
 ) -> anyhow::Result<Vec<TestData>> {
+    read_data_opts(data, benchmark, arrays, &ReadOptions::default())
+}
+
+/// [`read_data_with`] with the reading options every file starts from
+/// ([`crate::cli::reading::ReadingArgs`]).
+pub fn read_data_opts(
+    data: &[String],
+    benchmark: Option<&str>,
+    arrays: &[ArrayRecord],
+    defaults: &ReadOptions,
+) -> anyhow::Result<Vec<TestData>> {
     let read = |name: &str, kind: TestKind, path: &str, options: ReadOptions| match record_for(
         path, arrays,
     )
@@ -193,7 +224,7 @@ pub fn read_data_with(
                         );
                     }
                 }
-                out.push(read("C1", TestKind::C1, path, ReadOptions::default())?);
+                out.push(read("C1", TestKind::C1, path, defaults.clone())?);
             }
         }
         Some(b) => anyhow::bail!(
@@ -201,7 +232,7 @@ pub fn read_data_with(
         ),
         None => {
             for d in data {
-                let (test, options, path) = split_data(d)?;
+                let (test, options, path) = split_data_with(d, defaults)?;
                 let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
                 let name = if out.iter().any(|o: &TestData| o.name == test) {
                     format!("{test}#{}", out.len() + 1)
@@ -223,6 +254,19 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
     if is_q1(&args) {
         return run_q1(&args, law);
+    }
+    // How each file was read (metadata, columns, sign), when there is
+    // anything to say beyond palpate's own format.
+    for d in read_data_opts(
+        &args.data,
+        args.benchmark.as_deref(),
+        &[],
+        &args.reading.defaults()?,
+    )? {
+        let about = d.describe();
+        if !about.is_empty() {
+            eprint!("{} ({} rows):\n{about}", d.file, d.observed.len());
+        }
     }
     let result = fit(&args, &[])?;
     print!("{}", calibration_table(&result));
@@ -300,7 +344,12 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         .map(Viscous::parse)
         .transpose()
         .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
-    let data = read_data_with(&args.data, args.benchmark.as_deref(), arrays)?;
+    let data = read_data_opts(
+        &args.data,
+        args.benchmark.as_deref(),
+        arrays,
+        &args.reading.defaults()?,
+    )?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
     crate::run::output::check_outputs(&inputs, &outputs)?;

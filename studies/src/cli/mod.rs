@@ -9,6 +9,7 @@ pub mod diagnose;
 pub mod doe;
 pub mod localize;
 pub mod merge;
+pub mod reading;
 pub mod realtime;
 pub mod run;
 pub mod sample;

@@ -4,7 +4,7 @@
 //! (`palpate_uq::mcmc::sample_until_converged`); finite-element benchmarks
 //! are sampled through a cached surrogate ([`super::sample_fe`]).
 
-use crate::cli::calibrate::read_data_with;
+use crate::cli::calibrate::read_data_opts;
 use crate::run::output::{write_atomic, write_json};
 use anyhow::Context;
 use palpate_material::Law;
@@ -57,6 +57,8 @@ pub struct Args {
     /// Data: TEST=FILE for homogeneous tests, or FILE with --benchmark C1. Repeatable.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
+    #[command(flatten)]
+    pub reading: crate::cli::reading::ReadingArgs,
     /// Benchmark whose force record the data are: C1 (analytic), or N1, N3, Q1 (finite elements, through a surrogate).
     #[arg(long, value_name = "ID")]
     pub benchmark: Option<String>,
@@ -307,7 +309,12 @@ pub fn draw(
         };
         (vec![set], Some(fe))
     } else {
-        let data = read_data_with(&args.data, args.benchmark.as_deref(), arrays)?;
+        let data = read_data_opts(
+            &args.data,
+            args.benchmark.as_deref(),
+            arrays,
+            &args.reading.defaults()?,
+        )?;
         let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
         crate::run::output::check_outputs_and_dirs(&inputs, &outputs, &output_dirs)?;
         let sets: Vec<DataSet> = data

@@ -9,6 +9,7 @@ fn c1_args() -> Args {
     Args {
         law: "neo-hookean".into(),
         data: vec!["x.csv".into()],
+        reading: Default::default(),
         benchmark: Some("C1".into()),
         boxes: vec![],
         mesh: None,

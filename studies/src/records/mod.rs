@@ -1,11 +1,19 @@
 //! The record vocabulary: the kinds of test a data file records
 //! ([`TestKind`]), a record read for one test ([`TestData`]), how to read it
 //! ([`ReadOptions`], [`DataSpec`] in manifests) and the columns of each kind
-//! ([`columns`]); records given as arrays ([`arrays`]). It depends on nothing
-//! else in the crate, so that models, calibration and the steps all build on it.
+//! ([`columns`]); files as testing machines write them, with metadata lines,
+//! column names with units and other separators ([`machine`]); sign
+//! conventions ([`sign`]); records given as arrays ([`arrays`]). It depends
+//! on nothing else in the crate, so that models, calibration and the steps
+//! all build on it.
 
 pub mod arrays;
 pub mod columns;
+pub mod machine;
+pub mod sign;
+
+pub use machine::{Metadata, Role, SpecimenSize};
+pub use sign::Compression;
 
 use palpate_analytic::Mode;
 use palpate_core::data::{Column, Table};
@@ -81,10 +89,19 @@ pub struct TestData {
     pub weight: f64,
     /// Simple shear: the axial stretch the shear is superposed on (default 1).
     pub axial_stretch: f64,
+    /// The lines of the file before its header (specimen size, speed,
+    /// machine), in order; empty for a file in palpate's own format.
+    pub metadata: Metadata,
+    /// How the file's columns were read, e.g. `Load (N) -> force_N`,
+    /// `Strain (%) -> strain (x 0.01)` (only those renamed or converted).
+    pub columns_read: Vec<String>,
+    /// How the record's sign was read, e.g. `compression, written negative
+    /// as palpate's` (empty when there is nothing to say).
+    pub sign: String,
 }
 
 /// How to read a data file beyond its test kind (all optional).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct ReadOptions {
     /// Weight of the record in a joint fit (> 0).
     pub weight: f64,
@@ -94,6 +111,14 @@ pub struct ReadOptions {
     /// overriding the unit in their names (for a file whose header is
     /// known to be wrong).
     pub stress_unit: Option<f64>,
+    /// How the file writes compression; `None`: read from the data, and
+    /// refused when ambiguous ([`sign`]).
+    pub compression: Option<Compression>,
+    /// Columns chosen by name (`force=Load`, `stress=Engineering Stress`).
+    pub columns: Vec<(Role, String)>,
+    /// Lines at the top of the file before the header (kept as metadata);
+    /// `None`: the header is found.
+    pub skip_rows: Option<usize>,
 }
 
 impl Default for ReadOptions {
@@ -102,14 +127,39 @@ impl Default for ReadOptions {
             weight: 1.0,
             axial_stretch: 1.0,
             stress_unit: None,
+            compression: None,
+            columns: Vec::new(),
+            skip_rows: None,
         }
     }
 }
 
 impl ReadOptions {
     /// Parses the options of a `--data KIND[key=value,...]=FILE` or a
-    /// manifest data set: `weight`, `axial_stretch`, `stress_unit` (MPa, kPa, Pa).
+    /// manifest data set: `weight`, `axial_stretch`, `stress_unit` (MPa,
+    /// kPa, Pa), `compression` (negative, positive, none), `skip_rows` (a
+    /// count of lines), or a column chosen by name: `time`, `displacement`,
+    /// `force`, `stretch`, `strain`, `true_strain`, `stress`, `true_stress`
+    /// (`force=Load`).
     pub fn set(&mut self, key: &str, value: &str) -> anyhow::Result<()> {
+        if let Some(role) = Role::parse(key) {
+            let name = value.trim();
+            anyhow::ensure!(
+                !name.is_empty(),
+                "{}=: expected the name of a column of the file",
+                role.key()
+            );
+            if let Some((_, before)) = self.columns.iter().find(|(r, _)| *r == role) {
+                anyhow::bail!(
+                    "{}={name}: the {} column is already chosen ({}={before})",
+                    role.key(),
+                    role.key(),
+                    role.key()
+                );
+            }
+            self.columns.push((role, name.to_string()));
+            return Ok(());
+        }
         let number = |what: &str| -> anyhow::Result<f64> {
             value
                 .trim()
@@ -129,8 +179,16 @@ impl ReadOptions {
                     other => anyhow::bail!("stress_unit `{other}`: expected MPa, kPa or Pa"),
                 })
             }
+            "compression" => self.compression = Some(Compression::parse(value)?),
+            "skip_rows" => {
+                self.skip_rows = Some(value.trim().parse::<usize>().map_err(|_| {
+                    anyhow::anyhow!("skip_rows `{value}`: expected a count of lines (0, 1, 2, ...)")
+                })?)
+            }
             other => anyhow::bail!(
-                "unknown data option `{other}`; expected weight, axial_stretch or stress_unit"
+                "unknown data option `{other}`; expected weight, axial_stretch, stress_unit, compression, skip_rows \
+                 or a column chosen by name ({})",
+                Role::ALL.map(|r| format!("{}=NAME", r.key())).join(", ")
             ),
         }
         Ok(())
@@ -150,7 +208,52 @@ impl TestData {
         path: &Path,
         options: ReadOptions,
     ) -> anyhow::Result<TestData> {
-        Self::from_table(name, test, Table::read(path)?, options)
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| anyhow::anyhow!("{}: cannot read: {e}", path.display()))?;
+        let m = machine::parse(
+            path,
+            &text,
+            &machine::Layout {
+                columns: &options.columns,
+                skip_rows: options.skip_rows,
+                stress_unit: options.stress_unit,
+            },
+        )?;
+        let mut d = Self::from_parts(name, test, m.table, &m.metadata, &m.header, options)?;
+        d.metadata = m.metadata;
+        d.columns_read = m.renamed;
+        Ok(d)
+    }
+
+    /// The specimen size the file's metadata states (`Cylinder Diameter:
+    /// 50mm`, `Height (mm),30`), for an experiment description; `Ok(None)`
+    /// when it states none, `Err` naming the line of a value that is not a
+    /// length.
+    pub fn specimen(&self) -> anyhow::Result<Option<SpecimenSize>> {
+        self.metadata
+            .specimen()
+            .map_err(|e| anyhow::anyhow!("{}: {e}", self.file))
+    }
+
+    /// What a report says about how the record was read: its metadata,
+    /// the columns renamed or converted and its sign convention (empty for
+    /// a file in palpate's own format with nothing to say).
+    pub fn describe(&self) -> String {
+        let mut out = String::new();
+        for e in &self.metadata.entries {
+            if e.value.is_empty() {
+                out.push_str(&format!("  {}\n", e.key));
+            } else {
+                out.push_str(&format!("  {}: {}\n", e.key, e.value));
+            }
+        }
+        if !self.columns_read.is_empty() {
+            out.push_str(&format!("  columns: {}\n", self.columns_read.join("; ")));
+        }
+        if !self.sign.is_empty() && !(self.metadata.is_empty() && self.columns_read.is_empty()) {
+            out.push_str(&format!("  sign: {}\n", self.sign));
+        }
+        out
     }
 
     /// A record from a table already read (a file's, or the columns of an
@@ -161,6 +264,21 @@ impl TestData {
         table: Table,
         options: ReadOptions,
     ) -> anyhow::Result<TestData> {
+        let header = table.names.clone();
+        Self::from_parts(name, test, table, &Metadata::default(), &header, options)
+    }
+
+    /// [`TestData::from_table`] with the file's metadata and original
+    /// header, which tell whether it records a compression test ([`sign`]).
+    fn from_parts(
+        name: &str,
+        test: TestKind,
+        mut table: Table,
+        metadata: &Metadata,
+        header: &[String],
+        options: ReadOptions,
+    ) -> anyhow::Result<TestData> {
+        let sign = sign::resolve(&mut table, test, metadata, header, options.compression)?;
         let path = table.file.clone();
         let path = path.as_path();
         if options.axial_stretch != 1.0 && test != TestKind::SimpleShear {
@@ -234,6 +352,9 @@ impl TestData {
             observed,
             weight: options.weight,
             axial_stretch: options.axial_stretch,
+            metadata: Metadata::default(),
+            columns_read: Vec::new(),
+            sign,
         })
     }
 
@@ -262,7 +383,7 @@ pub const TESTS: [&str; 7] = [
 ];
 
 /// One data file and the test it records.
-#[derive(Debug, Clone, Deserialize)]
+#[derive(Debug, Clone, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DataSpec {
     /// CSV file, relative to the manifest's directory.
@@ -281,6 +402,18 @@ pub struct DataSpec {
     /// file whose header names the wrong unit (default: the header's).
     #[serde(default)]
     pub stress_unit: Option<String>,
+    /// `negative`, `positive` or `none`: how the file writes compression
+    /// (default: read from the data, refused when ambiguous).
+    #[serde(default)]
+    pub compression: Option<String>,
+    /// Columns chosen by name: `{ force = "Load", displacement = "Compression" }`
+    /// (keys time, displacement, force, stretch, strain, true_strain, stress,
+    /// true_stress).
+    #[serde(default)]
+    pub columns: Option<std::collections::BTreeMap<String, String>>,
+    /// Lines at the top of the file before its header (default: found).
+    #[serde(default)]
+    pub skip_rows: Option<usize>,
 }
 
 impl DataSpec {
@@ -295,6 +428,21 @@ impl DataSpec {
         }
         if let Some(u) = &self.stress_unit {
             o.set("stress_unit", u)?;
+        }
+        if let Some(c) = &self.compression {
+            o.set("compression", c)?;
+        }
+        for (k, v) in self.columns.iter().flatten() {
+            anyhow::ensure!(
+                Role::parse(k).is_some(),
+                "columns.{k}: unknown column role; expected one of {}",
+                Role::ALL.map(|r| r.key()).join(", ")
+            );
+            o.set(k, v)
+                .map_err(|e| anyhow::anyhow!("columns.{k}: {e}"))?;
+        }
+        if let Some(n) = self.skip_rows {
+            o.skip_rows = Some(n);
         }
         Ok(o)
     }

@@ -178,6 +178,7 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                                 weight: None,
                                 axial_stretch: None,
                                 stress_unit: None,
+                                ..DataSpec::default()
                             },
                         )
                     })

@@ -1,0 +1,415 @@
+//! Testing-machine files read as they come: the phantom compression tests
+//! of Dawood et al. (2026, CC BY 4.0; `tests/data/phantom_dawood2026/README.md`)
+//! with their metadata lines, column names with units and sign
+//! conventions, and copies of them written as other machines write files
+//! (compression positive, tabs, semicolons with decimal commas, trailing
+//! separators, a byte-order mark, no metadata, stresses in MPa).
+
+use palpate_analytic::Mode;
+use palpate_studies::records::{ReadOptions, TestData, TestKind};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn phantom(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/phantom_dawood2026")
+        .join(name)
+}
+
+const A1: &str = "EF10_0T_A1.csv";
+const UNIAXIAL: TestKind = TestKind::Homogeneous(Mode::Uniaxial);
+
+fn read(path: &Path, options: &[(&str, &str)]) -> anyhow::Result<TestData> {
+    let mut o = ReadOptions::default();
+    for (k, v) in options {
+        o.set(k, v)?;
+    }
+    TestData::read_with("uniaxial", UNIAXIAL, path, o)
+}
+
+fn err(path: &Path, options: &[(&str, &str)]) -> String {
+    format!("{:#}", read(path, options).unwrap_err())
+}
+
+/// A scratch directory of this test binary.
+fn scratch(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("palpate-records-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// The phantom file with each data row's fields passed through `row` (the
+/// fields as strings; metadata and header lines through `other`), joined by `sep`.
+fn rewrite(
+    name: &str,
+    out: &str,
+    other: impl Fn(usize, &str) -> Option<String>,
+    row: impl Fn(Vec<f64>) -> Vec<String>,
+    sep: &str,
+) -> PathBuf {
+    let text = std::fs::read_to_string(phantom(A1)).unwrap();
+    let mut s = String::new();
+    for (i, line) in text.lines().enumerate() {
+        let fields: Option<Vec<f64>> = line.split(',').map(|f| f.parse().ok()).collect();
+        match fields {
+            Some(v) if v.len() == 7 => {
+                s.push_str(&row(v).join(sep));
+                s.push('\n');
+            }
+            _ => {
+                if let Some(l) = other(i + 1, line) {
+                    s.push_str(&l);
+                    s.push('\n');
+                }
+            }
+        }
+    }
+    let p = scratch(name).join(out);
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
+fn as_is(v: Vec<f64>) -> Vec<String> {
+    v.iter().map(|x| x.to_string()).collect()
+}
+
+/// Columns: 0 time, 1 compression, 2 load, 3 strain, 4 stress kPa, 5 true strain, 6 true stress kPa.
+fn negate(cols: &'static [usize]) -> impl Fn(Vec<f64>) -> Vec<String> {
+    move |v| {
+        v.iter()
+            .enumerate()
+            .map(|(k, x)| if cols.contains(&k) { -x } else { *x }.to_string())
+            .collect()
+    }
+}
+
+#[test]
+fn the_phantom_file_loads_with_its_metadata_sign_and_units() {
+    let d = read(&phantom(A1), &[]).unwrap();
+    assert_eq!(d.observed.len(), 1202);
+    let stretch = &d.loading.drive;
+    // Last row: Engineering Strain -0.666668, Engineering Stress -254.303192 kPa.
+    assert!(
+        (stretch[1201] - (1.0 - 0.666668)).abs() < 1e-12,
+        "{}",
+        stretch[1201]
+    );
+    assert!(
+        (d.observed[1201] + 0.254303192).abs() < 1e-12,
+        "{}",
+        d.observed[1201]
+    );
+    assert_eq!(d.sign, "compression, written negative as palpate's");
+    let s = d.specimen().unwrap().unwrap();
+    assert_eq!((s.diameter_mm, s.height_mm), (Some(50.0), Some(30.0)));
+    assert_eq!(s.radius_mm(), Some(25.0));
+    assert_eq!(d.metadata.get("machine"), Some("INSTRON 5900"));
+    assert_eq!(d.metadata.get("speed"), Some("10"));
+    assert_eq!(d.metadata.entries[0].key, "EF10_0T_A_sample_1");
+    let about = d.describe();
+    for says in [
+        "Cylinder Diameter: 50mm",
+        "Load cell: 1kN",
+        "Engineering Stress (kPa) -> stress_kPa",
+        "sign: compression",
+    ] {
+        assert!(about.contains(says), "{about}");
+    }
+    // As a force record: compression and load are positive, as palpate takes them.
+    let f =
+        TestData::read_with("record", TestKind::C1, &phantom(A1), ReadOptions::default()).unwrap();
+    assert!((f.observed[1201] - 499.32315).abs() < 1e-9);
+    assert!((f.loading.drive[1201] - 20.00004).abs() < 1e-9);
+    assert_eq!(f.sign, "compression, written positive as palpate's");
+    // The other phantom (10 kN load cell) too.
+    let b3 = read(&phantom("EF30_50T_B3.csv"), &[]).unwrap();
+    assert!((b3.observed.last().unwrap() + 0.128142159).abs() < 1e-12);
+}
+
+#[test]
+fn compression_written_positive_is_refused_unless_declared_then_read_the_same() {
+    let original = read(&phantom(A1), &[]).unwrap();
+    // Strains and stresses positive in compression (the force columns as they are).
+    let positive = rewrite(
+        "positive",
+        "positive.csv",
+        |_, l| Some(l.to_string()),
+        negate(&[3, 4, 5, 6]),
+        ",",
+    );
+    let e = err(&positive, &[]);
+    for says in [
+        "positive.csv:",
+        "ambiguous",
+        "line 2 says `Compression test`",
+        "compression=positive",
+        "--compression positive",
+        "compression=none",
+    ] {
+        assert!(e.contains(says), "{e}");
+    }
+    let d = read(&positive, &[("compression", "positive")]).unwrap();
+    assert_eq!(d.observed, original.observed);
+    assert_eq!(d.loading.drive, original.loading.drive);
+    assert_eq!(
+        d.sign,
+        "compression, written positive in the file, converted"
+    );
+    // The sign contradicts what is declared: refused.
+    let e = err(&positive, &[("compression", "negative")]);
+    assert!(
+        e.contains("compression=negative, but `strain` is")
+            && e.contains("set compression=positive"),
+        "{e}"
+    );
+    let e = err(&phantom(A1), &[("compression", "positive")]);
+    assert!(
+        e.contains("compression=positive, but `strain` is -0.666668"),
+        "{e}"
+    );
+    let e = err(&phantom(A1), &[("compression", "none")]);
+    assert!(
+        e.contains("compression=none (a tension test), but `strain` is -0.666668"),
+        "{e}"
+    );
+    // A tension test (no word of compression) reads as tension; declared as
+    // compression it is refused.
+    let tension = rewrite(
+        "tension",
+        "tension.csv",
+        |i, l| (i >= 8).then(|| l.replace("Compression (mm)", "Extension (mm)")),
+        negate(&[3, 4, 5, 6]),
+        ",",
+    );
+    let t = read(&tension, &[]).unwrap();
+    assert_eq!(t.sign, "tension");
+    assert!(t.observed[1201] > 0.25);
+    let e = err(&tension, &[("compression", "negative")]);
+    assert!(
+        e.contains("tension.csv:") && e.contains("compression=negative, but"),
+        "{e}"
+    );
+    // A force record written negative in compression.
+    let neg = rewrite(
+        "force",
+        "force.csv",
+        |_, l| Some(l.to_string()),
+        negate(&[1, 2]),
+        ",",
+    );
+    let c1 = |o: ReadOptions| TestData::read_with("record", TestKind::C1, &neg, o);
+    let e = format!("{:#}", c1(ReadOptions::default()).unwrap_err());
+    assert!(
+        e.contains("`displacement_mm` is -20.00004") && e.contains("compression=negative"),
+        "{e}"
+    );
+    let mut o = ReadOptions::default();
+    o.set("compression", "negative").unwrap();
+    let f = c1(o).unwrap();
+    assert!((f.observed[1201] - 499.32315).abs() < 1e-9);
+}
+
+#[test]
+fn tabs_semicolons_trailing_separators_bom_and_no_metadata_read_the_same() {
+    let original = read(&phantom(A1), &[]).unwrap();
+    let drop_meta = |i: usize, l: &str| (i >= 8).then(|| l.to_string());
+    let keep = |_: usize, l: &str| Some(l.to_string());
+    let decimal_comma = |v: Vec<f64>| -> Vec<String> {
+        v.iter().map(|x| x.to_string().replace('.', ",")).collect()
+    };
+    let files = [
+        rewrite(
+            "sep",
+            "tab.csv",
+            |_, l| Some(l.replace(',', "\t")),
+            as_is,
+            "\t",
+        ),
+        rewrite(
+            "sep",
+            "semicolon.csv",
+            |_, l| Some(l.replace(',', ";")),
+            decimal_comma,
+            ";",
+        ),
+        rewrite(
+            "sep",
+            "trailing.csv",
+            |_, l| Some(format!("{l},")),
+            |v| {
+                let mut f = as_is(v);
+                f.push(String::new());
+                f
+            },
+            ",",
+        ),
+        rewrite("sep", "no_metadata.csv", drop_meta, as_is, ","),
+        rewrite(
+            "sep",
+            "bom.csv",
+            |i, l| {
+                Some(if i == 1 {
+                    format!("\u{feff}{l}")
+                } else {
+                    l.to_string()
+                })
+            },
+            as_is,
+            ",",
+        ),
+        rewrite("sep", "crlf.csv", |_, l| Some(format!("{l}\r")), as_is, ","),
+        // Stresses given in MPa.
+        rewrite(
+            "sep",
+            "mpa.csv",
+            |_, l| Some(l.replace("(kPa)", "(MPa)")),
+            |v| {
+                v.iter()
+                    .enumerate()
+                    .map(|(k, x)| if k == 4 || k == 6 { x / 1000.0 } else { *x }.to_string())
+                    .collect()
+            },
+            ",",
+        ),
+        rewrite("sep", "same.csv", keep, as_is, ","),
+    ];
+    for f in &files {
+        let d = read(f, &[]).unwrap_or_else(|e| panic!("{}: {e:#}", f.display()));
+        assert_eq!(d.loading.drive.len(), 1202, "{}", f.display());
+        for (a, b) in d.observed.iter().zip(&original.observed) {
+            assert!(
+                (a - b).abs() <= 1e-15 * b.abs().max(1e-3),
+                "{}: {a} {b}",
+                f.display()
+            );
+        }
+        assert_eq!(d.loading.drive, original.loading.drive, "{}", f.display());
+    }
+    // One stress column relabelled MPa without its values changed: refused,
+    // naming the column.
+    let half = rewrite(
+        "sep",
+        "half_mpa.csv",
+        |_, l| Some(l.replace("Engineering Stress (kPa)", "Engineering Stress (MPa)")),
+        as_is,
+        ",",
+    );
+    let e = err(&half, &[]);
+    assert!(
+        e.contains("half_mpa.csv:")
+            && e.contains("column `true_stress_kPa`")
+            && e.contains("disagree"),
+        "{e}"
+    );
+}
+
+#[test]
+fn columns_chosen_by_name_and_rows_to_skip() {
+    let original = read(&phantom(A1), &[]).unwrap();
+    // The true pair alone, converted to the nominal stress of the stretch it gives.
+    let t = read(
+        &phantom(A1),
+        &[
+            ("true_strain", "True Strain"),
+            ("true_stress", "True Stress (kPa)"),
+        ],
+    )
+    .unwrap();
+    for (a, b) in t.observed.iter().zip(&original.observed).skip(100) {
+        assert!((a - b).abs() < 1e-3 * b.abs() + 1e-7, "{a} {b}");
+    }
+    let e = err(&phantom(A1), &[("stress", "Stress")]);
+    assert!(
+        e.contains("stress=Stress: no column `Stress` (header has: Time (s), Compression (mm)"),
+        "{e}"
+    );
+    let e = read(&phantom(A1), &[("force", "Load"), ("force", "Time")]).unwrap_err();
+    assert!(
+        format!("{e:#}").contains("the force column is already chosen (force=Load)"),
+        "{e:#}"
+    );
+    let d = read(&phantom(A1), &[("skip_rows", "7")]).unwrap();
+    assert_eq!(d.metadata.entries.len(), 7);
+    let e = err(&phantom(A1), &[("skip_rows", "3")]);
+    assert!(
+        e.contains("EF10_0T_A1.csv:4: `Cylinder Height: 30mm;`"),
+        "{e}"
+    );
+}
+
+fn palpate(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_palpate"))
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+#[test]
+fn calibrate_reads_the_phantom_file_and_its_positive_copy_to_the_same_fit() {
+    let file = phantom(A1);
+    let data = format!("uniaxial={}", file.display());
+    let out = palpate(&["calibrate", "--law", "neo-hookean", "--data", &data]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("Cylinder Height: 30mm") && stderr.contains("sign: compression"),
+        "{stderr}"
+    );
+    let original = String::from_utf8_lossy(&out.stdout).to_string();
+    let positive = rewrite(
+        "cli",
+        "positive.csv",
+        |_, l| Some(l.to_string()),
+        negate(&[3, 4, 5, 6]),
+        ",",
+    );
+    let data = format!("uniaxial={}", positive.display());
+    let out = palpate(&["calibrate", "--law", "neo-hookean", "--data", &data]);
+    assert!(!out.status.success());
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("--compression positive"), "{stderr}");
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &data,
+        "--compression",
+        "positive",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(String::from_utf8_lossy(&out.stdout), original);
+    // Columns chosen on the command line, overridden in brackets.
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--column",
+        "stress=Nothing",
+        "--data",
+        &format!("uniaxial[stress=Engineering Stress]={}", file.display()),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--column",
+        "load=Load",
+        "--data",
+        &data,
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("--column load=Load: unknown role `load`"),
+        "{stderr}"
+    );
+}
