@@ -46,6 +46,9 @@
 //! [models.press-analytic.c1]  # C1 compression (analytic, lubricated)
 //! law = "neo-hookean"
 //!
+//! [models.disc]               # a lab's own experiment (finite elements, [`experiment`])
+//! experiment = "gel"          # a table [experiments.gel] of the manifest, a preset (N1, ...) or a file
+//!
 //! [models.tension.homogeneous] # homogeneous test (analytic)
 //! law = "mooney-rivlin"
 //! mode = "uniaxial"           # uniaxial | biaxial | planar | general_biaxial | simple_shear
