@@ -219,6 +219,35 @@ impl RigidSurface for Wheel2d {
     }
 }
 
+/// A fixed rigid base under a 2D body: the line `y = 0` (tool-local) with
+/// the body above it, so its normal is `(0, 1)` (from the base into the
+/// body) and its tangent `(-1, 0)`; `xi = -x`. The lower platen or the
+/// rigid support a specimen rests on with Coulomb friction.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Floor2d;
+
+impl RigidSurface for Floor2d {
+    fn dim(&self) -> usize {
+        2
+    }
+    fn project(&self, p: [f64; 3]) -> SurfacePoint {
+        SurfacePoint {
+            gap: p[1],
+            normal: [0.0, 1.0, 0.0],
+            tangent: [-1.0, 0.0, 0.0],
+            xi: -p[0],
+            dxi: [-1.0, 0.0, 0.0],
+            ..SurfacePoint::default()
+        }
+    }
+    fn name(&self) -> String {
+        "rigid base".into()
+    }
+    fn check(&self) -> Result<(), String> {
+        Ok(())
+    }
+}
+
 /// A [`ToolShape`] profile revolved about the tool's z axis, for 3D models
 /// (`r = sqrt(x^2 + y^2)`). `Revolution3d(ToolShape::Platen)` is the plane
 /// `z = 0` with normal `(0, 0, -1)`.

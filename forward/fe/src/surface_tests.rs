@@ -211,6 +211,20 @@ fn revolution3d_derivatives_match_finite_differences() {
     }
 }
 
+/// The rigid base: gap is the height above it, the normal points up into
+/// the body, `xi = -x` along the tangent `(-1, 0)`.
+#[test]
+fn floor_derivatives_match_finite_differences() {
+    for q in [[0.0, 0.3], [2.0, -0.1], [-1.0, 4.0]] {
+        let p = [q[0], q[1], 0.0];
+        check_fd(&Floor2d, p, &|_| true);
+        let sp = Floor2d.project(p);
+        assert_eq!(sp.gap, q[1]);
+        assert_eq!(sp.normal, [0.0, 1.0, 0.0]);
+        assert_eq!(sp.xi, -q[0]);
+    }
+}
+
 #[test]
 fn wheels_derivatives_match_finite_differences() {
     let w = Wheel2d { radius: 2.5 };

@@ -31,6 +31,53 @@ impl Mesh {
         Ok(Self::tensor(&rs, &zs))
     }
 
+    /// [`Mesh::graded_rectangle`] cut into horizontal bands at the given
+    /// depths below the top (`interfaces`, increasing, inside `(0,
+    /// height)`): each depth is a mesh line (inserted into the axial
+    /// grading; a graded line closer to it than a third of the local
+    /// spacing is dropped, so no sliver element is made), and the cells of
+    /// band `i` (from the top) are region `layer{i}`. Without interfaces it
+    /// is exactly [`Mesh::graded_rectangle`] (one region `body`).
+    pub fn graded_layers(
+        width: f64,
+        height: f64,
+        radial: Grading,
+        axial: Grading,
+        interfaces: &[f64],
+    ) -> Result<Mesh, FeError> {
+        if interfaces.is_empty() {
+            return Self::graded_rectangle(width, height, radial, axial);
+        }
+        let bad = |reason: String| FeError::InvalidMesh {
+            field: "interfaces".into(),
+            reason,
+        };
+        let mut last = 0.0;
+        for &t in interfaces {
+            if !(t > last && t < height) {
+                return Err(bad(format!(
+                    "depths {interfaces:?} must increase strictly inside (0, {height})"
+                )));
+            }
+            last = t;
+        }
+        let from_top = with_lines(&axial.positions(height)?, interfaces);
+        let zs: Vec<f64> = from_top.iter().rev().map(|t| height - t).collect();
+        let mut m = Self::tensor(&radial.positions(width)?, &zs);
+        let mut bands: Vec<Vec<usize>> = vec![Vec::new(); interfaces.len() + 1];
+        for e in 0..m.cell_count() {
+            let yc = m.cell(e).iter().map(|&n| m.nodes[n][1]).sum::<f64>() / 4.0;
+            let depth = height - yc;
+            let band = interfaces.iter().filter(|&&t| t < depth).count();
+            bands[band].push(e);
+        }
+        m.regions.clear();
+        for (i, cells) in bands.into_iter().enumerate() {
+            m.regions.insert(format!("layer{i}"), cells);
+        }
+        Ok(m)
+    }
+
     /// Tensor-product mesh of 4-node quadrilaterals on the coordinate lines
     /// `xs` (increasing) x `ys` (increasing); node `(i, j)` is `j * xs.len() + i`.
     pub fn tensor(xs: &[f64], ys: &[f64]) -> Mesh {
@@ -66,6 +113,39 @@ impl Mesh {
             .insert("body".into(), (0..m.cell_count()).collect());
         m
     }
+}
+
+/// `positions` (increasing, from 0) with the `lines` inserted; a graded
+/// position (not an end, not a line) closer to a line than a third of the
+/// interval the line falls in is dropped.
+pub fn with_lines(positions: &[f64], lines: &[f64]) -> Vec<f64> {
+    let mut out = positions.to_vec();
+    let mut fixed: Vec<f64> = vec![out[0], out[out.len() - 1]];
+    for &l in lines {
+        let k = out.partition_point(|&p| p < l);
+        // a line on a graded position (to rounding) is that position
+        let tol = 1e-9 * out[out.len() - 1];
+        if let Some(j) = [k.wrapping_sub(1), k]
+            .into_iter()
+            .find(|&j| j < out.len() && (out[j] - l).abs() <= tol)
+        {
+            if j != 0 && j != out.len() - 1 {
+                out[j] = l;
+            }
+            fixed.push(out[j]);
+            continue;
+        }
+        let (lo, hi) = (out[k - 1], out[k]);
+        let h = hi - lo;
+        out.insert(k, l);
+        fixed.push(l);
+        // the nearer neighbour, if it is free and too close
+        let (near, j) = if l - lo < hi - l { (lo, k - 1) } else { (hi, k + 1) };
+        if (near - l).abs() < h / 3.0 && !fixed.contains(&near) {
+            out.remove(j);
+        }
+    }
+    out
 }
 
 impl Mesh {
@@ -173,6 +253,39 @@ impl Mesh {
 mod tests {
     use super::super::jacobian::corner_jacobians;
     use super::*;
+
+    /// Interfaces become mesh lines without slivers, the bands become
+    /// regions, and without interfaces the mesh is the graded rectangle.
+    #[test]
+    fn layers_are_mesh_lines_and_regions() {
+        let p = with_lines(&[0.0, 1.0, 2.0, 3.0, 4.0], &[1.1, 2.5, 4.0]);
+        assert_eq!(p, vec![0.0, 1.1, 2.0, 2.5, 3.0, 4.0]);
+        let g = Grading {
+            h_fine: 0.5,
+            fine_length: 2.0,
+            growth: 1.3,
+        };
+        let m = Mesh::graded_layers(5.0, 10.0, g, g, &[1.2, 3.0]).unwrap();
+        let ys: Vec<f64> = (0..m.nodes.len())
+            .filter(|&n| m.nodes[n][0] == 0.0)
+            .map(|n| m.nodes[n][1])
+            .collect();
+        for t in [1.2, 3.0] {
+            assert!(ys.iter().any(|&y| (y - (10.0 - t)).abs() < 1e-12), "{ys:?}");
+        }
+        for w in ys.windows(2) {
+            assert!(w[1] - w[0] > 0.15, "{ys:?}");
+        }
+        let top = m.region("layer0").unwrap().len();
+        let mid = m.region("layer1").unwrap().len();
+        let bottom = m.region("layer2").unwrap().len();
+        assert_eq!(top + mid + bottom, m.cell_count());
+        assert!(top > 0 && mid > 0 && bottom > 0);
+        assert!(m.region("body").is_err());
+        let plain = Mesh::graded_layers(5.0, 10.0, g, g, &[]).unwrap();
+        assert_eq!(plain, Mesh::graded_rectangle(5.0, 10.0, g, g).unwrap());
+        assert!(Mesh::graded_layers(5.0, 10.0, g, g, &[3.0, 1.0]).is_err());
+    }
 
     #[test]
     fn rectangle_sets_and_orientation() {

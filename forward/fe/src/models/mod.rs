@@ -1,7 +1,9 @@
 //! The forward models built on the layer, one [`crate::model::Setup`] each
 //! (the reference problems of docs/benchmarks.md) and the models made of them:
 //!
-//! * [`n1`] — N1, needle indentation of a cylinder (axisymmetric);
+//! * [`n1`] — N1, needle indentation of a cylinder (axisymmetric), and
+//!   [`cylinder`], the axisymmetric cylinder of an experiment description
+//!   (N1's setup with any tool, support, layers and materials);
 //! * [`n3`] — N3, the same needle on a block in 3D (quarter model);
 //! * [`c1`] — C1, compression of a short cylinder between platens;
 //! * [`q1`] — Q1, flat-punch ramp-and-hold indentation, and
@@ -11,6 +13,7 @@
 //!   [`r2_scan`], the force of the wheel rolled past one nodule.
 
 pub mod c1;
+pub mod cylinder;
 pub mod n1;
 pub mod n3;
 pub mod q1;

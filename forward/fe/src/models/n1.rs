@@ -5,7 +5,18 @@
 //! positive in compression.
 //!
 //! The mesh is graded toward the indentation point ([`N1Setup::mesh`]); the
-//! contact surface is the whole top face. Effects:
+//! contact surface is the whole top face.
+//!
+//! The setup is the axisymmetric cylinder of any experiment description
+//! ([`crate::cylinder`], [`N1Setup::from_experiment`]): any [`ToolShape`]
+//! on the axis (a platen over the whole top), the tool's friction a number,
+//! a parameter or infinite (bonded: a point sticks where it first touches),
+//! the base bonded, sliding, or on a fixed rigid plane with Coulomb
+//! friction ([`N1Setup::base_friction`], a number or a parameter),
+//! horizontal bands of several materials ([`N1Setup::layers`]), Prony
+//! terms fixed or as parameters, and a mesh by a sizing rule at any level
+//! ([`Sizing`], [`N1Needle::with_level`]). N1 is the preset with none of
+//! these. Effects:
 //!
 //! * `friction` — the friction coefficient becomes a parameter (bounds 0..2).
 //! * `boundary_condition` — the base slides radially (`u_z = 0` only) instead
@@ -19,12 +30,15 @@
 //! * `zero_offset` — contact starts at a recorded displacement d0
 //!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
 
-use palpate_core::{enrichable::not_applicable, Effect, ForwardError, ForwardModel, ParamSpace};
-use palpate_enrich::{richer_law, MaterialForm, ZeroOffset};
+use palpate_core::{
+    enrichable::not_applicable, Effect, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec,
+};
+use palpate_enrich::{prony_params, richer_law, MaterialForm, ZeroOffset};
 use palpate_material::Law;
 use std::sync::Arc;
 
 use crate::body::{RegionMaterial, SolidBody};
+use crate::material::LawMaterial;
 use crate::contact::{ContactOptions, ContactPoints, RigidContact};
 use crate::contribution::Contribution;
 use crate::discretisation::{Coarser, ConvergenceOrder};
@@ -36,7 +50,7 @@ use crate::model::{
     doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup, Support,
 };
 use crate::motion::ToolMotion;
-use crate::surface::Profile2d;
+use crate::surface::{Floor2d, Profile2d};
 use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
@@ -94,11 +108,11 @@ pub type N1Needle = FeModel<N1Setup>;
 /// The N1 experiment ([`N1Needle`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct N1Setup {
-    law: Law,
+    pub(crate) law: Law,
     /// The law's parameter space when it is not [`law_space`]`(law)`: the
     /// richer law of the `material_form` enrichment, whose added modulus
     /// is >= 0.
-    law_bounds: Option<ParamSpace>,
+    pub(crate) law_bounds: Option<ParamSpace>,
     pub bulk: Bulk,
     pub friction: f64,
     pub tool: ToolShape,
@@ -138,7 +152,87 @@ pub struct N1Setup {
     pub prony: Option<Prony>,
     pub options: SolverOptions,
     /// Friction is the parameter after the law's (the `friction` effect).
-    friction_is_parameter: bool,
+    pub(crate) friction_is_parameter: bool,
+    /// Number of Prony terms of the law's material taken from the
+    /// parameters after the law's (`g1, tau1_s, ...`; 0: `prony` fixed).
+    pub(crate) prony_parameters: usize,
+    /// Horizontal bands of the cylinder from the top down: thickness (mm)
+    /// and material (0: the law's, `k > 0`: `materials[k - 1]`); each band
+    /// is its own region `layer{i}` with mesh lines at the interfaces.
+    /// Empty: one region `body` (N1).
+    pub layers: Vec<(f64, usize)>,
+    /// The materials after the law's, in the order of their parameters.
+    pub materials: Vec<BandMaterial>,
+    /// `Some(mu)`: the base rests on a fixed rigid plane with Coulomb
+    /// friction `mu` (unilateral; `base` is then not used); `None`: the
+    /// base is held as `base` says.
+    pub base_friction: Option<f64>,
+    /// The base's friction coefficient is the last parameter.
+    pub(crate) base_friction_is_parameter: bool,
+    /// When set, the mesh is graded by this sizing rule at its level
+    /// (unless `grading` is set): the rule of a described experiment.
+    pub sizing: Option<Sizing>,
+    /// The parameter space of a description (its names, bounds and
+    /// starts); `None`: derived from the law and the options.
+    pub(crate) space: Option<ParamSpace>,
+    /// The name of the law's material (the prefix of its parameters when
+    /// there are band materials).
+    pub first_material: String,
+}
+
+/// A material of a band after the law's ([`N1Setup::layers`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct BandMaterial {
+    /// The material's name (its parameters are prefixed with it).
+    pub name: String,
+    pub law: Law,
+    pub bulk: Bulk,
+    /// A fixed Prony series on its isochoric stress.
+    pub prony: Option<Prony>,
+    /// Prony terms taken from the parameters after its law's.
+    pub prony_parameters: usize,
+}
+
+impl BandMaterial {
+    /// The number of its parameters (law, then Prony terms).
+    fn param_count(&self) -> usize {
+        self.law.params().len() + 2 * self.prony_parameters
+    }
+}
+
+/// The mesh of a described experiment: at level `level`, elements of
+/// `h / level` mm in a zone of `fine_zone` mm (radial from the axis and
+/// axial from the top) growing by `1 + growth / level` beyond it. The
+/// needle's rule with `h = 0.4`, `fine_zone = 5`, `growth = 0.2` is N1's
+/// [`MeshDensity`] at integer levels, bit for bit.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Sizing {
+    pub h: f64,
+    pub fine_zone: f64,
+    pub growth: f64,
+    /// Any level > 0 (elements scale as `1 / level`).
+    pub level: f64,
+}
+
+impl Sizing {
+    /// N1's rule ([`MeshDensity`]) at `level`.
+    pub fn needle(level: f64) -> Sizing {
+        Sizing {
+            h: 0.4,
+            fine_zone: 5.0,
+            growth: 0.2,
+            level,
+        }
+    }
+
+    /// The grading at this level.
+    pub fn grading(&self) -> Grading {
+        Grading {
+            h_fine: self.h / self.level,
+            fine_length: self.fine_zone,
+            growth: 1.0 + self.growth / self.level,
+        }
+    }
 }
 
 /// The contributions of the N1 system.
@@ -146,6 +240,8 @@ pub struct N1Setup {
 pub struct N1Parts {
     body: Part<SolidBody>,
     contact: Part<RigidContact>,
+    /// The rigid base and the element size along it.
+    base: Option<(Part<RigidContact>, f64)>,
 }
 
 impl N1Needle {
@@ -186,7 +282,29 @@ impl N1Needle {
                 ..SolverOptions::default()
             },
             friction_is_parameter: false,
+            prony_parameters: 0,
+            layers: Vec::new(),
+            materials: Vec::new(),
+            base_friction: None,
+            base_friction_is_parameter: false,
+            sizing: None,
+            space: None,
+            first_material: "body".into(),
         })
+    }
+
+    /// The same experiment meshed at `level` (> 0; any real: element sizes
+    /// scale as `1 / level`) by its sizing rule (N1's [`MeshDensity`] rule
+    /// for a model without one), e.g. for a mesh chosen for an accuracy.
+    pub fn with_level(&self, level: f64) -> N1Needle {
+        let mut s = self.setup().clone();
+        let rule = s.sizing.unwrap_or_else(|| Sizing {
+            fine_zone: s.fine_zone,
+            ..Sizing::needle(level)
+        });
+        s.sizing = Some(Sizing { level, ..rule });
+        s.grading = None;
+        FeModel::from_setup(s)
     }
 
     /// The coarser companion of the discretisation error estimate: the same
@@ -206,16 +324,97 @@ impl N1Setup {
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
-        let m = Mesh::graded_rectangle(self.radius, self.height, g, g)?;
+        let m = Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?;
         match self.element {
             PlaneCell::Quad4 => Ok(m),
             PlaneCell::Quad9 => m.to_quadratic(),
         }
     }
 
-    fn effective_grading(&self) -> Grading {
-        self.grading
-            .unwrap_or_else(|| self.mesh.grading(self.fine_zone))
+    /// The grading in use (radial from the axis and axial from the top).
+    pub fn effective_grading(&self) -> Grading {
+        self.grading.unwrap_or_else(|| match self.sizing {
+            Some(s) => s.grading(),
+            None => self.mesh.grading(self.fine_zone),
+        })
+    }
+
+    /// The depths of the band interfaces below the top (mm).
+    fn interfaces(&self) -> Vec<f64> {
+        let mut t = 0.0;
+        let mut out = Vec::new();
+        for (thickness, _) in self.layers.iter().take(self.layers.len().saturating_sub(1)) {
+            t += thickness;
+            out.push(t);
+        }
+        out
+    }
+
+    /// The regions of the body.
+    fn regions(&self) -> Vec<String> {
+        if self.layers.is_empty() {
+            vec!["body".into()]
+        } else {
+            (0..self.layers.len()).map(|i| format!("layer{i}")).collect()
+        }
+    }
+
+    /// Number of Prony terms of the law's material taken from the
+    /// parameters.
+    pub fn prony_parameters(&self) -> usize {
+        self.prony_parameters
+    }
+
+    /// Whether the tool's friction is a parameter.
+    pub fn friction_is_parameter(&self) -> bool {
+        self.friction_is_parameter
+    }
+
+    /// Whether the base's friction is a parameter.
+    pub fn base_friction_is_parameter(&self) -> bool {
+        self.base_friction_is_parameter
+    }
+
+    /// The parameters after the law's: its Prony terms, then each band
+    /// material's, then the tool's and the base's friction; `(prony of the
+    /// law, per material its slice, friction, base friction)`.
+    #[allow(clippy::type_complexity)]
+    fn split_extra<'a>(
+        &self,
+        extra: &'a [f64],
+    ) -> Result<(&'a [f64], Vec<&'a [f64]>, Option<f64>, Option<f64>), FeError> {
+        let need = 2 * self.prony_parameters
+            + self.materials.iter().map(BandMaterial::param_count).sum::<usize>()
+            + usize::from(self.friction_is_parameter)
+            + usize::from(self.base_friction_is_parameter);
+        if extra.len() < need {
+            return Err(FeError::InvalidConfig {
+                field: "parameters".into(),
+                reason: format!(
+                    "{} parameters after the law's, {need} expected",
+                    extra.len()
+                ),
+            });
+        }
+        let (prony, mut rest) = extra.split_at(2 * self.prony_parameters);
+        let mut mats = Vec::new();
+        for m in &self.materials {
+            let (p, r) = rest.split_at(m.param_count());
+            mats.push(p);
+            rest = r;
+        }
+        let mut next = rest.iter().copied();
+        let friction = if self.friction_is_parameter {
+            next.next()
+        } else {
+            None
+        };
+        let base = if self.base_friction_is_parameter {
+            next.next()
+        } else {
+            None
+        };
+        Ok((prony, mats, friction, base))
     }
 
     /// The order of convergence of the force with the element size. Q1/P0,
@@ -256,49 +455,137 @@ impl Setup for N1Setup {
     fn set_law(&mut self, law: Law) {
         self.law = law;
         self.law_bounds = None;
+        self.space = None;
     }
     fn param_space(&self) -> ParamSpace {
+        if let Some(space) = &self.space {
+            return space.clone();
+        }
         let law = self
             .law_bounds
             .clone()
             .unwrap_or_else(|| law_space(&self.law));
-        if self.friction_is_parameter {
-            law.extended(&[friction_param(self.friction)])
-        } else {
-            law
+        let prefixed = !self.materials.is_empty();
+        let prefix = |space: ParamSpace, name: &str| -> Vec<ParamSpec> {
+            space
+                .params
+                .iter()
+                .map(|p| ParamSpec {
+                    name: if prefixed {
+                        format!("{name}_{}", p.name)
+                    } else {
+                        p.name.clone()
+                    },
+                    ..p.clone()
+                })
+                .collect()
+        };
+        let mut specs = prefix(
+            law.extended(&prony_params(self.prony_parameters)),
+            &self.first_material,
+        );
+        for m in &self.materials {
+            specs.extend(prefix(
+                law_space(&m.law).extended(&prony_params(m.prony_parameters)),
+                &m.name,
+            ));
         }
+        if self.friction_is_parameter {
+            specs.push(friction_param(self.friction));
+        }
+        if self.base_friction_is_parameter {
+            specs.push(ParamSpec {
+                name: "base_friction".into(),
+                ..friction_param(self.base_friction.unwrap_or(0.0))
+            });
+        }
+        ParamSpace::new(specs)
     }
     fn bulk(&self) -> Bulk {
         self.bulk
     }
-    fn options(&self) -> SolverOptions {
-        self.options
-    }
     fn prony(&self) -> Option<&Prony> {
         self.prony.as_ref()
     }
+    fn prony_for(&self, extra: &[f64]) -> Result<Option<Prony>, FeError> {
+        if self.prony_parameters == 0 {
+            return Ok(self.prony.clone());
+        }
+        prony_of(&extra[..(2 * self.prony_parameters).min(extra.len())]).map(Some)
+    }
+    fn options(&self) -> SolverOptions {
+        let mut o = self.options;
+        // a band material's relaxation sets the time step when the law's
+        // material is elastic (the run sets it from the law's otherwise)
+        if o.max_time_step.is_none() && self.prony.is_none() && self.prony_parameters == 0 {
+            let shortest = self
+                .materials
+                .iter()
+                .filter_map(|m| m.prony.as_ref().map(Prony::shortest_time))
+                .fold(f64::INFINITY, f64::min);
+            if shortest.is_finite() {
+                o.max_time_step = Some(0.1 * shortest);
+            }
+        }
+        o
+    }
+    fn check_loading(&self, loading: &Loading) -> Result<(), ForwardError> {
+        let viscous = self
+            .materials
+            .iter()
+            .any(|m| m.prony.is_some() || m.prony_parameters > 0);
+        if viscous && loading.time.is_none() {
+            return Err(ForwardError::InvalidLoading(
+                "a viscoelastic material needs the time of each sample".into(),
+            ));
+        }
+        if let Some(&d) = loading
+            .drive
+            .iter()
+            .find(|&&d| !(d.is_finite() && d < self.height))
+        {
+            return Err(ForwardError::InvalidLoading(format!(
+                "a depth of {d} mm: the tool must stay above the base ({} mm below the top)",
+                self.height
+            )));
+        }
+        Ok(())
+    }
     fn build(&self) -> Result<(System, N1Parts), FeError> {
-        if !(self.friction >= 0.0 && self.friction.is_finite()) {
+        if !(self.friction >= 0.0) {
             return Err(FeError::InvalidConfig {
                 field: "friction".into(),
-                reason: format!("{} must be >= 0", self.friction),
+                reason: format!("{} must be >= 0 (infinite: bonded)", self.friction),
             });
+        }
+        if let Some(mu) = self.base_friction {
+            if !(mu >= 0.0) {
+                return Err(FeError::InvalidConfig {
+                    field: "base_friction".into(),
+                    reason: format!("{mu} must be >= 0 (infinite: bonded)"),
+                });
+            }
         }
         let mesh = self.build_mesh()?;
         let kin = Kinematics::Axisymmetric;
+        let regions = self.regions();
+        let region_refs: Vec<&str> = regions.iter().map(String::as_str).collect();
         let body = SolidBody::new(
             "body",
             &mesh,
-            &["body"],
+            &region_refs,
             {
                 let (cell, pressure) = self.element.element();
                 kernel_for(cell, kin, pressure)?
             },
             self.bulk.exact(),
         )?;
-        let mut bcs = vec![Dirichlet::fixed("axis", 0), Dirichlet::fixed("bottom", 1)];
-        if self.base == Support::Bonded {
-            bcs.push(Dirichlet::fixed("bottom", 0));
+        let mut bcs = vec![Dirichlet::fixed("axis", 0)];
+        if self.base_friction.is_none() {
+            bcs.push(Dirichlet::fixed("bottom", 1));
+            if self.base == Support::Bonded {
+                bcs.push(Dirichlet::fixed("bottom", 0));
+            }
         }
         // Penalties scale with the initial shear modulus, set per run.
         let options = ContactOptions {
@@ -319,10 +606,37 @@ impl Setup for N1Setup {
             options,
             1,
         )?;
+        let base = match self.base_friction {
+            None => None,
+            Some(mu) => {
+                // the element size along the base, for its penalty
+                let bottom = mesh.facet_set("bottom")?;
+                let h = bottom
+                    .iter()
+                    .map(|f| (mesh.nodes[f[1]][0] - mesh.nodes[f[0]][0]).abs())
+                    .fold(0.0, f64::max);
+                let floor = RigidContact::new(
+                    "base",
+                    Box::new(Floor2d),
+                    ToolMotion::translating([0.0; 3], Vec::new()),
+                    &mesh,
+                    "bottom",
+                    kin,
+                    ContactOptions {
+                        friction: mu,
+                        points: ContactPoints::EdgeGauss,
+                        ..options
+                    },
+                    1,
+                )?;
+                Some((floor, h))
+            }
+        };
         let mut parts = Parts::new();
         let handles = N1Parts {
             body: parts.add(body),
             contact: parts.add(contact),
+            base: base.map(|(floor, h)| (parts.add(floor), h)),
         };
         Ok((System::from_parts(mesh, 2, parts, &bcs, 1)?, handles))
     }
@@ -335,16 +649,37 @@ impl Setup for N1Setup {
     ) -> Result<(), FeError> {
         let mu = material.material.shear_modulus();
         let h = self.effective_grading().h_fine;
+        let (_, mats, friction, base_friction) = self.split_extra(extra)?;
         sys.force_floor = 1e-6 * mu * sys.mesh.min_edge().powi(2);
-        sys.get_mut(parts.body)?.set_material("body", material)?;
+        let body = sys.get_mut(parts.body)?;
+        if self.layers.is_empty() {
+            body.set_material("body", material)?;
+        } else {
+            let mut band_materials = vec![material];
+            for (m, p) in self.materials.iter().zip(mats) {
+                band_materials.push(band_material(m, p)?);
+            }
+            for (i, (_, k)) in self.layers.iter().enumerate() {
+                let m = band_materials
+                    .get(*k)
+                    .ok_or_else(|| FeError::InvalidConfig {
+                        field: format!("layers[{i}]"),
+                        reason: format!("material {k} of {}", band_materials.len()),
+                    })?
+                    .clone();
+                body.set_material(&format!("layer{i}"), m)?;
+            }
+        }
         let cs = sys.get_mut(parts.contact)?;
         cs.options.penalty_normal = self.penalty * mu / h;
         cs.options.penalty_tangent = self.penalty * mu / h;
-        cs.options.friction = if self.friction_is_parameter {
-            extra.first().copied().unwrap_or(self.friction)
-        } else {
-            self.friction
-        };
+        cs.options.friction = friction.unwrap_or(self.friction);
+        if let Some((part, hb)) = parts.base {
+            let floor = sys.get_mut(part)?;
+            floor.options.penalty_normal = self.penalty * mu / hb;
+            floor.options.penalty_tangent = self.penalty * mu / hb;
+            floor.options.friction = base_friction.or(self.base_friction).unwrap_or(0.0);
+        }
         Ok(())
     }
     fn observe(&self, sys: &System, parts: &N1Parts) -> Vec<f64> {
@@ -354,30 +689,90 @@ impl Setup for N1Setup {
             .unwrap_or(0.0)]
     }
     fn name(&self) -> String {
-        let base = match self.base {
-            Support::Bonded => "",
-            Support::Sliding => ", sliding base",
+        let words = |mu: f64| {
+            if mu.is_infinite() {
+                "bonded".to_string()
+            } else {
+                mu.to_string()
+            }
         };
-        let mut name = format!(
-            "N1 FE needle indentation, {}, friction {}{base}",
-            self.law, self.friction
-        );
+        let base = match (self.base_friction, self.base) {
+            (Some(mu), _) => format!(", base on a rigid plane with friction {}", words(mu)),
+            (None, Support::Bonded) => String::new(),
+            (None, Support::Sliding) => ", sliding base".into(),
+        };
+        let n1 = self.tool == ToolShape::n1_needle()
+            && self.radius == 35.0
+            && self.height == 80.0
+            && self.layers.is_empty();
+        let mut name = if n1 {
+            format!(
+                "N1 FE needle indentation, {}, friction {}{base}",
+                self.law,
+                words(self.friction)
+            )
+        } else {
+            format!(
+                "FE axisymmetric cylinder (radius {} mm, height {} mm), {}, {}, friction {}{base}",
+                self.radius,
+                self.height,
+                self.tool.name(),
+                self.law,
+                words(self.friction)
+            )
+        };
         if let Some(p) = &self.prony {
             name += &format!(", Prony {p}");
+        }
+        if self.prony_parameters > 0 {
+            name += &format!(", {} Prony terms as parameters", self.prony_parameters);
+        }
+        if !self.layers.is_empty() {
+            let names: Vec<String> = self
+                .layers
+                .iter()
+                .map(|(t, k)| {
+                    let m = if *k == 0 {
+                        format!("{} {}", self.first_material, self.law)
+                    } else {
+                        let b = &self.materials[*k - 1];
+                        let mut w = format!("{} {}", b.name, b.law);
+                        if let Some(p) = &b.prony {
+                            w += &format!(" Prony {p}");
+                        }
+                        if b.prony_parameters > 0 {
+                            w += &format!(" {} Prony terms as parameters", b.prony_parameters);
+                        }
+                        if b.bulk != self.bulk {
+                            w += &format!(" bulk {:?}", b.bulk);
+                        }
+                        w
+                    };
+                    format!("{t} mm {m}")
+                })
+                .collect();
+            name += &format!(", layers [{}]", names.join(", "));
+        }
+        if self.sizing.is_some() || self.grading.is_some() || self.element != PlaneCell::Quad4 {
+            name += &format!(
+                ", {:?} mesh of {}",
+                self.element,
+                graded_mesh_words(self.effective_grading(), "tool")
+            );
         }
         name
     }
     fn effects(&self) -> Option<Vec<Effect>> {
         let mut v = Vec::new();
-        if !self.friction_is_parameter {
+        if self.friction_offered() {
             v.push(Effect::Friction);
         }
-        if self.base == Support::Bonded {
+        if self.base == Support::Bonded && self.base_friction.is_none() {
             v.push(Effect::BoundaryCondition);
         }
         // (one enrichment at a time: the richer law of a model whose friction
         // is already a parameter is not offered)
-        if !self.friction_is_parameter && richer_law(&self.law).is_some() {
+        if self.material_form_offered() {
             v.push(Effect::MaterialForm);
         }
         v.push(Effect::ZeroOffset);
@@ -388,22 +783,28 @@ impl Setup for N1Setup {
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {
-            Effect::Friction if !self.friction_is_parameter => {
+            Effect::Friction if self.friction_offered() => {
                 let mut m = self.clone();
                 m.friction_is_parameter = true;
+                if let Some(space) = &mut m.space {
+                    // the tool's friction comes before the base's
+                    let at = space.params.len() - usize::from(m.base_friction_is_parameter);
+                    space.params.insert(at, friction_param(m.friction));
+                }
                 Ok(Box::new(FeModel::from_setup(m)))
             }
-            Effect::BoundaryCondition if self.base == Support::Bonded => {
+            Effect::BoundaryCondition
+                if self.base == Support::Bonded && self.base_friction.is_none() =>
+            {
                 let mut m = self.clone();
                 m.base = Support::Sliding;
                 Ok(Box::new(FeModel::from_setup(m)))
             }
-            Effect::MaterialForm
-                if !self.friction_is_parameter && richer_law(&self.law).is_some() =>
-            {
+            Effect::MaterialForm if self.material_form_offered() => {
                 let richer = richer_law(&self.law).expect("checked above");
                 let mut inner = self.clone();
                 inner.law = richer.law;
+                inner.space = None;
                 let space = richer.space.clone();
                 inner.law_bounds = Some(space.clone());
                 Ok(Box::new(MaterialForm::new(
@@ -423,11 +824,40 @@ impl Setup for N1Setup {
 }
 
 impl N1Setup {
+    /// Whether the parameters after the law's are none (the model is the
+    /// law's alone, as the richer law's wrapper needs).
+    fn law_only(&self) -> bool {
+        self.prony_parameters == 0
+            && self.materials.is_empty()
+            && !self.friction_is_parameter
+            && !self.base_friction_is_parameter
+    }
+
+    /// Whether `friction` is offered: the tool's coefficient is a finite
+    /// number.
+    fn friction_offered(&self) -> bool {
+        !self.friction_is_parameter && self.friction.is_finite()
+    }
+
+    /// Whether `material_form` is offered: one material, its law's
+    /// parameters the only ones, and a richer law exists.
+    fn material_form_offered(&self) -> bool {
+        self.law_only() && richer_law(&self.law).is_some()
+    }
+}
+
+impl N1Setup {
     /// Whether `modelling_space` is offered: the axisymmetric model with a
     /// bonded base, its friction fixed, elastic (N3 has neither a sliding
     /// base nor viscoelasticity).
     fn modelling_space_applies(&self) -> bool {
-        self.base == Support::Bonded && !self.friction_is_parameter && self.prony.is_none()
+        self.base == Support::Bonded
+            && self.base_friction.is_none()
+            && self.law_only()
+            && self.layers.is_empty()
+            && self.friction.is_finite()
+            && self.tool != ToolShape::Platen
+            && self.prony.is_none()
     }
 
     /// The `modelling_space` enrichment: the same needle, law, bulk
@@ -449,14 +879,27 @@ impl N1Setup {
     }
 }
 
-impl N1Setup {
-    /// The axisymmetric cylinder of an experiment description (specimen,
-    /// materials, tool, supports, mesh) as this setup.
-    pub fn from_experiment(e: &crate::experiment::Experiment) -> Result<N1Setup, FeError> {
-        let _ = e;
-        Err(FeError::InvalidConfig {
-            field: "specimen".into(),
-            reason: "an axisymmetric cylinder cannot be built from a description yet".into(),
-        })
-    }
+/// A Prony series from `[g1, tau1, g2, tau2, ...]`.
+pub(crate) fn prony_of(flat: &[f64]) -> Result<Prony, FeError> {
+    Prony::new(flat.chunks_exact(2).map(|c| (c[0], c[1])).collect())
+}
+
+/// The material of a band from its parameters (law's, then Prony terms).
+fn band_material(m: &BandMaterial, p: &[f64]) -> Result<RegionMaterial, FeError> {
+    let n = m.law.params().len();
+    let law = LawMaterial::new(m.law, p[..n].to_vec())?;
+    let mu = m.law.shear_modulus(&p[..n]);
+    let prony = if m.prony_parameters > 0 {
+        Some(prony_of(&p[n..])?)
+    } else {
+        m.prony.clone()
+    };
+    let material: Arc<dyn crate::material::PointMaterial> = match prony {
+        None => Arc::new(law),
+        Some(prony) => Arc::new(crate::viscoelastic::Viscoelastic::new(law, prony)),
+    };
+    Ok(RegionMaterial {
+        material,
+        volumetric: m.bulk.volumetric(mu),
+    })
 }

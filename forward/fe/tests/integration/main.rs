@@ -8,6 +8,7 @@ mod bad_input;
 mod c1_bonded;
 mod c1_frictionless;
 mod c1_viscoelastic;
+mod closed_form_experiments;
 mod hertz;
 mod mesh_gmsh;
 mod n1_needle;
