@@ -185,10 +185,24 @@ def _flags(options: Mapping[str, Any]) -> list[str]:
     return out
 
 
+def _experiment_option(experiment: Any) -> list[str]:
+    """``--experiment`` for a description given as a dict (passed as JSON
+    text, read by the same description types as an experiment file), a
+    file path or a preset's name."""
+    if experiment is None:
+        return []
+    if isinstance(experiment, Mapping):
+        return ["--experiment", json.dumps(experiment)]
+    if isinstance(experiment, (str, os.PathLike)):
+        return ["--experiment", os.fspath(experiment)]
+    raise TypeError(f"experiment: expected a dict, a file path or a preset name, not {type(experiment).__name__}")
+
+
 def calibrate(
-    law: str,
-    data: Any,
+    law: str | None = None,
+    data: Any = None,
     *,
+    experiment: Any = None,
     benchmark: str | None = None,
     residual: str = "absolute",
     estimator: str = "lm",
@@ -215,6 +229,11 @@ def calibrate(
     identification). A record is a CSV path, ``(x, y)`` arrays or
     ``{column: array}``.
 
+    ``experiment``: a lab's own experiment (a dict with the fields of an
+    experiment file, a file path or a preset's name, docs/guide/experiment.md)
+    instead of ``law``: its fitted parameters are estimated from one force
+    record by finite elements, its fixed ones held.
+
     ``residual``: absolute, relative or normalised; ``estimator``: lm, bfgs
     or lbfgs; ``fix``: parameters held, e.g. ``{"C01": 0.0}``;
     ``viscoelastic``: ``"qlv:N"`` or ``"finite:N"`` for timed records. The
@@ -229,19 +248,25 @@ def calibrate(
     borrowed slices); ``benchmark="Q1"`` reads files, so its record is
     written to a temporary CSV.
     """
+    if data is None:
+        raise TypeError("calibrate() missing required argument: 'data'")
+    if law is None and experiment is None:
+        raise TypeError("calibrate() needs 'law' or 'experiment'")
     options = dict(benchmark=benchmark, residual=residual, estimator=estimator, fix=fix,
                    viscoelastic=viscoelastic, stages=stages, prony_terms=prony_terms, fit_mesh=fit_mesh,
                    correct_mesh=correct_mesh, time_step=time_step, edge_radius=edge_radius,
                    fit_edge_radius=fit_edge_radius, mesh_check=mesh_check, compare=compare, profile=profile)
     flags = _flags(options)
+    model_args = (["--law", law] if law is not None else []) + _experiment_option(experiment)
     if (benchmark or "").lower() != "q1":
-        data_args, records = _data_in_memory(data, benchmark)
+        one_record = benchmark if experiment is None else "experiment"
+        data_args, records = _data_in_memory(data, one_record)
         with _quiet(not verbose):
-            report = json.loads(_native.calibrate_arrays(["--law", law, *data_args, *flags], records))
+            report = json.loads(_native.calibrate_arrays([*model_args, *data_args, *flags], records))
         return Calibration.from_report(report)
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "fit.json")
-        args = ["calibrate", "--law", law, *_data_options(data, benchmark, tmp), "--json", out]
+        args = ["calibrate", *model_args, *_data_options(data, benchmark, tmp), "--json", out]
         with _quiet(not verbose):
             _run_cli(args + flags)
         report = json.loads(Path(out).read_text())
@@ -249,10 +274,11 @@ def calibrate(
 
 
 def simulate(
-    benchmark: str,
+    benchmark: str | None = None,
     law: str | None = None,
     params: Mapping[str, float] | None = None,
     *,
+    experiment: Any = None,
     mesh: str | int | None = None,
     depth: float | None = None,
     step: float | None = None,
@@ -274,7 +300,14 @@ def simulate(
     nodule_params: Mapping[str, float] | None = None,
     verbose: bool = False,
 ) -> Curve:
-    """Runs a finite-element benchmark (as ``palpate simulate``).
+    """Runs a finite-element benchmark or a lab's own experiment (as
+    ``palpate simulate``).
+
+    ``experiment``: the description (a dict with the fields of an experiment
+    file, a file path or a preset's name, docs/guide/experiment.md) instead
+    of ``benchmark``; it holds the specimen, materials, tool, protocol and
+    mesh, so the benchmark's options do not apply; ``params`` set its
+    parameters by name (default: their starts).
 
     ``params``: the law's parameters by name (MPa). ``mesh``: coarse,
     medium, fine or a level; ``depth`` and ``step`` in mm; ``friction``,
@@ -293,7 +326,9 @@ def simulate(
     (no copy, full precision). R2 (a scan) goes through a CSV file (values
     to the CSV's 10 significant digits).
     """
-    args = ["--benchmark", benchmark]
+    if (benchmark is None) == (experiment is None):
+        raise TypeError("simulate() needs exactly one of 'benchmark' and 'experiment'")
+    args = ["--benchmark", benchmark] if benchmark is not None else _experiment_option(experiment)
     if law is not None:
         args += ["--law", law]
     for k, v in (params or {}).items():
@@ -304,7 +339,7 @@ def simulate(
                         bulk=bulk, bonded=bonded, sliding_base=sliding_base, edge_radius=edge_radius,
                         prony=prony, ramp=ramp, hold=hold, error_estimate=error_estimate, order=order,
                         rd=rd, nodules=nodules, nodule_law=nodule_law))
-    if benchmark.lower() != "r2":
+    if (benchmark or "").lower() != "r2":
         with _quiet(not verbose):
             curve = _native.simulate_arrays(args)
         return Curve(**curve)

@@ -2,7 +2,7 @@
 //! C1 force record, print a table, optionally write JSON and an SVG plot.
 
 use crate::model::calibration::{calibrate, parse_method, Calibration, Request};
-use crate::model::Viscous;
+use crate::model::{ExperimentSpec, ModelSpec, Viscous};
 use crate::records::arrays::{record_for, ArrayRecord};
 use crate::records::{ReadOptions, TestData, TestKind};
 use crate::report::{calibration_table, fit_plot};
@@ -34,14 +34,32 @@ use std::path::PathBuf;
 /// Benchmark C1 (38 x 9 mm cylinder between lubricated platens):
 /// `--benchmark C1 --data FILE` with columns `displacement_mm,force_N`.
 ///
+/// A lab's own experiment (docs/guide/experiment.md): `--experiment FILE
+/// --data RECORD` fits the description's fitted parameters by finite
+/// elements (its fixed ones held), the record's columns `displacement_mm,
+/// force_N`. `--benchmark N1` (or N3) is the preset of that name: `palpate
+/// experiment show N1` prints it, to edit friction, mesh or law.
+///
 /// Example: palpate calibrate --law mooney-rivlin --data uniaxial=u.csv --data biaxial=b.csv --json fit.json
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N (N = 1..6),
     /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N.
-    #[arg(long)]
-    pub law: String,
+    /// Not with --experiment, whose description names its laws; with
+    /// --benchmark N1 or N3 it replaces the preset's law.
+    #[arg(
+        long,
+        required_unless_present = "experiment",
+        conflicts_with = "experiment"
+    )]
+    pub law: Option<String>,
+    /// A lab's own experiment: an experiment file (TOML), a preset's name
+    /// (palpate experiment list) or the description as JSON text. Its
+    /// fitted parameters are estimated by finite elements from --data
+    /// (displacement_mm, force_N), its fixed ones held.
+    #[arg(long, value_name = "FILE|PRESET", conflicts_with_all = ["benchmark", "viscoelastic"])]
+    pub experiment: Option<String>,
     /// Data to fit: TEST=FILE or TEST[key=value,...]=FILE for homogeneous
     /// tests (TEST = uniaxial, biaxial, planar, simple_shear; keys weight,
     /// axial_stretch, stress_unit, compression, skip_rows, or a column chosen
@@ -58,8 +76,9 @@ pub struct Args {
     #[arg(long, value_name = "FORM")]
     pub viscoelastic: Option<String>,
     /// Fit a benchmark's force record instead of homogeneous stress data: C1
-    /// (analytic, lubricated compression) or N1 (finite-element needle
-    /// indentation, friction 0.8, coarse mesh; each evaluation is a full FE run).
+    /// (analytic, lubricated compression), Q1 (the staged identification) or
+    /// a preset of the experiment descriptions, N1 or N3 (finite elements,
+    /// as --experiment N1; each evaluation is a full FE run).
     #[arg(long, value_name = "ID")]
     pub benchmark: Option<String>,
     /// Residual: absolute (default), relative ((f-y)/y; zero-stress points
@@ -248,11 +267,8 @@ pub fn read_data_opts(
 
 /// Runs `palpate calibrate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
-    let law: Law = args
-        .law
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
     if is_q1(&args) {
+        let law = law_of(&args)?;
         return run_q1(&args, law);
     }
     // How each file was read (metadata, columns, sign), when there is
@@ -281,6 +297,158 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// The parsed `--law`.
+fn law_of(args: &Args) -> anyhow::Result<Law> {
+    let text = args
+        .law
+        .as_deref()
+        .ok_or_else(|| anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)"))?;
+    text.parse()
+        .map_err(|e| anyhow::anyhow!("--law {text}: {e}"))
+}
+
+/// The experiment of `--experiment`, or of `--benchmark N1` (a preset of
+/// the descriptions, its law replaced by `--law` when given); `None` for the
+/// other calibrations.
+pub fn experiment_of(args: &Args) -> anyhow::Result<Option<ExperimentSpec>> {
+    if let Some(e) = &args.experiment {
+        return ExperimentSpec::from_option(e).map(Some);
+    }
+    let Some(b) = args.benchmark.as_deref() else {
+        return Ok(None);
+    };
+    if b.eq_ignore_ascii_case("c1") || b.eq_ignore_ascii_case("q1") {
+        return Ok(None);
+    }
+    let Some(preset) = crate::model::experiment::preset(b) else {
+        anyhow::bail!(
+            "--benchmark {b}: calibrate takes C1, Q1 or a preset of the experiment descriptions ({})",
+            crate::model::experiment::preset_names().join(", ")
+        );
+    };
+    let mut spec = ExperimentSpec {
+        source: crate::model::ExperimentSource::Preset(b.to_ascii_uppercase()),
+        experiment: Box::new(preset),
+    };
+    if let Some(law) = &args.law {
+        law.parse::<Law>()
+            .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
+        let materials = &mut spec.experiment.materials;
+        anyhow::ensure!(
+            materials.len() == 1,
+            "--law {law}: preset {b} has {} materials; give the laws in an experiment file (palpate experiment show {b})",
+            materials.len()
+        );
+        for m in materials.values_mut() {
+            if m.law != *law {
+                m.law = law.clone();
+                m.params.clear();
+            }
+        }
+    }
+    spec.check()?;
+    Ok(Some(spec))
+}
+
+/// `palpate calibrate --experiment`: the description's fitted parameters
+/// from force records, its fixed ones (and `--fix`) held.
+fn fit_experiment(
+    args: &Args,
+    arrays: &[ArrayRecord],
+    spec: ExperimentSpec,
+) -> anyhow::Result<Calibration> {
+    for (given, name) in [
+        (args.stages.is_some(), "--stages"),
+        (args.prony_terms.is_some(), "--prony-terms"),
+        (args.fit_mesh.is_some(), "--fit-mesh"),
+        (args.correct_mesh.is_some(), "--correct-mesh"),
+        (args.time_step.is_some(), "--time-step"),
+        (args.edge_radius.is_some(), "--edge-radius"),
+        (args.fit_edge_radius.is_some(), "--fit-edge-radius"),
+        (args.mesh_check.is_some(), "--mesh-check"),
+        (args.compare, "--compare"),
+        (args.profile, "--profile"),
+        (args.viscoelastic.is_some(), "--viscoelastic"),
+    ] {
+        anyhow::ensure!(
+            !given,
+            "{name}: not an option of an experiment's calibration (its description holds the model)"
+        );
+    }
+    let residual: ResidualKind = args
+        .residual
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
+    let method = parse_method(&args.estimator).context("--estimator")?;
+    let space = spec
+        .experiment
+        .param_space()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let mut fixed: Vec<(String, f64)> = Vec::new();
+    for f in &args.fix {
+        let (name, value) = split_pair(f, "NAME=VALUE, e.g. C10=0.002")
+            .map_err(|e| anyhow::anyhow!("--fix {e}"))?;
+        anyhow::ensure!(
+            space.names().iter().any(|n| n == name),
+            "--fix {f}: the experiment has no parameter `{name}`; its parameters: {}",
+            space.names().join(", ")
+        );
+        let v: f64 = value
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| anyhow::anyhow!("--fix {f}: `{value}` is not a finite number"))?;
+        anyhow::ensure!(
+            !fixed.iter().any(|(n, _)| n == name),
+            "--fix {f}: {name} is fixed twice; give each parameter once"
+        );
+        fixed.push((name.to_string(), v));
+    }
+    let law: Law = spec
+        .law_text()
+        .parse()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let mut data = Vec::new();
+    for d in &args.data {
+        // FILE, or force=FILE
+        let path = d
+            .split_once('=')
+            .filter(|(t, _)| t.eq_ignore_ascii_case("force") || t.eq_ignore_ascii_case("n1"))
+            .map_or(d.as_str(), |(_, p)| p);
+        let name = format!("record{}", data.len() + 1);
+        let record = match record_for(path, arrays).with_context(|| format!("--data {path}"))? {
+            Some(r) => TestData::from_table(
+                &name,
+                TestKind::N1,
+                r.table(&format!("{name} arrays"))?,
+                ReadOptions::default(),
+            )?,
+            None => {
+                TestData::read_with(&name, TestKind::N1, Path::new(path), ReadOptions::default())?
+            }
+        };
+        data.push(record);
+    }
+    let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
+    let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
+    crate::run::output::check_outputs(&inputs, &outputs)?;
+    let model = ModelSpec::Experiment(spec);
+    model
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}", e.expected))?;
+    calibrate(Request {
+        law,
+        model: Some(&model),
+        fitted: &data,
+        predict: &[],
+        residual,
+        method,
+        fixed,
+        observer: None,
+        viscous: None,
+    })
+}
+
 /// Whether `--benchmark Q1` (the staged identification, files only).
 pub fn is_q1(args: &Args) -> bool {
     args.benchmark
@@ -293,10 +461,10 @@ pub fn is_q1(args: &Args) -> bool {
 /// (`--data TEST=<array:K>` takes `arrays[K]`, [`crate::records::arrays`]). The
 /// checks and messages are those of the command line.
 pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
-    let law: Law = args
-        .law
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    if let Some(spec) = experiment_of(args)? {
+        return fit_experiment(args, arrays, spec);
+    }
+    let law = law_of(args)?;
     anyhow::ensure!(
         !is_q1(args),
         "--benchmark Q1: the staged identification reads its record from a file (palpate calibrate --benchmark Q1 --data FILE)"

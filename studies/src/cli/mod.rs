@@ -7,6 +7,7 @@ pub mod anova;
 pub mod calibrate;
 pub mod diagnose;
 pub mod doe;
+pub mod experiment;
 pub mod localize;
 pub mod merge;
 pub mod reading;
@@ -16,6 +17,7 @@ pub mod sample;
 pub mod sample_fe;
 pub mod simulate;
 mod simulate_estimate;
+mod simulate_experiment;
 pub mod simulate_r2;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify
@@ -61,6 +63,8 @@ pub enum Command {
     Realtime(realtime::Args),
     // Nodule localisation from an R2 record (localize::Args).
     Localize(localize::Args),
+    // Experiment descriptions: presets, show, check (experiment::Args).
+    Experiment(experiment::Args),
 }
 
 /// The command line with a negative number after an option joined to it
@@ -106,5 +110,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Merge(a) => merge::run(a),
         Command::Realtime(a) => realtime::run(a),
         Command::Localize(a) => localize::run(a),
+        Command::Experiment(a) => experiment::run(a),
     }
 }

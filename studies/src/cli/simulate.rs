@@ -48,8 +48,11 @@ use crate::run::output::write_atomic;
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Benchmark: N1 (needle indentation of a 70 x 80 mm cylinder), N3 (the same needle into a 70 x 80 x 80 mm block, 3D quarter model), C1 (compression of a 38 x 9 mm cylinder), Q1 (ramp-and-hold of a flat punch of radius 2 mm, edge rounded 0.2 mm, frictionless, on a cylinder of radius 50 and height 60 mm) or R2 (a wheel of diameter 8 mm pressed to --rd at x = 10 mm and rolled to x = 140 mm over a 150 x 30 mm block, 50 mm thick, with bonded nodules of diameter 10 mm; plane stress).
-    #[arg(long, value_parser = ["N1", "N3", "C1", "Q1", "R2", "n1", "n3", "c1", "q1", "r2"])]
-    pub benchmark: String,
+    #[arg(long, value_parser = ["N1", "N3", "C1", "Q1", "R2", "n1", "n3", "c1", "q1", "r2"], required_unless_present = "experiment")]
+    pub benchmark: Option<String>,
+    /// A lab's own experiment instead of a benchmark: an experiment file (TOML) or a preset's name (palpate experiment list; docs/guide/experiment.md). The description holds the specimen, materials, tool, supports, protocol and mesh, so the benchmark options are refused with it; --param NAME=VALUE sets a parameter (default: its start in the description).
+    #[arg(long, value_name = "FILE|PRESET", conflicts_with_all = EXPERIMENT_HOLDS)]
+    pub experiment: Option<String>,
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N (required, except R2: the tissue law, default arruda-boyce with rtv6166-ab's mu=0.00498, lambda_m=1.05).
     #[arg(long)]
     pub law: Option<String>,
@@ -176,11 +179,11 @@ pub(crate) fn parse_params(law: &Law, given: &[String]) -> anyhow::Result<Vec<f6
 pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
     let kind = if is_q1(args) {
         "Q1"
-    } else if args.benchmark.eq_ignore_ascii_case("r2") {
+    } else if args.benchmark().eq_ignore_ascii_case("r2") {
         "R2"
-    } else if args.benchmark.eq_ignore_ascii_case("n3") {
+    } else if args.benchmark().eq_ignore_ascii_case("n3") {
         "N3"
-    } else if args.benchmark.eq_ignore_ascii_case("n1") {
+    } else if args.benchmark().eq_ignore_ascii_case("n1") {
         "N1"
     } else {
         "C1"
@@ -331,7 +334,38 @@ pub fn model_spec(args: &Args) -> anyhow::Result<ModelSpec> {
 }
 
 fn is_q1(args: &Args) -> bool {
-    args.benchmark.eq_ignore_ascii_case("q1")
+    args.benchmark().eq_ignore_ascii_case("q1")
+}
+
+/// The options an experiment description holds itself (its specimen,
+/// materials, tool, supports, protocol and mesh): refused with --experiment.
+const EXPERIMENT_HOLDS: [&str; 19] = [
+    "benchmark",
+    "law",
+    "friction",
+    "rd",
+    "nodules",
+    "nodule_law",
+    "nodule_params",
+    "bonded",
+    "sliding_base",
+    "tool",
+    "element",
+    "edge_radius",
+    "depth",
+    "step",
+    "mesh",
+    "bulk",
+    "prony",
+    "ramp",
+    "hold",
+];
+
+impl Args {
+    /// The benchmark's name (empty with --experiment).
+    pub fn benchmark(&self) -> &str {
+        self.benchmark.as_deref().unwrap_or("")
+    }
 }
 
 /// A force curve of `palpate simulate` (N1, N3, C1, Q1), as its CSV holds
@@ -352,6 +386,10 @@ pub struct Curve {
 
 /// Runs `palpate simulate`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if let Some(e) = &args.experiment {
+        let (c, solver) = super::simulate_experiment::compute(&args, e)?;
+        return write_outputs(&args, &c, solver.as_ref());
+    }
     let model = model_spec(&args)?
         .validate()
         .map_err(|e| anyhow!("{}", e.as_option()))?;
@@ -359,6 +397,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         return super::simulate_r2::run(&args, m);
     }
     let (c, solver) = compute(&args, model)?;
+    write_outputs(&args, &c, Some(&solver))
+}
+
+/// Writes a curve as the options ask (--csv, --vtu, --plot; printed
+/// without --csv).
+fn write_outputs(
+    args: &Args,
+    c: &Curve,
+    solver: Option<&palpate_fe::system::System>,
+) -> anyhow::Result<()> {
     if let Some(path) = &args.csv {
         write_curve(
             path,
@@ -369,8 +417,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             c.error_estimate_n.as_deref(),
         )?;
     }
-    if let Some(path) = &args.vtu {
-        let vtu = palpate_fe::vtu::to_vtu(&solver).map_err(|e| anyhow!("{e}"))?;
+    if let (Some(path), Some(solver)) = (&args.vtu, solver) {
+        let vtu = palpate_fe::vtu::to_vtu(solver).map_err(|e| anyhow!("{e}"))?;
         write_atomic(path, vtu.as_bytes())?;
     }
     if let Some(path) = &args.plot {
@@ -407,6 +455,9 @@ pub fn run(args: Args) -> anyhow::Result<()> {
 /// the vectors, such as the Python package. R2 (a scan, not a force curve)
 /// is refused with the command to use.
 pub fn curve(args: &Args) -> anyhow::Result<Curve> {
+    if let Some(e) = &args.experiment {
+        return super::simulate_experiment::compute(args, e).map(|(c, _)| c);
+    }
     let model = model_spec(args)?
         .validate()
         .map_err(|e| anyhow!("{}", e.as_option()))?;
@@ -433,7 +484,8 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         ]),
     )?;
     // needle benchmarks (N1, N3): 10 mm every 0.25 mm
-    let n1 = args.benchmark.eq_ignore_ascii_case("n1") || args.benchmark.eq_ignore_ascii_case("n3");
+    let n1 =
+        args.benchmark().eq_ignore_ascii_case("n1") || args.benchmark().eq_ignore_ascii_case("n3");
     let q1 = is_q1(args);
     let depth = args.depth.unwrap_or(if n1 {
         10.0
@@ -506,7 +558,10 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
             m.bulk,
             m.simulate(&theta, &loading, Some(&mut cb)),
         ),
-        _ => bail!("--benchmark {}: expected N1, N3, C1 or Q1", args.benchmark),
+        _ => bail!(
+            "--benchmark {}: expected N1, N3, C1 or Q1",
+            args.benchmark()
+        ),
     };
     drop(cb);
     bar.finish_and_clear();
@@ -638,8 +693,8 @@ fn timed_history(
         }
         return Ok(None);
     }
-    if !(args.benchmark.eq_ignore_ascii_case("c1")
-        || args.benchmark.eq_ignore_ascii_case("n1")
+    if !(args.benchmark().eq_ignore_ascii_case("c1")
+        || args.benchmark().eq_ignore_ascii_case("n1")
         || q1)
     {
         bail!("--prony: only N1, C1 and Q1 have the viscoelastic material so far");
@@ -647,7 +702,7 @@ fn timed_history(
     // N1: the needle's 0.4 mm/s (docs/benchmarks.md), C1: 1 s, Q1: 0.5 s
     let ramp = args.ramp.unwrap_or(if q1 {
         0.5
-    } else if args.benchmark.eq_ignore_ascii_case("n1") {
+    } else if args.benchmark().eq_ignore_ascii_case("n1") {
         depth / 0.4
     } else {
         1.0
@@ -677,7 +732,7 @@ fn timed_history(
     Ok(Some(time))
 }
 
-fn curve_text(
+pub(crate) fn curve_text(
     comments: &[String],
     time: Option<&[f64]>,
     d: &[f64],

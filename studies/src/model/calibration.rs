@@ -167,7 +167,15 @@ impl Request<'_> {
 }
 
 /// Fits a law and evaluates it on the fitted and the extra data sets.
-pub fn calibrate(req: Request<'_>) -> anyhow::Result<Calibration> {
+pub fn calibrate(mut req: Request<'_>) -> anyhow::Result<Calibration> {
+    // an experiment's fixed parameters are held unless given here
+    if let Some(ModelSpec::Experiment(e)) = req.model {
+        for (name, value) in e.fixed()? {
+            if !req.fixed.iter().any(|(n, _)| *n == name) {
+                req.fixed.push((name, value));
+            }
+        }
+    }
     let sets: Vec<DataSet> = req
         .fitted
         .iter()

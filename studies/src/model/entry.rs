@@ -7,7 +7,9 @@ use std::collections::BTreeMap;
 
 /// A named model: a law applied to each data set's own test (`law = "..."`,
 /// the original form) or one model of [`ModelSpec`] (`[models.NAME.n1_needle]`,
-/// `[models.NAME.c1_fe]`, ...), with parameters optionally held fixed in fits.
+/// `[models.NAME.c1_fe]`, ..., `experiment = "NAME"` for a lab's own
+/// experiment, [`super::experiment`]), with parameters optionally held fixed
+/// in fits (an experiment's own fixed parameters are held too).
 #[derive(Debug, Clone, PartialEq)]
 pub struct ModelEntry {
     pub model: ModelForm,
@@ -43,13 +45,14 @@ impl<'de> Deserialize<'de> for ModelEntry {
             "n1_needle",
             "q1",
             "n3_needle",
+            "experiment",
         ];
         struct V;
         impl<'de> Visitor<'de> for V {
             type Value = ModelEntry;
             fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
                 f.write_str(
-                    "a model: `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle",
+                    "a model: `law = \"...\"`, `experiment = \"NAME\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle, q1, experiment",
                 )
             }
             fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<ModelEntry, A::Error> {
@@ -79,6 +82,10 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         "n1_needle" => Some(ModelSpec::N1Needle(map.next_value::<N1NeedleSpec>()?)),
                         "q1" => Some(ModelSpec::Q1(map.next_value::<Q1Spec>()?)),
                         "n3_needle" => Some(ModelSpec::N3Needle(map.next_value::<N3NeedleSpec>()?)),
+                        // a name ([experiments.NAME], a preset, a file) or the table
+                        "experiment" => Some(ModelSpec::Experiment(
+                            map.next_value::<super::ExperimentSpec>()?,
+                        )),
                         other => return Err(A::Error::unknown_field(other, FIELDS)),
                     };
                     if let Some(n) = next {
@@ -104,7 +111,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                     }
                     (None, None) => {
                         return Err(A::Error::custom(
-                            "no model: expected `law = \"...\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle",
+                            "no model: expected `law = \"...\"`, `experiment = \"NAME\"` or one table of homogeneous, c1, c1_fe, n1_needle, n3_needle, q1, experiment",
                         ))
                     }
                 };

@@ -46,6 +46,9 @@
 //! [models.press-analytic.c1]  # C1 compression (analytic, lubricated)
 //! law = "neo-hookean"
 //!
+//! [models.disc]               # a lab's own experiment (finite elements, [`experiment`])
+//! experiment = "gel"          # a table [experiments.gel] of the manifest, a preset (N1, ...) or a file
+//!
 //! [models.tension.homogeneous] # homogeneous test (analytic)
 //! law = "mooney-rivlin"
 //! mode = "uniaxial"           # uniaxial | biaxial | planar | general_biaxial | simple_shear
@@ -66,9 +69,12 @@
 pub mod calibration;
 pub mod defaults;
 pub mod entry;
+pub mod experiment;
+pub mod experiment_api;
 pub mod fields;
 
 pub use entry::{ModelEntry, ModelForm};
+pub use experiment::{ExperimentSource, ExperimentSpec};
 
 use crate::records::{TestData, TestKind};
 use palpate_analytic::{
@@ -118,6 +124,10 @@ pub enum ModelSpec {
     /// Benchmark R2 (and R2-1), rolling indentation over bonded nodules,
     /// plane stress, by finite elements.
     R2(R2Spec),
+    /// A lab's own experiment ([`experiment`]): specimen, materials, tool,
+    /// supports, protocol and mesh described as data; `experiment = "NAME"`
+    /// names a manifest's `[experiments.NAME]` table, a preset or a file.
+    Experiment(ExperimentSpec),
 }
 
 /// `[... .r2]`
@@ -349,6 +359,13 @@ pub struct ModelError {
     pub expected: String,
 }
 
+/// What is wrong with an experiment description: the field
+/// (`tool.radius`, `specimen.layers[1].thickness`), the description's
+/// source and why.
+fn experiment_error(spec: &ExperimentSpec, e: impl fmt::Display) -> ModelError {
+    ModelError::new("experiment", "description", &spec.source, e.to_string())
+}
+
 impl ModelError {
     pub(crate) fn new(
         kind: &'static str,
@@ -390,6 +407,21 @@ pub enum Model {
     Q1(Q1Punch),
     N3Needle(N3Needle),
     R2(R2Rolling),
+    Experiment(BuiltExperiment),
+}
+
+/// The model an experiment description builds, with the description (two
+/// are equal when their descriptions are: the model is made from it).
+#[derive(Debug, Clone)]
+pub struct BuiltExperiment {
+    pub spec: ExperimentSpec,
+    pub model: palpate_fe::experiment::ExperimentModel,
+}
+
+impl PartialEq for BuiltExperiment {
+    fn eq(&self, other: &Self) -> bool {
+        self.spec == other.spec
+    }
 }
 
 impl Model {
@@ -409,6 +441,7 @@ impl Model {
             Model::Q1(m) => Box::new(m),
             Model::N3Needle(m) => Box::new(m),
             Model::R2(m) => Box::new(m),
+            Model::Experiment(m) => m.model.boxed(),
         }
     }
 }
@@ -420,7 +453,7 @@ pub fn build(spec: &ModelSpec) -> Result<Box<dyn ForwardModel>, ModelError> {
 
 impl ModelSpec {
     /// The kinds, as spelled in manifests.
-    pub const KINDS: [&'static str; 7] = [
+    pub const KINDS: [&'static str; 8] = [
         "homogeneous",
         "c1",
         "c1_fe",
@@ -428,6 +461,7 @@ impl ModelSpec {
         "n3_needle",
         "q1",
         "r2",
+        "experiment",
     ];
 
     /// The kind, as spelled in manifests.
@@ -440,6 +474,7 @@ impl ModelSpec {
             ModelSpec::Q1(_) => "q1",
             ModelSpec::N3Needle(_) => "n3_needle",
             ModelSpec::R2(_) => "r2",
+            ModelSpec::Experiment(_) => "experiment",
         }
     }
 
@@ -453,6 +488,7 @@ impl ModelSpec {
             ModelSpec::Q1(s) => &s.law,
             ModelSpec::N3Needle(s) => &s.law,
             ModelSpec::R2(s) => &s.law,
+            ModelSpec::Experiment(s) => s.law_text(),
         }
     }
 
@@ -472,8 +508,10 @@ impl ModelSpec {
                 HomogeneousKind::SimpleShear => TestKind::SimpleShear,
             },
             ModelSpec::C1(_) | ModelSpec::C1Fe(_) => TestKind::C1,
-            // needle force records, as N1's
-            ModelSpec::N1Needle(_) | ModelSpec::N3Needle(_) => TestKind::N1,
+            // force records (displacement_mm, force_N), as N1's
+            ModelSpec::N1Needle(_) | ModelSpec::N3Needle(_) | ModelSpec::Experiment(_) => {
+                TestKind::N1
+            }
             ModelSpec::Q1(_) => {
                 return Err(ModelError::new(
                     "q1",
@@ -495,6 +533,10 @@ impl ModelSpec {
 
     /// Checks every field and builds the model; errors name the field.
     pub fn validate(&self) -> Result<Model, ModelError> {
+        // (its laws are checked with their fields by the description)
+        if let ModelSpec::Experiment(s) = self {
+            return experiment_model(s);
+        }
         let law = self.law()?;
         Ok(match self {
             ModelSpec::Homogeneous(s) => homogeneous_model(law, s)?,
@@ -614,8 +656,21 @@ impl ModelSpec {
                 Model::N3Needle(m)
             }
             ModelSpec::R2(s) => Model::R2(r2_model(s, law)?),
+            ModelSpec::Experiment(s) => experiment_model(s)?,
         })
     }
+}
+
+/// The model of an experiment description, checked first
+/// ([`Experiment::check`](palpate_fe::experiment::Experiment)).
+fn experiment_model(s: &ExperimentSpec) -> Result<Model, ModelError> {
+    use experiment_api::ExperimentApi;
+    s.experiment.check().map_err(|e| experiment_error(s, e))?;
+    let model = s.experiment.model().map_err(|e| experiment_error(s, e))?;
+    Ok(Model::Experiment(BuiltExperiment {
+        spec: s.clone(),
+        model,
+    }))
 }
 
 /// The R2 model of a spec: every field checked, the geometry (nodules

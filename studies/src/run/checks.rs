@@ -205,6 +205,8 @@ pub fn travel_limit(model: &Model) -> Option<(f64, &'static str)> {
         // the rolling depth is checked against the wheel and the block by
         // palpate_fe::r2::check_model; the travel is along the surface
         Model::R2(_) => None,
+        // the description checks its protocol against its specimen
+        Model::Experiment(_) => None,
         Model::C1(m) => Some((
             m.geometry.height_mm,
             "the C1 specimen is that high: the platens would meet",

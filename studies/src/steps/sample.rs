@@ -89,7 +89,11 @@ fn default_sampler() -> String {
 fn is_fe(spec: &ModelSpec) -> bool {
     matches!(
         spec,
-        ModelSpec::C1Fe(_) | ModelSpec::N1Needle(_) | ModelSpec::N3Needle(_) | ModelSpec::Q1(_)
+        ModelSpec::C1Fe(_)
+            | ModelSpec::N1Needle(_)
+            | ModelSpec::N3Needle(_)
+            | ModelSpec::Q1(_)
+            | ModelSpec::Experiment(_)
     )
 }
 

@@ -21,6 +21,14 @@
 //! [models.nh]
 //! law = "neo-hookean"
 //!
+//! [experiments.gel]                      # a lab's own experiment (crate::model::experiment)
+//! specimen = { shape = "cylinder", radius = 20.0, height = 10.0 }
+//! tool = { shape = "sphere", radius = 2.5 }
+//! materials.gel = { law = "neo-hookean", C10 = { start = 2e-3 } }
+//!
+//! [models.disc]
+//! experiment = "gel"                     # [experiments.gel], a preset (N1, ...) or a file
+//!
 //! [[steps]]
 //! [steps.calibrate]
 //! name = "laws"
@@ -29,8 +37,10 @@
 //! residuals = ["absolute", "relative"]
 //! ```
 
+use crate::model::experiment_api::ExperimentApi;
 use crate::records::TESTS;
 use crate::run::step::{At, StepRef, Study};
+use palpate_fe::experiment::Experiment;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -49,7 +59,19 @@ pub struct Manifest {
     pub data: BTreeMap<String, DataSpec>,
     #[serde(default)]
     pub models: BTreeMap<String, ModelEntry>,
+    /// Experiment descriptions by name, as in an experiment file; a model
+    /// refers to one with `experiment = "NAME"`.
+    #[serde(default)]
+    pub experiments: BTreeMap<String, Experiment>,
     pub steps: Vec<StepEntry>,
+}
+
+/// The `[experiments]` tables alone (the first reading of a manifest, so
+/// that its models can refer to them by name).
+#[derive(Deserialize)]
+struct Experiments {
+    #[serde(default)]
+    experiments: BTreeMap<String, Experiment>,
 }
 
 /// A manifest whose references, names and files [`Manifest::validate`] has
@@ -82,8 +104,13 @@ impl Manifest {
 
     /// Parses manifest text (errors name `path`).
     pub fn parse(path: &Path, text: &str) -> anyhow::Result<Manifest> {
-        toml::from_str(text)
-            .map_err(|e| anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end()))
+        let err = |e: toml::de::Error| {
+            anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end())
+        };
+        let tables = toml::from_str::<Experiments>(text)
+            .map_err(err)?
+            .experiments;
+        crate::model::experiment::with_tables(path, tables, || toml::from_str(text)).map_err(err)
     }
 
     /// The study as its steps see it.
@@ -140,6 +167,10 @@ impl Manifest {
             if !f.is_file() {
                 anyhow::bail!("{where_}: data.{name}.file: no such file {}", f.display());
             }
+        }
+        for (name, e) in &self.experiments {
+            e.check()
+                .map_err(|e| anyhow::anyhow!("{where_}: experiments.{name}: {e}"))?;
         }
         for (name, m) in &self.models {
             match &m.model {

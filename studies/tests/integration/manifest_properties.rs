@@ -218,6 +218,7 @@ fn manifest() -> impl Strategy<Value = Manifest> {
                     },
                     data,
                     models,
+                    experiments: Default::default(),
                     steps,
                 }
             },

@@ -1,0 +1,149 @@
+//! `palpate simulate --experiment FILE|PRESET`: the force curve of a lab's
+//! own experiment along its protocol's segments, with the mesh it used and
+//! the estimated discretisation error of that mesh.
+
+use anyhow::{anyhow, bail};
+use palpate_core::{ForwardModel, Loading};
+use palpate_fe::experiment::ExperimentModel;
+
+use super::simulate::{progress_bar, volumetric, Args, Curve};
+use super::simulate_estimate::estimate;
+use crate::model::experiment_api::ModelLoading;
+use crate::model::{ExperimentSpec, Model, ModelSpec};
+
+/// The parameter values of a run: the description's starts (and fixed
+/// values), each `--param NAME=VALUE` replacing one by name.
+pub(crate) fn theta(model: &dyn ForwardModel, given: &[String]) -> anyhow::Result<Vec<f64>> {
+    let space = model.space();
+    let mut theta: Vec<f64> = space.params.iter().map(|s| s.initial).collect();
+    let names = space.names();
+    for g in given {
+        let (n, v) = super::calibrate::split_pair(g, "NAME=VALUE, e.g. C10=0.002")
+            .map_err(|e| anyhow!("--param {e}"))?;
+        let k = names.iter().position(|m| m == n).ok_or_else(|| {
+            anyhow!(
+                "--param {g}: the experiment has no parameter `{n}`; its parameters: {}",
+                names.join(", ")
+            )
+        })?;
+        let v: f64 = v
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| anyhow!("--param {g}: `{v}` is not a finite number"))?;
+        let s = &space.params[k];
+        if !(v >= s.lower && v <= s.upper) {
+            bail!(
+                "--param {g}: outside {n}'s bounds [{}, {}]",
+                s.lower,
+                s.upper
+            );
+        }
+        theta[k] = v;
+    }
+    Ok(theta)
+}
+
+/// The curve of `palpate simulate --experiment` (and its solved system
+/// when the model has one to write as --vtu).
+pub(crate) fn compute(
+    args: &Args,
+    arg: &str,
+) -> anyhow::Result<(Curve, Option<palpate_fe::system::System>)> {
+    let spec = ExperimentSpec::from_option(arg)?;
+    let source = spec.source.to_string();
+    let protocol = spec.experiment.protocol.clone();
+    let Model::Experiment(built) = ModelSpec::Experiment(spec)
+        .validate()
+        .map_err(|e| anyhow!("--experiment {source}: {}", e.expected))?
+    else {
+        bail!("--experiment {source}: not an experiment model");
+    };
+    crate::run::output::check_outputs(
+        &[],
+        &crate::run::output::given(&[
+            ("--csv", &args.csv),
+            ("--vtu", &args.vtu),
+            ("--plot", &args.plot),
+        ]),
+    )?;
+    if let Some(p) = args.order {
+        if !(p > 0.0 && p.is_finite()) {
+            bail!("--order {p}: must be a positive order of convergence");
+        }
+    }
+    let loading: Loading = built
+        .model
+        .loading(&protocol)
+        .map_err(|e| anyhow!("--experiment {source}: {e}"))?;
+    let model = built.model;
+    let theta = theta(model.as_forward(), &args.params)?;
+    let title = model.as_forward().name();
+    let mut comments = vec![
+        format!("palpate simulate: {title}"),
+        format!("experiment: {source}"),
+    ];
+    let (bar, mut cb) = progress_bar(loading.len(), "");
+    #[allow(unreachable_patterns)]
+    let (forces, solver, as_model) = match &model {
+        ExperimentModel::Cylinder(m) => {
+            let (sim, solver) = m
+                .simulate(&theta, &loading, Some(&mut cb))
+                .map_err(|e| anyhow!("{title}: {e}"))?;
+            comments.push(format!(
+                "mesh: level {}, {:?} elements ({} cells, {} unknowns)",
+                m.mesh.level,
+                m.element,
+                solver.mesh.cell_count(),
+                solver.equations()
+            ));
+            comments.push(format!("volumetric: {}", volumetric(m.bulk)));
+            (sim.forces, Some(solver), Some(Model::N1Needle(m.clone())))
+        }
+        other => {
+            let f = other
+                .as_forward()
+                .predict(&theta, &loading)
+                .map_err(|e| anyhow!("{title}: {e}"))?;
+            (f, None, None)
+        }
+    };
+    drop(cb);
+    bar.finish_and_clear();
+    for c in &comments[2..] {
+        eprintln!("{c}");
+    }
+    let errors = match (&as_model, args.error_estimate.as_str()) {
+        (_, "off") => {
+            comments.push("discretisation error: not estimated (--error-estimate off)".into());
+            None
+        }
+        (Some(m), _) => {
+            let est = estimate(m, &theta, &loading, args.order, &forces)?;
+            eprintln!("{}", est.line);
+            comments.push(est.line);
+            if est.errors.is_some() {
+                comments.push(
+                    "error_estimate_N: force_N minus the estimated converged force, per sample"
+                        .into(),
+                );
+            }
+            est.errors
+        }
+        (None, _) => {
+            comments.push("discretisation error: no estimate for this model".into());
+            None
+        }
+    };
+    Ok((
+        Curve {
+            title,
+            comments,
+            time_s: loading.time.clone(),
+            displacement_mm: loading.drive.clone(),
+            force_n: forces,
+            error_estimate_n: errors,
+        },
+        solver,
+    ))
+}
