@@ -716,7 +716,7 @@ mod models {
     }
 
     #[test]
-    #[ignore = "needs N1Setup::from_experiment; run: cargo test -p palpate-fe --lib experiment::tests::models -- --ignored"]
+    #[ignore = "needs N1Setup::from_experiment; run: cargo test -p palpate-fe --lib experiment::description_tests::models -- --ignored"]
     fn the_n1_preset_is_n1_s_model() {
         match model("N1").1 {
             ExperimentModel::Cylinder(m) => {
@@ -812,5 +812,62 @@ mod models {
         e.protocol.segments.clear();
         e.protocol.samples = None;
         assert_eq!(e.loading().unwrap(), None);
+    }
+}
+
+#[test]
+fn a_gmsh_specimen_is_checked_against_its_groups_and_not_built_yet() {
+    let file = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/tests/data/inclusion_quad4.msh"
+    );
+    let text = format!(
+        r#"
+[specimen]
+shape = "mesh"
+file = "{file}"
+kinematics = "plane_strain"
+support = {{ group = "bottom", kind = "bonded" }}
+contact_surface = "top"
+
+[materials.matrix]
+law = "neo-hookean"
+
+[materials.inclusion]
+law = "neo-hookean"
+
+[tool]
+shape = "sphere"
+radius = 0.2
+"#
+    );
+    let e = Experiment::from_toml_str(&text, "slice.toml").unwrap();
+    match e.model() {
+        Err(FeError::InvalidConfig { field, reason }) => {
+            assert_eq!(field, "specimen.file");
+            assert!(
+                reason.contains("inclusion_quad4.msh") && reason.contains("not supported"),
+                "{reason}"
+            );
+        }
+        other => panic!("{:?}", other.map(|m| m.kind())),
+    }
+    let (field, reason) = field_of_named(&text.replace("\"top\"", "\"lid\""), "slice.toml");
+    assert_eq!(field, "specimen.contact_surface", "{reason}");
+    assert!(reason.contains("top"), "{reason}");
+    let (field, reason) = field_of_named(
+        &text.replace("[materials.inclusion]", "[materials.tumour]"),
+        "slice.toml",
+    );
+    assert_eq!(field, "materials.tumour", "{reason}");
+    assert!(reason.contains("inclusion_quad4.msh"), "{reason}");
+    let (field, _) = field_of_named(&text.replace("plane_strain", "3d"), "slice.toml");
+    assert_eq!(field, "specimen.kinematics");
+}
+
+fn field_of_named(text: &str, file: &str) -> (String, String) {
+    match Experiment::from_toml_str(text, file) {
+        Err(FeError::InvalidConfig { field, reason }) => (field, reason),
+        other => panic!("expected InvalidConfig, got {other:?}"),
     }
 }
