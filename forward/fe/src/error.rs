@@ -47,6 +47,15 @@ pub enum FeError {
     /// A configuration value is invalid.
     #[error("configuration `{field}`: {reason}")]
     InvalidConfig { field: String, reason: String },
+    /// A configuration file (an experiment description) is unreadable or
+    /// does not describe one; `line` is 1-based (0 when the fault is not
+    /// tied to a line, e.g. an I/O error).
+    #[error("{file}:{line}: {reason}")]
+    ConfigFile {
+        file: String,
+        line: usize,
+        reason: String,
+    },
 }
 
 impl FeError {

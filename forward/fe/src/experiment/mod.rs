@@ -36,7 +36,13 @@
 //! specimen) is refused by [`Experiment::check`], naming the field.
 
 pub mod build;
+mod check;
+#[cfg(test)]
+mod description_tests;
+mod io;
 pub mod params;
+pub mod presets;
+mod value;
 
 use std::collections::BTreeMap;
 
@@ -282,7 +288,11 @@ pub struct PronyTerm {
 /// (`{ start = 0.3 }`, optionally with `lower`, `upper`, and `fit = false`
 /// to keep it at `start`); `"bonded"` where a friction coefficient may be
 /// infinite (no slip).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+///
+/// A bad value is refused with what is valid (a number, `{ start = .. }`
+/// with optional `fit`, `lower`, `upper`, `nuisance`, or a keyword) and an
+/// unknown key of `{ .. }` by its name (`value.rs`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum Value {
     Fixed(f64),
@@ -419,7 +429,9 @@ pub struct Protocol {
     /// Segments in order, from the tool just touching the specimen.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub segments: Vec<Segment>,
-    /// Samples per ramp segment when segments are given (default 20).
+    /// Samples per segment (ramp, hold, roll) when segments are given
+    /// (default 20), after the start: a ramp to 10 mm with 40 samples is
+    /// sampled every 0.25 mm from 0.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub samples: Option<usize>,
 }
@@ -452,6 +464,9 @@ pub struct Segment {
     pub roll_to_x: Option<f64>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub time: Option<f64>,
+    /// Samples of this ramp, hold or roll (default `protocol.samples`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub samples: Option<usize>,
 }
 
 /// The mesh: made for a stated accuracy (default), or at a given level.

@@ -151,6 +151,14 @@ pub struct N3Parts {
     contact: Part<RigidContact>,
 }
 
+impl N3Setup {
+    /// Makes the friction coefficient the parameter after the law's (as
+    /// the `friction` effect does), starting at `friction`, or not.
+    pub fn set_friction_parameter(&mut self, on: bool) {
+        self.friction_is_parameter = on;
+    }
+}
+
 impl N3Needle {
     /// docs/benchmarks.md N3 with the given law: friction 0.8, exact
     /// incompressibility, the box of mesh level 1, contact at the facet
