@@ -413,3 +413,41 @@ fn calibrate_reads_the_phantom_file_and_its_positive_copy_to_the_same_fit() {
         "{stderr}"
     );
 }
+
+#[test]
+fn a_manifest_data_table_states_the_same_options() {
+    let original = read(&phantom(A1), &[]).unwrap();
+    let positive = rewrite(
+        "manifest",
+        "positive.csv",
+        |_, l| Some(l.to_string()),
+        negate(&[3, 4, 5, 6]),
+        ",",
+    );
+    let spec: palpate_studies::records::DataSpec = toml::from_str(
+        r#"file = "positive.csv"
+test = "uniaxial"
+compression = "positive"
+columns = { strain = "Engineering Strain", stress = "Engineering Stress" }
+skip_rows = 7
+"#,
+    )
+    .unwrap();
+    let o = spec.read_options().unwrap();
+    assert_eq!(o.columns.len(), 2);
+    let d = TestData::read_with("phantom", UNIAXIAL, &positive, o).unwrap();
+    assert_eq!(d.observed, original.observed);
+    assert_eq!(d.columns_read.len(), 5, "{:?}", d.columns_read);
+    let bad: palpate_studies::records::DataSpec =
+        toml::from_str("file = \"x.csv\"\ntest = \"uniaxial\"\ncolumns = { load = \"Load\" }\n")
+            .unwrap();
+    let e = format!("{:#}", bad.read_options().unwrap_err());
+    assert!(
+        e.contains("columns.load: unknown column role; expected one of time, displacement, force"),
+        "{e}"
+    );
+    let bad: palpate_studies::records::DataSpec =
+        toml::from_str("file = \"x.csv\"\ntest = \"uniaxial\"\ncompression = \"up\"\n").unwrap();
+    let e = format!("{:#}", bad.read_options().unwrap_err());
+    assert!(e.contains("compression `up`: expected negative"), "{e}");
+}

@@ -185,7 +185,10 @@ fn check_data(path: &Path, m: &crate::study::manifest::Manifest) -> anyhow::Resu
     for (name, spec) in &m.data {
         let kind = TestKind::parse(&spec.test)
             .map_err(|e| anyhow::anyhow!("{}: data.{name}.test: {e}", path.display()))?;
-        let d = TestData::read(name, kind, &dir.join(&spec.file))
+        let options = spec
+            .read_options()
+            .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
+        let d = TestData::read_with(name, kind, &dir.join(&spec.file), options)
             .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
         rows += d.observed.len();
     }

@@ -269,10 +269,9 @@ pub fn resolve(
             };
             if d_max < 0.0 {
                 let hint = if declared.is_none() && f_at < 0.0 {
-                    format!(
-                        "if the machine writes compression as negative, set compression=negative \
-                         (--data TEST[compression=negative]=FILE, --compression negative or `compression = \"negative\"`)"
-                    )
+                    "if the machine writes compression as negative, set compression=negative \
+                     (--data TEST[compression=negative]=FILE, --compression negative or `compression = \"negative\"`)"
+                        .to_string()
                 } else {
                     "check the sign of the displacement column".to_string()
                 };
