@@ -6,8 +6,9 @@ run statistics.
 usage: post.py DECK.dat --out CURVE.csv [--note TEXT]
 
 Indentation decks (a tool node set NTOOL only): displacement = the second
-step's time (mm) less the tool's initial gap (`** GAP g` in NAME.inp). Cylinder decks (sets TOP and NTOOL): the force is TOP's
-reaction plus the platen strip's; displacement = 12 mm x step time (the
+step's time (mm) less the tool's initial gap (`** GAP g` in NAME.inp).
+Cylinder decks (sets TOP and NTOOL): the force is TOP's reaction plus the
+platen strip's; displacement = 12 mm x step time (the
 platens' travel). NAME.sta and NAME.time (from run.sh) beside the .dat give
 increments, iterations and CPU seconds.
 """

@@ -42,7 +42,8 @@ def base_grid():
     return xs, ys
 
 
-def write(path, level, platens="bonded", penalty=10.0, dmax=1.0 / 96, r0=PLATEN_R0):
+def write(path, level, platens="bonded", penalty=10.0, dmax=1.0 / 96, r0=PLATEN_R0,
+          corner_face=True):
     xs, ys = base_grid()
     xs, ys = refine(xs, level), refine(ys, level)
     m = Mesh()
@@ -54,6 +55,9 @@ def write(path, level, platens="bonded", penalty=10.0, dmax=1.0 / 96, r0=PLATEN_
     axis = m.nodes_where(lambda x, y: abs(x) < tol)
     side = m.nodes_where(lambda x, y: abs(x - R) < tol)
     slave = m.faces_where(lambda x, y: abs(x - R) < tol and y >= zt / 2 - tol)
+    if not corner_face:         # leave out the side face at the bonded edge
+        slave = [(e, f) for e, f in slave
+                 if max(m.nodes[n][1] for n in m.face_nodes(e, f)) < zt - tol]
 
     def pt(s):      # the platen's face from PLATEN_R0 out, normal down
         return (r0 + s, zt, 0.0, -1.0)
@@ -114,6 +118,9 @@ if __name__ == "__main__":
     ap.add_argument("--penalty", type=float, default=10.0)
     ap.add_argument("--platen-r0", type=float, default=PLATEN_R0,
                     help="where the platen strip's face starts (mm)")
+    ap.add_argument("--no-corner-face", action="store_true",
+                    help="leave the side face at the bonded edge out of the contact")
     a = ap.parse_args()
     out = a.out or f"cyl_l{a.level}.inp"
-    print(out, write(out, a.level, a.platens, a.penalty, r0=a.platen_r0))
+    print(out, write(out, a.level, a.platens, a.penalty, r0=a.platen_r0,
+                     corner_face=not a.no_corner_face))

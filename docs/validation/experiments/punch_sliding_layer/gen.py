@@ -11,8 +11,9 @@ the axis). The punch is a strip of elements 0.1 mm deep along its profile
 cylindrical side 1.8 mm up), all of its nodes prescribed, starting
 GAP = 0.002 mm above the layer (flush, CalculiX's first step does not
 converge; the curve's displacement is counted from the touch); its outer
-face is the master of a face-to-face penalty contact (frictionless, 10 MPa/mm) with the layer's top face within
-r <= 3.5 mm; the first 0.01 mm of the face, at the axis, is left out.
+face is the master of a face-to-face penalty contact (frictionless,
+10 MPa/mm) with the layer's top face within r <= 3.5 mm; the first
+0.01 mm of the face, at the axis, is left out.
 
 Mesh level L: elements of H0 = 0.16 / L mm in r in [1.4, 2.6] mm (under
 and around the edge), graded by 1.2 per element to 0.2 mm at the axis and
