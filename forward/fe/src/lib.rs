@@ -61,6 +61,7 @@
     clippy::collapsible_match
 )]
 
+pub mod accuracy;
 pub mod body;
 pub mod contact;
 pub mod contact_split;

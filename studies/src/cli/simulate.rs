@@ -83,7 +83,7 @@ pub struct Args {
     /// N1, N3 tool: needle (docs/benchmarks.md), sphere:RADIUS, punch:RADIUS (flat, edge rounded 0.1 mm) or platen [default: needle].
     #[arg(long)]
     pub tool: Option<String>,
-    /// N1 and Q1 element: quad4 (4-node, constant pressure; the validated default) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4]. N3: hex8 (8-node, constant pressure, on the graded box) or hex27 (27-node, linear discontinuous pressure, on the quarter O-grid with cells of 1.6/N mm: the accurate choice with friction; accuracy and cost: docs/validation/fe.md "N3") [default: hex8].
+    /// N1 and Q1 element: quad4 (4-node, constant pressure) or quad9 (9-node, linear discontinuous pressure, on the same grading made quadratic: more accurate per unknown) [default: quad4; N1 needle without --mesh: quad9 on the bench mesh]. N3: hex8 (8-node, constant pressure, on the graded box) or hex27 (27-node, linear discontinuous pressure, on the quarter O-grid with cells of 1.6/N mm: the accurate choice with friction; accuracy and cost: docs/validation/fe.md "N3") [default without --mesh: hex27 with friction, hex8 frictionless; with --mesh: hex8].
     #[arg(long, value_name = "quad4|quad9")]
     pub element: Option<String>,
     /// Q1: radius of the punch's rounded edge in mm, > 0 and below the punch radius 2 [default: 0.2]. The default runs the 5 mm ramp; a larger edge is a rounded punch, no longer the flat one (its force and accuracy against depth: docs/validation/fe.md "Q1").
@@ -95,9 +95,12 @@ pub struct Args {
     /// Spacing of the output samples in mm (default: 0.25 for N1, 0.1 for C1, depth/100 for Q1, 0.5 mm of wheel travel for R2).
     #[arg(long)]
     pub step: Option<f64>,
-    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: elements of 0.4/N mm under the tool; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch; N3: hexahedra of 0.8/N mm, levels 1..2, default coarse; R2: 9-node elements of 2/N mm at the surface and around the nodules, levels 1..3, default coarse) [default: medium].
+    /// Mesh density: coarse, medium, fine or a refinement level N = 1..12 (N1: 4-node elements of 0.4/N mm under the tool, or bench: the benchmark mesh, 9-node cells of 0.5 mm in a 2 mm zone, the default for the needle, within 0.5 % of the converged force; C1: 19N x 9N elements; Q1: 0.2/N mm under the punch; N3: hexahedra of 0.8/N mm, levels 1..2, default: 27-node cells of 1.6 mm on the O-grid with friction, the coarse box frictionless; R2: 9-node elements of 2/N mm at the surface and around the nodules, levels 1..3, default coarse) [default: medium; N1 needle: bench]. --accuracy chooses it for a stated error instead.
     #[arg(long)]
     pub mesh: Option<String>,
+    /// N1, N3: choose the mesh for this relative discretisation error of the force at the deepest sample (e.g. 0.01 for 1 %) instead of --mesh: the model is solved on a ladder of refinement levels, each error estimated by Richardson from a mesh with elements twice as large, and the first level that meets it is used; the level is cached (in $XDG_CACHE_HOME/palpate or ~/.cache/palpate) so the search is paid once per model, depth and accuracy.
+    #[arg(long, value_name = "FRACTION")]
+    pub accuracy: Option<f64>,
     /// Incompressibility: exact (Lagrange multiplier per element) or a bulk-to-shear modulus ratio K/mu such as 1000 [default: exact].
     #[arg(long)]
     pub bulk: Option<String>,
@@ -536,6 +539,15 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         None => Loading::quasi_static(Drive::DisplacementMm, drive.clone()),
     };
 
+    let chosen = match args.accuracy {
+        Some(target) => Some(choose_mesh(args, &model, target, &theta, &loading)?),
+        None => None,
+    };
+    let (model, chosen_line) = match chosen {
+        Some((m, line)) => (m, Some(line)),
+        None => (model, None),
+    };
+
     let (bar, mut cb) = progress_bar(drive.len(), "");
     let (title, bulk, result) = match &model {
         Model::N1Needle(m) => (
@@ -569,6 +581,7 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         format!("palpate simulate: {title}"),
         format!("volumetric: {}", volumetric(bulk)),
     ];
+    comments.extend(chosen_line);
     let (sim, solver): (Simulation, _) = match result {
         Ok(r) => r,
         Err(palpate_core::ForwardError::NotConverged {
@@ -646,6 +659,56 @@ fn compute(args: &Args, model: Model) -> anyhow::Result<(Curve, palpate_fe::syst
         },
         solver,
     ))
+}
+
+/// `--accuracy`: the N1 or N3 model at the level of its mesh family that
+/// meets the target (`palpate_fe::accuracy::choose`, cached in the user's
+/// cache directory), and the line stating it.
+fn choose_mesh(
+    args: &Args,
+    model: &Model,
+    target: f64,
+    theta: &[f64],
+    loading: &Loading,
+) -> anyhow::Result<(Model, String)> {
+    use palpate_fe::accuracy::{choose, AccuracyOptions, Refinable};
+    if let Some(mesh) = &args.mesh {
+        bail!(
+            "--accuracy {target} with --mesh {mesh}: --accuracy chooses the mesh; give one of them"
+        );
+    }
+    let mut opts = AccuracyOptions::new(target);
+    opts.cache_dir = cache_dir();
+    let bar = ProgressBar::new_spinner();
+    bar.set_message(format!(
+        "choosing the mesh for {} % accuracy",
+        100.0 * target
+    ));
+    let result = match model {
+        Model::N1Needle(m) => choose(m, loading, &opts, |m, l| m.predict(theta, l))
+            .map(|c| (Model::N1Needle(m.at_level(c.level)), c)),
+        Model::N3Needle(m) => choose(m, loading, &opts, |m, l| m.predict(theta, l))
+            .map(|c| (Model::N3Needle(m.at_level(c.level)), c)),
+        _ => bail!(
+            "--accuracy: N1 and N3 choose their mesh for an accuracy; --benchmark {} takes --mesh",
+            args.benchmark
+        ),
+    };
+    bar.finish_and_clear();
+    let (m, choice) = result.map_err(|e| anyhow!("--accuracy {target}: {e}"))?;
+    let line = choice.line();
+    eprintln!("{line}");
+    Ok((m, line))
+}
+
+/// The user's cache directory for palpate (`$XDG_CACHE_HOME/palpate`, else
+/// `~/.cache/palpate`); `None` without either variable (no cache).
+fn cache_dir() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_CACHE_HOME")
+        .filter(|v| !v.is_empty())
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("palpate"))
 }
 
 /// The volumetric treatment in words.

@@ -12,7 +12,8 @@ use palpate_material::Law;
 /// The model of a data set's test for a law (the legacy manifest form
 /// `law = "..."` and the commands' `--benchmark`): the analytic homogeneous
 /// test, analytic C1, or N1 with the docs/benchmarks.md needle (friction 0.8) on
-/// the coarse mesh, since every evaluation of a fit is a full FE run.
+/// its default mesh ([`set_n1_mesh`]: the cheapest within 0.5 % of the
+/// converged force).
 pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
     let law = law.to_string();
     match test {
@@ -38,7 +39,6 @@ pub fn for_test(test: TestKind, law: Law) -> ModelSpec {
         TestKind::C1 => ModelSpec::C1(C1Spec { law }),
         TestKind::N1 => ModelSpec::N1Needle(N1NeedleSpec {
             law,
-            mesh: Some("coarse".into()),
             ..Default::default()
         }),
     }
@@ -148,4 +148,68 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
         .iter()
         .map(|e| e.parse::<Effect>().map_err(|m| anyhow::anyhow!("{m}")))
         .collect()
+}
+
+/// The N1 mesh name of the Q2/P1 benchmark mesh (and, for `quad4`, the
+/// Q1/P0 one, `MeshDensity::BENCH_GRADING`).
+pub const BENCH_MESH: &str = "bench";
+
+/// Sets the mesh and element of an N1 model from a spec's `mesh` and
+/// `element` (the model's tool and friction already set).
+///
+/// Without `mesh`, the needle gets the mesh and element that meet 0.5 %
+/// of the converged force at 2, 5 and 10 mm at the least cost:
+/// [`palpate_fe::accuracy::N1_QUAD9_BENCH`], 9-node Q2/P1 cells (1.4 s of
+/// CPU to 10 mm, where the Q1/P0 medium mesh takes 5 s for +0.63 %;
+/// docs/validation/fe.md "N1 speed"); with `element = "quad4"`, or
+/// another tool (that mesh was measured for the needle), the Q1/P0 medium
+/// mesh. `mesh = "bench"` names the benchmark mesh of the element
+/// (Q2/P1 by default; `quad4`: `MeshDensity::BENCH_GRADING`). A level
+/// (`coarse`, `medium`, `fine`, `N`) keeps its meaning: Q1/P0 elements of
+/// 0.4/N mm unless `element` says otherwise.
+pub(crate) fn set_n1_mesh(
+    kind: &'static str,
+    mesh: Option<&str>,
+    element: Option<&str>,
+    m: &mut palpate_fe::N1Needle,
+) -> Result<(), super::ModelError> {
+    use palpate_fe::{accuracy::N1_QUAD9_BENCH, MeshDensity, PlaneCell, ToolShape};
+    let needle = m.tool == ToolShape::n1_needle();
+    let explicit = element
+        .map(|e| super::fields::parse_element(kind, Some(e)))
+        .transpose()?;
+    match mesh {
+        None if needle && explicit != Some(PlaneCell::Quad4) => {
+            m.element = PlaneCell::Quad9;
+            m.grading = Some(N1_QUAD9_BENCH);
+        }
+        Some(BENCH_MESH) => {
+            m.element = explicit.unwrap_or(PlaneCell::Quad9);
+            m.grading = Some(match m.element {
+                PlaneCell::Quad9 => N1_QUAD9_BENCH,
+                PlaneCell::Quad4 => MeshDensity::BENCH_GRADING,
+            });
+        }
+        _ => {
+            m.element = explicit.unwrap_or(PlaneCell::Quad4);
+            m.mesh = MeshDensity {
+                level: super::parse_mesh(kind, mesh)?,
+            };
+        }
+    }
+    Ok(())
+}
+
+/// The default N3 element when the spec names none. With no `mesh`, for
+/// the needle with friction: 27-node Q2/P1 hexahedra on the quarter O-grid
+/// (level 1: +0.6 % from the extrapolated force at 10 mm, where the 8-node
+/// box is +6.4 %). Otherwise the 8-node Q1/P0 box: a mesh level names the
+/// box's level, and frictionless the 27-node cells stop near 5.5 mm
+/// (docs/validation/fe.md "N3").
+pub(crate) fn n3_default_element(m: &palpate_fe::N3Needle, mesh_given: bool) -> &'static str {
+    if !mesh_given && m.friction > 0.0 && m.tool == palpate_fe::ToolShape::n1_needle() {
+        "hex27"
+    } else {
+        "hex8"
+    }
 }

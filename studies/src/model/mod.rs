@@ -82,8 +82,7 @@ use palpate_analytic::{
 };
 use palpate_core::ForwardModel;
 use palpate_fe::{
-    C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch, R2Rolling,
-    Support,
+    C1Fe, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch, R2Rolling, Support,
 };
 use palpate_material::Law;
 use serde::Deserialize;
@@ -588,9 +587,6 @@ impl ModelSpec {
                     ));
                 }
                 m.friction = friction;
-                m.mesh = MeshDensity {
-                    level: parse_mesh(K, s.mesh.as_deref())?,
-                };
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
                 m.base = match s.base.as_deref().unwrap_or("bonded") {
                     "bonded" => Support::Bonded,
@@ -605,7 +601,7 @@ impl ModelSpec {
                     }
                 };
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
-                m.element = parse_element(K, s.element.as_deref())?;
+                defaults::set_n1_mesh(K, s.mesh.as_deref(), s.element.as_deref(), &mut m)?;
                 m.prony = parse_prony(K, s.prony.as_deref())?;
                 Model::N1Needle(m)
             }
@@ -638,7 +634,11 @@ impl ModelSpec {
                 m.level = level;
                 m.bulk = parse_bulk(K, s.bulk.as_deref())?;
                 m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
-                match s.element.as_deref().unwrap_or("hex8") {
+                match s
+                    .element
+                    .as_deref()
+                    .unwrap_or(defaults::n3_default_element(&m, s.mesh.is_some()))
+                {
                     "hex8" => {}
                     "hex27" => {
                         m.element = N3Element::Hex27;
