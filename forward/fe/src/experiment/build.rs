@@ -39,6 +39,7 @@ fn bad(field: impl Into<String>, reason: impl Into<String>) -> FeError {
 pub struct Described<M> {
     model: M,
     space: ParamSpace,
+    loading: Option<Loading>,
 }
 
 impl<M: ForwardModel> Described<M> {
@@ -56,12 +57,28 @@ impl<M: ForwardModel> Described<M> {
                 ),
             ));
         }
-        Ok(Described { model, space })
+        Ok(Described {
+            model,
+            space,
+            loading: None,
+        })
+    }
+
+    /// The same with the loading of the description's protocol.
+    pub fn with_loading(mut self, loading: Option<Loading>) -> Self {
+        self.loading = loading;
+        self
     }
 
     /// The model.
     pub fn model(&self) -> &M {
         &self.model
+    }
+
+    /// The loading of the description's protocol segments (`None`: the
+    /// protocol is a record's).
+    pub fn loading(&self) -> Option<&Loading> {
+        self.loading.as_ref()
     }
 }
 
@@ -141,6 +158,18 @@ impl ExperimentModel {
     pub fn name(&self) -> String {
         self.as_forward().name()
     }
+    /// The loading of the description's `protocol.segments` (a wheel's
+    /// `tool.path`), so that a description runs without a record
+    /// ([`Experiment::loading`]); `None` when the protocol is a record's.
+    pub fn loading(&self) -> Option<Loading> {
+        match self {
+            ExperimentModel::Cylinder(m) => m.loading().cloned(),
+            ExperimentModel::Compression(m) => m.loading().cloned(),
+            ExperimentModel::Punch(m) => m.loading().cloned(),
+            ExperimentModel::Block(m) => m.loading().cloned(),
+            ExperimentModel::Rolling(m) => m.loading().cloned(),
+        }
+    }
     /// Which setup it is: `cylinder`, `compression`, `punch`, `block`,
     /// `rolling`.
     pub fn kind(&self) -> &'static str {
@@ -162,6 +191,7 @@ impl Experiment {
     pub fn model(&self) -> Result<ExperimentModel, FeError> {
         self.check()?;
         let space = self.param_space()?;
+        let loading = self.loading()?;
         Ok(match (&self.specimen, &self.tool) {
             (Specimen::Mesh(m), _) => {
                 return Err(bad(
@@ -179,20 +209,21 @@ impl Experiment {
                 ))
             }
             (Specimen::Cylinder(_), Tool::Platens(_)) if self.is_c1() => {
-                ExperimentModel::Compression(Described::new(c1_from(self)?, space)?)
+                ExperimentModel::Compression(Described::new(c1_from(self)?, space)?.with_loading(loading))
             }
             (Specimen::Cylinder(_), Tool::FlatPunch(_)) if self.is_q1() => {
-                ExperimentModel::Punch(Described::new(q1_from(self)?, space)?)
+                ExperimentModel::Punch(Described::new(q1_from(self)?, space)?.with_loading(loading))
             }
             (Specimen::Cylinder(_), _) => ExperimentModel::Cylinder(Described::new(
                 FeModel::from_setup(crate::N1Setup::from_experiment(self)?),
                 space,
-            )?),
+            )?
+            .with_loading(loading)),
             (Specimen::Block(_), Tool::Wheel(_)) => {
-                ExperimentModel::Rolling(Described::new(r2_from(self)?, space)?)
+                ExperimentModel::Rolling(Described::new(r2_from(self)?, space)?.with_loading(loading))
             }
             (Specimen::Block(_), _) => {
-                ExperimentModel::Block(Described::new(n3_from(self)?, space)?)
+                ExperimentModel::Block(Described::new(n3_from(self)?, space)?.with_loading(loading))
             }
         })
     }
