@@ -5,7 +5,6 @@
 use std::path::PathBuf;
 
 use crate::model::experiment::{preset, preset_names, ExperimentSpec};
-use crate::model::experiment_api::ExperimentApi;
 use palpate_fe::experiment::Experiment;
 
 /// Experiment descriptions: list the presets, print one to edit, check a file

@@ -691,7 +691,7 @@ fn choose_mesh(
             .map(|c| (Model::N3Needle(m.at_level(c.level)), c)),
         _ => bail!(
             "--accuracy: N1 and N3 choose their mesh for an accuracy; --benchmark {} takes --mesh",
-            args.benchmark
+            args.benchmark()
         ),
     };
     bar.finish_and_clear();

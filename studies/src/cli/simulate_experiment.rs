@@ -8,7 +8,6 @@ use palpate_fe::experiment::ExperimentModel;
 
 use super::simulate::{progress_bar, volumetric, Args, Curve};
 use super::simulate_estimate::estimate;
-use crate::model::experiment_api::ModelLoading;
 use crate::model::{ExperimentSpec, Model, ModelSpec};
 
 /// The parameter values of a run: the description's starts (and fixed
@@ -52,7 +51,7 @@ pub(crate) fn compute(
 ) -> anyhow::Result<(Curve, Option<palpate_fe::system::System>)> {
     let spec = ExperimentSpec::from_option(arg)?;
     let source = spec.source.to_string();
-    let protocol = spec.experiment.protocol.clone();
+
     let Model::Experiment(built) = ModelSpec::Experiment(spec)
         .validate()
         .map_err(|e| anyhow!("--experiment {source}: {}", e.expected))?
@@ -72,10 +71,11 @@ pub(crate) fn compute(
             bail!("--order {p}: must be a positive order of convergence");
         }
     }
-    let loading: Loading = built
-        .model
-        .loading(&protocol)
-        .map_err(|e| anyhow!("--experiment {source}: {e}"))?;
+    let loading: Loading = built.model.loading().ok_or_else(|| {
+        anyhow!(
+            "--experiment {source}: its protocol is a record's; give the record with --data, or protocol.segments (e.g. [{{ ramp_to = 2.0 }}])"
+        )
+    })?;
     let model = built.model;
     let theta = theta(model.as_forward(), &args.params)?;
     let title = model.as_forward().name();
@@ -98,7 +98,7 @@ pub(crate) fn compute(
                 solver.equations()
             ));
             comments.push(format!("volumetric: {}", volumetric(m.bulk)));
-            (sim.forces, Some(solver), Some(Model::N1Needle(m.clone())))
+            (sim.forces, Some(solver), Some(Model::N1Needle(m.model().clone())))
         }
         other => {
             let f = other

@@ -30,7 +30,6 @@ use std::path::{Path, PathBuf};
 
 use palpate_fe::experiment::Experiment;
 
-use super::experiment_api::ExperimentApi;
 
 /// An experiment description and where it came from.
 #[derive(Debug, Clone, PartialEq)]
@@ -83,7 +82,7 @@ pub fn preset(name: &str) -> Option<Experiment> {
 
 /// Parses an experiment file's text; errors name `file` and the line.
 pub fn parse(text: &str, file: &Path) -> anyhow::Result<Experiment> {
-    Experiment::from_toml_str(text, file).map_err(|e| anyhow::anyhow!("{e}"))
+    Experiment::from_toml_str(text, &file.display().to_string()).map_err(|e| anyhow::anyhow!("{e}"))
 }
 
 /// Reads an experiment file; errors name the file.

@@ -70,7 +70,6 @@ pub mod calibration;
 pub mod defaults;
 pub mod entry;
 pub mod experiment;
-pub mod experiment_api;
 pub mod fields;
 
 pub use entry::{ModelEntry, ModelForm};
@@ -664,7 +663,6 @@ impl ModelSpec {
 /// The model of an experiment description, checked first
 /// ([`Experiment::check`](palpate_fe::experiment::Experiment)).
 fn experiment_model(s: &ExperimentSpec) -> Result<Model, ModelError> {
-    use experiment_api::ExperimentApi;
     s.experiment.check().map_err(|e| experiment_error(s, e))?;
     let model = s.experiment.model().map_err(|e| experiment_error(s, e))?;
     Ok(Model::Experiment(BuiltExperiment {

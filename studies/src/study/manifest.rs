@@ -37,7 +37,6 @@
 //! residuals = ["absolute", "relative"]
 //! ```
 
-use crate::model::experiment_api::ExperimentApi;
 use crate::records::TESTS;
 use crate::run::step::{At, StepRef, Study};
 use palpate_fe::experiment::Experiment;

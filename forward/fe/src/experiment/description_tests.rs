@@ -716,7 +716,6 @@ mod models {
     }
 
     #[test]
-    #[ignore = "needs N1Setup::from_experiment; run: cargo test -p palpate-fe --lib experiment::description_tests::models -- --ignored"]
     fn the_n1_preset_is_n1_s_model() {
         match model("N1").1 {
             ExperimentModel::Cylinder(m) => {
