@@ -181,10 +181,15 @@ fn compression_written_positive_is_refused_unless_declared_then_read_the_same() 
         negate(&[3, 4, 5, 6]),
         ",",
     );
-    let t = read(&tension, &[]).unwrap();
+    // (Negated, the true pair is no longer a true pair: the engineering pair is read.)
+    let eng = [
+        ("strain", "Engineering Strain"),
+        ("stress", "Engineering Stress"),
+    ];
+    let t = read(&tension, &eng).unwrap();
     assert_eq!(t.sign, "tension");
     assert!(t.observed[1201] > 0.25);
-    let e = err(&tension, &[("compression", "negative")]);
+    let e = err(&tension, &[eng[0], eng[1], ("compression", "negative")]);
     assert!(
         e.contains("tension.csv:") && e.contains("compression=negative, but"),
         "{e}"

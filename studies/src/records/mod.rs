@@ -250,7 +250,8 @@ impl TestData {
         if !self.columns_read.is_empty() {
             out.push_str(&format!("  columns: {}\n", self.columns_read.join("; ")));
         }
-        if !self.sign.is_empty() && !(self.metadata.is_empty() && self.columns_read.is_empty()) {
+        let plain = self.metadata.is_empty() && self.columns_read.is_empty();
+        if !self.sign.is_empty() && !plain {
             out.push_str(&format!("  sign: {}\n", self.sign));
         }
         out
