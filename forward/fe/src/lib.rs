@@ -95,12 +95,12 @@ pub use models::{c1, cylinder, n1, n3, q1, r2, r2_gap, r2_scan};
 
 pub use c1::{C1Fe, C1Setup, Platens};
 pub use contact::ContactPoints;
+pub use cylinder::{Cylinder, CylinderSetup};
 pub use discretisation::{Coarser, ConvergenceOrder, ErrorEstimate};
 pub use error::FeError;
 pub use line_search::LineSearch;
 pub use material::LawMaterial;
 pub use model::{Bulk, FeModel, PlaneCell, Setup, Simulation, Support};
-pub use cylinder::{Cylinder, CylinderSetup};
 pub use n1::{BandMaterial, MeshDensity, N1Needle, N1Setup, Sizing};
 pub use n3::{
     n3_core_cells, n3_grading, n3_quadratic_grading, N3Element, N3Mesh, N3Needle, N3Setup,
@@ -110,7 +110,9 @@ pub use q1::{Q1Punch, Q1Setup};
 pub use r2::{r2_element_size, Nodule, R2Rolling, R2Setup};
 pub use r2_gap::R2Gap;
 pub use stepper::{LoadPath, Progress};
-pub use surface::{Cylinder3d, Floor2d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d};
+pub use surface::{
+    Cylinder3d, Floor2d, Profile2d, Revolution3d, RigidSurface, SurfacePoint, Wheel2d,
+};
 pub use system::{RunStats, SolverOptions, System};
 pub use tool::ToolShape;
 pub use viscoelastic::{Prony, Viscoelastic};

@@ -140,7 +140,11 @@ pub fn with_lines(positions: &[f64], lines: &[f64]) -> Vec<f64> {
         out.insert(k, l);
         fixed.push(l);
         // the nearer neighbour, if it is free and too close
-        let (near, j) = if l - lo < hi - l { (lo, k - 1) } else { (hi, k + 1) };
+        let (near, j) = if l - lo < hi - l {
+            (lo, k - 1)
+        } else {
+            (hi, k + 1)
+        };
         if (near - l).abs() < h / 3.0 && !fixed.contains(&near) {
             out.remove(j);
         }

@@ -41,7 +41,7 @@
 //!   | needle (tip `rho`) | | `5 rho / 2.5` | `0.4 rho / 2.5` (N1's [`MeshDensity`]) | |
 //!   | sphere `R` | `sqrt(R d)` (at most `R`) | `2 a` | `a / 5` | `R / 10` |
 //!   | cone `alpha`, tip `rho` | `2 d tan(alpha) / pi + rho` | `2 a` | `a / 5` | `height / 10` |
-//!   | flat punch `a`, edge `rho` | `a` | `1.5 a` | `min(a / 10, rho)` | |
+//!   | flat punch `a`, edge `rho` | `a` | `1.5 a` | `a / 10` | `a / 10` |
 //!   | platens | | the whole body | `min(radius, height) / 8`, uniform | `0.3 height` |
 //!
 //!   A zone larger than the body is the whole body.
@@ -85,7 +85,9 @@ fn friction_value(field: &str, v: &Value) -> Result<(f64, bool), FeError> {
         Value::Keyword(k) if k == "frictionless" => Ok((0.0, false)),
         Value::Keyword(k) => Err(bad(
             field,
-            format!("`{k}`: expected a number >= 0, {{ start = .. }}, \"frictionless\" or \"bonded\""),
+            format!(
+                "`{k}`: expected a number >= 0, {{ start = .. }}, \"frictionless\" or \"bonded\""
+            ),
         )),
     }
 }
@@ -319,7 +321,7 @@ impl N1Setup {
                     )
                 } else {
                     let a = 2.0 * d * alpha.to_radians().tan() / std::f64::consts::PI + tip;
-                    (contact_sizing(a, level), d / 10.0)
+                    (contact_sizing(a, level), d / 5.0)
                 };
                 (tool, &t.friction, sizing, max_step)
             }
@@ -338,7 +340,7 @@ impl N1Setup {
                     ToolShape::Sphere { radius: r },
                     &t.friction,
                     contact_sizing(a, level),
-                    d / 10.0,
+                    d / 5.0,
                 )
             }
             Tool::FlatPunch(t) => {
@@ -368,12 +370,12 @@ impl N1Setup {
                     },
                     &t.friction,
                     Sizing {
-                        h: (0.1 * a).min(rho),
+                        h: 0.1 * a,
                         fine_zone: 1.5 * a,
                         growth: 0.2,
                         level,
                     },
-                    d / 10.0,
+                    d / 5.0,
                 )
             }
             Tool::Platens(t) => {
@@ -402,12 +404,10 @@ impl N1Setup {
         let (base, base_friction, base_friction_is_parameter) = match &c.support {
             SupportSpec::Bonded => (Support::Bonded, None, false),
             SupportSpec::Sliding | SupportSpec::Symmetry => (Support::Sliding, None, false),
-            SupportSpec::Friction(v) => {
-                match friction_value("specimen.support.friction", v)? {
-                    (mu, false) if mu.is_infinite() => (Support::Bonded, None, false),
-                    (mu, p) => (Support::Sliding, Some(mu), p),
-                }
-            }
+            SupportSpec::Friction(v) => match friction_value("specimen.support.friction", v)? {
+                (mu, false) if mu.is_infinite() => (Support::Bonded, None, false),
+                (mu, p) => (Support::Sliding, Some(mu), p),
+            },
         };
         let element = match e.mesh.element {
             None | Some(ElementSpec::Quad9) => PlaneCell::Quad9,

@@ -38,13 +38,13 @@ use palpate_material::Law;
 use std::sync::Arc;
 
 use crate::body::{RegionMaterial, SolidBody};
-use crate::material::LawMaterial;
 use crate::contact::{ContactOptions, ContactPoints, RigidContact};
 use crate::contribution::Contribution;
 use crate::discretisation::{Coarser, ConvergenceOrder};
 use crate::dofs::Dirichlet;
 use crate::kernel::kernel_for;
 use crate::kinematics::Kinematics;
+use crate::material::LawMaterial;
 use crate::mesh::{Grading, Mesh};
 use crate::model::{
     doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup, Support,
@@ -355,7 +355,9 @@ impl N1Setup {
         if self.layers.is_empty() {
             vec!["body".into()]
         } else {
-            (0..self.layers.len()).map(|i| format!("layer{i}")).collect()
+            (0..self.layers.len())
+                .map(|i| format!("layer{i}"))
+                .collect()
         }
     }
 
@@ -384,7 +386,11 @@ impl N1Setup {
         extra: &'a [f64],
     ) -> Result<(&'a [f64], Vec<&'a [f64]>, Option<f64>, Option<f64>), FeError> {
         let need = 2 * self.prony_parameters
-            + self.materials.iter().map(BandMaterial::param_count).sum::<usize>()
+            + self
+                .materials
+                .iter()
+                .map(BandMaterial::param_count)
+                .sum::<usize>()
             + usize::from(self.friction_is_parameter)
             + usize::from(self.base_friction_is_parameter);
         if extra.len() < need {
