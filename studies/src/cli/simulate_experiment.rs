@@ -98,7 +98,11 @@ pub(crate) fn compute(
                 solver.equations()
             ));
             comments.push(format!("volumetric: {}", volumetric(m.bulk)));
-            (sim.forces, Some(solver), Some(Model::N1Needle(m.model().clone())))
+            (
+                sim.forces,
+                Some(solver),
+                Some(Model::N1Needle(m.model().clone())),
+            )
         }
         other => {
             let f = other

@@ -30,7 +30,6 @@ use std::path::{Path, PathBuf};
 
 use palpate_fe::experiment::Experiment;
 
-
 /// An experiment description and where it came from.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ExperimentSpec {

@@ -717,9 +717,25 @@ mod models {
 
     #[test]
     fn the_n1_preset_is_n1_s_model() {
+        // the same mesh and settings; the forces are compared to 1e-9 in
+        // tests/integration/closed_form_experiments.rs
+        let n1 = crate::N1Needle::new(Law::NeoHookean);
         match model("N1").1 {
             ExperimentModel::Cylinder(m) => {
-                assert_eq!(*m.model(), crate::N1Needle::new(Law::NeoHookean))
+                let m = m.model();
+                assert_eq!(m.build_mesh().unwrap(), n1.build_mesh().unwrap());
+                assert_eq!(
+                    (m.friction, m.tool, m.base, m.element, m.bulk, m.options),
+                    (
+                        n1.friction,
+                        n1.tool,
+                        n1.base,
+                        n1.element,
+                        n1.bulk,
+                        n1.options
+                    )
+                );
+                assert_eq!(m.space().names(), ["C10"]);
             }
             other => panic!("{}", other.kind()),
         }
