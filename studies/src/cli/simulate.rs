@@ -678,7 +678,7 @@ fn choose_mesh(
         );
     }
     let mut opts = AccuracyOptions::new(target);
-    opts.cache_dir = cache_dir();
+    opts.cache_dir = crate::run::surrogate::mesh_cache_dir();
     let bar = ProgressBar::new_spinner();
     bar.set_message(format!(
         "choosing the mesh for {} % accuracy",
@@ -699,16 +699,6 @@ fn choose_mesh(
     let line = choice.line();
     eprintln!("{line}");
     Ok((m, line))
-}
-
-/// The user's cache directory for palpate (`$XDG_CACHE_HOME/palpate`, else
-/// `~/.cache/palpate`); `None` without either variable (no cache).
-fn cache_dir() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CACHE_HOME")
-        .filter(|v| !v.is_empty())
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
-    Some(base.join("palpate"))
 }
 
 /// The volumetric treatment in words.

@@ -63,6 +63,18 @@ pub fn default_cache_dir() -> PathBuf {
     PathBuf::from(".palpate-cache/surrogates")
 }
 
+/// The cache folder of the meshes chosen for an accuracy (`simulate
+/// --accuracy`): `$XDG_CACHE_HOME/palpate`, else `$HOME/.cache/palpate`;
+/// `None` without either (no cache). The user settings of the caches are
+/// read here, in one place.
+pub fn mesh_cache_dir() -> Option<PathBuf> {
+    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty());
+    let base = var("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| var("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("palpate"))
+}
+
 /// The code version in a cache key: the palpate version and the SHA-256 of
 /// the running executable, so that any rebuild of the code (a changed
 /// element, solver tolerance or mesh generator) invalidates the cache rather
