@@ -271,6 +271,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let law = law_of(&args)?;
         return run_q1(&args, law);
     }
+    // the options are checked (and the data read) by the fit first
+    let result = fit(&args, &[])?;
     // How each file was read (metadata, columns, sign), when there is
     // anything to say beyond palpate's own format.
     for d in read_data_opts(
@@ -284,7 +286,6 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             eprint!("{} ({} rows):\n{about}", d.file, d.observed.len());
         }
     }
-    let result = fit(&args, &[])?;
     print!("{}", calibration_table(&result));
     if let Some(p) = &args.json {
         write_json(p, &result)?;

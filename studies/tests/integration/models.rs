@@ -90,10 +90,12 @@ fn defaults_are_the_benchmark_settings() {
     let m = models("[models.needle.n1_needle]\nlaw = \"neo-hookean\"\n").unwrap();
     match spec(&m, "needle").validate().unwrap() {
         Model::N1Needle(n) => {
-            assert_eq!(
-                n,
-                palpate_fe::N1Needle::new(palpate_material::Law::NeoHookean)
-            )
+            // the reference settings, on the user path's default mesh: the
+            // 9-node benchmark grading
+            let mut expected = palpate_fe::N1Needle::new(palpate_material::Law::NeoHookean);
+            expected.element = palpate_fe::PlaneCell::Quad9;
+            expected.grading = Some(palpate_fe::accuracy::N1_QUAD9_BENCH);
+            assert_eq!(n, expected)
         }
         other => panic!("{other:?}"),
     }
