@@ -351,14 +351,9 @@ pub fn experiment_of(args: &Args) -> anyhow::Result<Option<ExperimentSpec>> {
     Ok(Some(spec))
 }
 
-/// `palpate calibrate --experiment`: the description's fitted parameters
-/// from force records, its fixed ones (and `--fix`) held.
-fn fit_experiment(
-    args: &Args,
-    arrays: &[ArrayRecord],
-    spec: ExperimentSpec,
-) -> anyhow::Result<Calibration> {
-    for (given, name) in [
+/// The options of the staged Q1 identification that were given.
+fn q1_options_given(args: &Args) -> impl Iterator<Item = &'static str> {
+    [
         (args.stages.is_some(), "--stages"),
         (args.prony_terms.is_some(), "--prony-terms"),
         (args.fit_mesh.is_some(), "--fit-mesh"),
@@ -369,13 +364,25 @@ fn fit_experiment(
         (args.mesh_check.is_some(), "--mesh-check"),
         (args.compare, "--compare"),
         (args.profile, "--profile"),
-        (args.viscoelastic.is_some(), "--viscoelastic"),
-    ] {
-        anyhow::ensure!(
-            !given,
-            "{name}: not an option of an experiment's calibration (its description holds the model)"
-        );
+    ]
+    .into_iter()
+    .filter_map(|(given, name)| given.then_some(name))
+}
+
+/// `palpate calibrate --experiment`: the description's fitted parameters
+/// from force records, its fixed ones (and `--fix`) held.
+fn fit_experiment(
+    args: &Args,
+    arrays: &[ArrayRecord],
+    spec: ExperimentSpec,
+) -> anyhow::Result<Calibration> {
+    if let Some(name) = q1_options_given(args).next() {
+        anyhow::bail!("{name}: not an option of an experiment's calibration (its description holds the model)");
     }
+    anyhow::ensure!(
+        args.viscoelastic.is_none(),
+        "--viscoelastic: not an option of an experiment's calibration (its description holds the model)"
+    );
     let residual: ResidualKind = args
         .residual
         .parse()
@@ -470,22 +477,8 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         !is_q1(args),
         "--benchmark Q1: the staged identification reads its record from a file (palpate calibrate --benchmark Q1 --data FILE)"
     );
-    for (given, name) in [
-        (args.stages.is_some(), "--stages"),
-        (args.prony_terms.is_some(), "--prony-terms"),
-        (args.fit_mesh.is_some(), "--fit-mesh"),
-        (args.correct_mesh.is_some(), "--correct-mesh"),
-        (args.time_step.is_some(), "--time-step"),
-        (args.edge_radius.is_some(), "--edge-radius"),
-        (args.fit_edge_radius.is_some(), "--fit-edge-radius"),
-        (args.mesh_check.is_some(), "--mesh-check"),
-        (args.compare, "--compare"),
-        (args.profile, "--profile"),
-    ] {
-        anyhow::ensure!(
-            !given,
-            "{name}: an option of --benchmark Q1 (the staged inverse FE identification)"
-        );
+    if let Some(name) = q1_options_given(args).next() {
+        anyhow::bail!("{name}: an option of --benchmark Q1 (the staged inverse FE identification)");
     }
     let residual: ResidualKind = args
         .residual

@@ -357,11 +357,16 @@ fn friction_of(v: &Value, field: &str) -> Result<(f64, bool), FeError> {
     }
 }
 
-/// A material's bulk treatment.
-pub fn bulk_of(m: &MaterialSpec) -> Bulk {
-    match m.bulk {
-        Some(BulkSpec::Ratio(r)) => Bulk::Ratio(r),
-        _ => Bulk::Exact,
+/// A material's volumetric treatment; an error names `materials.NAME.bulk`.
+pub fn bulk_of(name: &str, m: &MaterialSpec) -> Result<Bulk, FeError> {
+    match &m.bulk {
+        None => Ok(Bulk::Exact),
+        Some(BulkSpec::Keyword(k)) if k == "exact" => Ok(Bulk::Exact),
+        Some(BulkSpec::Ratio(r)) if *r > 0.0 && r.is_finite() => Ok(Bulk::Ratio(*r)),
+        Some(other) => Err(bad(
+            format!("materials.{name}.bulk"),
+            format!("{other:?}: expected \"exact\" or a bulk-to-shear ratio K / mu0 > 0"),
+        )),
     }
 }
 
@@ -495,7 +500,7 @@ pub fn c1_from(e: &Experiment) -> Result<C1Fe, FeError> {
         ((c.radius * level).round() as usize).max(1),
         ((height * level).round() as usize).max(1),
     );
-    model.bulk = bulk_of(m);
+    model.bulk = bulk_of(name, m)?;
     let (prony, params) = prony_of(name, m)?;
     if params > 0 {
         return Err(bad(
@@ -526,7 +531,7 @@ pub fn q1_from(e: &Experiment) -> Result<Q1Punch, FeError> {
         model.level = l;
     }
     model.element = plane_cell(e, PlaneCell::Quad4);
-    model.bulk = bulk_of(m);
+    model.bulk = bulk_of(name, m)?;
     let (prony, params) = prony_of(name, m)?;
     model.prony = prony;
     Ok(if params > 0 {
@@ -588,7 +593,7 @@ pub fn n3_from(e: &Experiment) -> Result<N3Needle, FeError> {
     model.friction = f;
     model.set_friction_parameter(is_param);
     model.size = [size[0] / 2.0, size[1] / 2.0, size[2]];
-    model.bulk = bulk_of(m);
+    model.bulk = bulk_of(name, m)?;
     if let Some(l) = e.mesh.level {
         model.level = l;
     }
@@ -637,7 +642,7 @@ pub fn r2_from(e: &Experiment) -> Result<R2Rolling, FeError> {
     for (n, m) in [(&order[0], tissue), (&order[1], nodule)] {
         elastic_only(n, m, "the rolling model")?;
     }
-    if bulk_of(tissue) != bulk_of(nodule) {
+    if bulk_of(&order[0], tissue)? != bulk_of(&order[1], nodule)? {
         return Err(bad(
             format!("materials.{}.bulk", order[1]),
             "the rolling model treats incompressibility alike in the block and the nodules: give both the same bulk",
@@ -690,7 +695,7 @@ pub fn r2_from(e: &Experiment) -> Result<R2Rolling, FeError> {
             ))
         }
     };
-    model.bulk = bulk_of(tissue);
+    model.bulk = bulk_of(&order[0], tissue)?;
     if let Some(l) = e.mesh.level {
         model.level = l;
     }

@@ -48,12 +48,12 @@
 
 use palpate_material::Law;
 
+use crate::experiment::build::bulk_of;
 use crate::experiment::params::material_law;
 use crate::experiment::{
-    BulkSpec, CylinderKinematics, ElementSpec, Experiment, MaterialSpec, Specimen, SupportSpec,
-    Tool, Value,
+    CylinderKinematics, ElementSpec, Experiment, MaterialSpec, Specimen, SupportSpec, Tool, Value,
 };
-use crate::model::{Bulk, FeModel, PlaneCell, Setup, Support};
+use crate::model::{FeModel, PlaneCell, Setup, Support};
 use crate::n1::{prony_of, BandMaterial, N1Needle, N1Setup, Sizing};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
@@ -97,19 +97,6 @@ fn positive(field: &str, v: f64) -> Result<f64, FeError> {
         Ok(v)
     } else {
         Err(bad(field, format!("{v} mm: expected a finite length > 0")))
-    }
-}
-
-/// A material's volumetric treatment.
-fn bulk_of(name: &str, m: &MaterialSpec) -> Result<Bulk, FeError> {
-    match &m.bulk {
-        None => Ok(Bulk::Exact),
-        Some(BulkSpec::Keyword(k)) if k == "exact" => Ok(Bulk::Exact),
-        Some(BulkSpec::Ratio(r)) if *r > 0.0 && r.is_finite() => Ok(Bulk::Ratio(*r)),
-        Some(other) => Err(bad(
-            format!("materials.{name}.bulk"),
-            format!("{other:?}: expected \"exact\" or a bulk-to-shear ratio K / mu0 > 0"),
-        )),
     }
 }
 
