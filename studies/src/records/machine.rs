@@ -177,7 +177,7 @@ impl Role {
                     "GPa" => ("MPa", 1e3),
                     "psi" => ("MPa", 6.894_757_293_168e-3),
                     "" => return Err(
-                        "a stress needs its unit in the header, e.g. `stress_MPa` or `Stress (kPa)`".into(),
+                        "a stress needs its unit in the header (e.g. `stress_MPa` or `Stress (kPa)`) or the data option `stress_unit=kPa`".into(),
                     ),
                     _ => return bad("Pa, kPa, MPa, GPa, N/mm^2, psi"),
                 };
