@@ -7,7 +7,7 @@ use serde::{Deserialize, Serialize};
 #[non_exhaustive]
 pub enum MaterialError {
     /// The law name is not one of the known spellings.
-    #[error("unknown material law `{text}` (expected neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce or ogden:N)")]
+    #[error("unknown material law `{text}` (expected neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N, gent, veronda-westmann or humphrey)")]
     UnknownLaw {
         /// The text that was parsed.
         text: String,
@@ -49,6 +49,16 @@ pub enum MaterialError {
         value: f64,
         /// The rule it breaks, e.g. `must be > 0`.
         requirement: String,
+    },
+    /// A deformation outside the domain of a law (Gent's limit) or where its energy overflows.
+    #[error("law `{law}` at principal stretches {stretches:?}: {reason}")]
+    OutsideDomain {
+        /// The canonical law name.
+        law: String,
+        /// The principal stretches evaluated.
+        stretches: [f64; 3],
+        /// What is wrong and what would be valid.
+        reason: String,
     },
     /// A stretch given to a homogeneous solution is not a positive finite number.
     #[error("stretch {stretch} is not a positive finite number")]

@@ -12,6 +12,7 @@
 
 use nalgebra::Matrix3;
 
+use crate::stability::Mode;
 use crate::{Law, MaterialError, Volumetric};
 
 fn nominal(law: &Law, p: &[f64], lam: [f64; 3], free: usize) -> f64 {
@@ -50,6 +51,32 @@ pub fn equibiaxial(law: &Law, p: &[f64], stretch: f64) -> f64 {
 /// Planar tension (pure shear): `l1 = s`, `l2 = 1`, `l3 = 1/s`, thickness stress free.
 pub fn planar(law: &Law, p: &[f64], stretch: f64) -> f64 {
     nominal(law, p, [stretch, 1.0, 1.0 / stretch], 2)
+}
+
+/// The nominal stress of `mode` (uniaxial, equibiaxial or planar) at `stretch`, with every
+/// input checked: the stretch, the parameters ([`Law::check`]) and the law's domain at the
+/// mode's stretches ([`Law::check_stretches`]: Gent's limit `I1 - 3 < Jm`, an exponential that
+/// overflows). The `f64` functions above give NaN or infinity there instead of an error.
+pub fn checked(law: &Law, p: &[f64], mode: Mode, stretch: f64) -> Result<f64, MaterialError> {
+    if !(stretch > 0.0 && stretch.is_finite()) {
+        return Err(MaterialError::BadStretch { stretch });
+    }
+    law.check(p)?;
+    law.check_stretches(p, mode.stretches(stretch))?;
+    let stress = match mode {
+        Mode::Uniaxial => uniaxial(law, p, stretch),
+        Mode::Biaxial => equibiaxial(law, p, stretch),
+        Mode::Planar => planar(law, p, stretch),
+    };
+    if stress.is_finite() {
+        Ok(stress)
+    } else {
+        Err(MaterialError::OutsideDomain {
+            law: law.to_string(),
+            stretches: mode.stretches(stretch),
+            reason: format!("the {mode:?} stress is not finite"),
+        })
+    }
 }
 
 /// Maximum safeguarded-Newton iterations of [`uniaxial_compressible`].

@@ -8,8 +8,9 @@ use serde::{Deserialize, Serialize};
 
 use crate::invariants::invariants;
 use crate::{
-    arruda_boyce, invariant_kinematics, kinematics, mooney_rivlin, neo_hookean, ogden,
-    reduced_polynomial, InvariantDerivs, MaterialError, PrincipalDerivs, StressTangent, Volumetric,
+    arruda_boyce, gent, humphrey, invariant_kinematics, kinematics, mooney_rivlin, neo_hookean,
+    ogden, reduced_polynomial, veronda_westmann, InvariantDerivs, MaterialError, PrincipalDerivs,
+    StressTangent, Volumetric,
 };
 
 /// Highest order of the reduced polynomial law.
@@ -27,6 +28,9 @@ pub const MAX_OGDEN_TERMS: usize = 6;
 /// * `ReducedPolynomial(N)`: `[C10, C20, .., CN0]` (Yeoh is `N = 3`)
 /// * `ArrudaBoyce`: `[mu, lambda_m]`
 /// * `Ogden(N)`: `[mu1, alpha1, .., muN, alphaN]`
+/// * `Gent`: `[mu, Jm]`
+/// * `VerondaWestmann`: `[C1, C2]`
+/// * `Humphrey`: `[C1, C2]`
 ///
 /// The evaluation functions ([`Law::isochoric_energy`], [`Law::stress_tangent`], ...) assume the
 /// parameters passed [`Law::check`]; they never panic, a wrong count gives NaN.
@@ -42,6 +46,13 @@ pub enum Law {
     ArrudaBoyce,
     /// `W = sum_{i=1..N} 2 mu_i / alpha_i^2 (l1^a_i + l2^a_i + l3^a_i - 3)`, `N = 1..=6` ([`MAX_OGDEN_TERMS`]).
     Ogden(usize),
+    /// `W = -(mu Jm / 2) ln(1 - (I1b - 3) / Jm)` (Gent 1996; [`crate::gent`]).
+    Gent,
+    /// `W = C1 (exp(C2 (I1b - 3)) - 1) - (C1 C2 / 2) (I2b - 3)` (Veronda & Westmann 1970;
+    /// [`crate::veronda_westmann`]).
+    VerondaWestmann,
+    /// `W = C1 (exp(C2 (I1b - 3)) - 1)` (Humphrey & Yin 1987; [`crate::humphrey`]).
+    Humphrey,
 }
 
 /// One material parameter with its unit, search bounds and a starting value for soft silicone/tissue.
@@ -88,6 +99,16 @@ impl MaterialParam {
 /// interior; where an exponent is not identifiable (Treloar uniaxial Ogden-3, a term with
 /// mu -> 0) the fit ends on this bound and the report says so.
 pub const OGDEN_ALPHA_BOUND: f64 = 50.0;
+
+/// Bound on the exponent `C2` of the Veronda-Westmann and Humphrey laws: `C2` in `(0, 50)`.
+///
+/// A box for the estimators, not a material limit: the silicone phantoms of Dawood et al. 2026
+/// have `C2` of 0.1 to 0.4. Beyond `C2 (I1 - 3) ~ 709` the exponential overflows, which
+/// [`Law::check_stretches`] names.
+pub const EXPONENT_BOUND: f64 = 50.0;
+
+/// Upper bound of Gent's `Jm` for the estimators (`Jm -> inf` is neo-Hookean).
+pub const GENT_JM_BOUND: f64 = 1e4;
 
 /// Starting exponents of the Ogden terms: alternating signs of growing magnitude, so that the terms differ.
 const OGDEN_INITIAL_ALPHA: [f64; 6] = [2.0, -2.0, 4.0, -4.0, 6.0, -6.0];
@@ -152,6 +173,18 @@ impl Law {
                     ]
                 })
                 .collect(),
+            Law::Gent => vec![
+                MaterialParam::new("mu", "MPa", 0.0, inf, 2e-3),
+                MaterialParam::new("Jm", "1", 0.0, GENT_JM_BOUND, 100.0),
+            ],
+            Law::VerondaWestmann => vec![
+                MaterialParam::new("C1", "MPa", 0.0, inf, 1e-2),
+                MaterialParam::new("C2", "1", 0.0, EXPONENT_BOUND, 0.2),
+            ],
+            Law::Humphrey => vec![
+                MaterialParam::new("C1", "MPa", 0.0, inf, 5e-3),
+                MaterialParam::new("C2", "1", 0.0, EXPONENT_BOUND, 0.2),
+            ],
         }
     }
 
@@ -163,6 +196,7 @@ impl Law {
             Law::ReducedPolynomial(n) => n,
             Law::ArrudaBoyce => 2,
             Law::Ogden(n) => 2 * n,
+            Law::Gent | Law::VerondaWestmann | Law::Humphrey => 2,
         }
     }
 
@@ -170,7 +204,8 @@ impl Law {
     ///
     /// Rules: neo-Hookean `C10 > 0`; Mooney-Rivlin `C10 + C01 > 0` (initial shear modulus);
     /// reduced polynomial `C10 > 0` (higher terms any sign); Arruda-Boyce `mu > 0`, `lambda_m > 1`;
-    /// Ogden `alpha_i != 0` and `mu0 = sum mu_i > 0`.
+    /// Ogden `alpha_i != 0` and `mu0 = sum mu_i > 0`; Gent `mu > 0`, `Jm > 0`; Veronda-Westmann
+    /// and Humphrey `C1 > 0`, `C2 > 0`.
     ///
     /// Ogden note: the classical rule `mu_i alpha_i > 0` belongs to Ogden's own convention
     /// `W = sum mu_i / alpha_i (...)`. In the Abaqus convention used here (`2 mu_i / alpha_i^2`) each
@@ -248,10 +283,65 @@ impl Law {
                     "must be > 0 (initial shear modulus)",
                 )
             }
+            Law::Gent => {
+                positive("mu", p[0], "must be > 0 (initial shear modulus)")?;
+                positive(
+                    "Jm",
+                    p[1],
+                    "must be > 0 (the limit of I1 - 3 the chains can reach; large Jm is neo-Hookean)",
+                )
+            }
+            Law::VerondaWestmann | Law::Humphrey => {
+                positive("C1", p[0], "must be > 0 (MPa)")?;
+                positive(
+                    "C2",
+                    p[1],
+                    "must be > 0 (the exponent's rate; the initial shear modulus is proportional to C1 C2)",
+                )
+            }
         }
     }
 
+    /// Checks that the law is defined and finite at the principal stretches `lam` (used as given:
+    /// the isochoric stretches of a compressible state), for parameters that passed
+    /// [`Law::check`]. Gent's energy is infinite at `I1 - 3 = Jm` and undefined beyond; an
+    /// exponential law (Veronda-Westmann, Humphrey) overflows where `C2 (I1 - 3) > ~709`. Where
+    /// this fails the evaluation functions give NaN (or infinity), never a wrong finite stress.
+    pub fn check_stretches(&self, p: &[f64], lam: [f64; 3]) -> Result<(), MaterialError> {
+        let outside = |reason: String| MaterialError::OutsideDomain {
+            law: self.to_string(),
+            stretches: lam,
+            reason,
+        };
+        if !lam.iter().all(|l| *l > 0.0 && l.is_finite()) {
+            return Err(outside("stretches must be positive finite numbers".into()));
+        }
+        let (i1, _) = invariants(lam);
+        if *self == Law::Gent && p.len() == 2 && i1 - 3.0 >= p[1] {
+            return Err(outside(format!(
+                "I1 - 3 = {} reaches the limit Jm = {} (chains fully extended: the energy is \
+                 infinite there and undefined beyond); the stretch must stay where I1 - 3 < Jm, \
+                 or Jm must be larger",
+                i1 - 3.0,
+                p[1]
+            )));
+        }
+        let d = self.isochoric_principal(p, lam);
+        if !(d.w.is_finite() && d.dw.iter().all(|v| v.is_finite())) {
+            let detail = match self {
+                Law::VerondaWestmann | Law::Humphrey if p.len() == 2 => format!(
+                    "exp(C2 (I1 - 3)) overflows (C2 (I1 - 3) = {}, the largest is about 709)",
+                    p[1] * (i1 - 3.0)
+                ),
+                _ => "the energy or stress is not finite".into(),
+            };
+            return Err(outside(detail));
+        }
+        Ok(())
+    }
+
     /// Initial shear modulus `mu0` (NH: `2 C10`; MR: `2 (C10 + C01)`; RP: `2 C10`; Ogden: `sum mu_i`;
+    /// Gent: `mu`; Veronda-Westmann: `C1 C2`; Humphrey: `2 C1 C2`;
     /// AB: `mu (1 + 3/(5 lm^2) + 99/(175 lm^4) + 513/(875 lm^6) + 42039/(67375 lm^8))`, which is the
     /// exact `2 dW/dI1` at rest of the 5-term series and tends to `mu` for large `lambda_m`).
     pub fn shear_modulus(&self, p: &[f64]) -> f64 {
@@ -266,6 +356,9 @@ impl Law {
                     f64::NAN
                 }
             }
+            Law::Gent => par(p, 0),
+            Law::VerondaWestmann => par(p, 0) * par(p, 1),
+            Law::Humphrey => 2.0 * par(p, 0) * par(p, 1),
         }
     }
 
@@ -305,6 +398,9 @@ impl Law {
             Law::ReducedPolynomial(_) => Some(reduced_polynomial::invariant_derivs(p, i1)),
             Law::ArrudaBoyce => Some(arruda_boyce::invariant_derivs(p[0], p[1], i1)),
             Law::Ogden(_) => None,
+            Law::Gent => Some(gent::invariant_derivs(p[0], p[1], i1)),
+            Law::VerondaWestmann => Some(veronda_westmann::invariant_derivs(p[0], p[1], i1, i2)),
+            Law::Humphrey => Some(humphrey::invariant_derivs(p[0], p[1], i1)),
         }
     }
 
@@ -343,6 +439,9 @@ impl fmt::Display for Law {
             Law::ReducedPolynomial(n) => write!(f, "reduced-polynomial:{n}"),
             Law::ArrudaBoyce => write!(f, "arruda-boyce"),
             Law::Ogden(n) => write!(f, "ogden:{n}"),
+            Law::Gent => write!(f, "gent"),
+            Law::VerondaWestmann => write!(f, "veronda-westmann"),
+            Law::Humphrey => write!(f, "humphrey"),
         }
     }
 }
@@ -351,7 +450,8 @@ impl FromStr for Law {
     type Err = MaterialError;
 
     /// Parses `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N` (N = 1..=6), `yeoh`
-    /// (= `reduced-polynomial:3`), `arruda-boyce`, `ogden:N` (N = 1..=6); case and surrounding blanks ignored.
+    /// (= `reduced-polynomial:3`), `arruda-boyce`, `ogden:N` (N = 1..=6), `gent`,
+    /// `veronda-westmann`, `humphrey`; case and surrounding blanks ignored.
     fn from_str(s: &str) -> Result<Self, Self::Err> {
         let text = s.trim().to_ascii_lowercase();
         let unknown = || MaterialError::UnknownLaw {
@@ -369,6 +469,9 @@ impl FromStr for Law {
             ("mooney-rivlin", None) => Law::MooneyRivlin,
             ("yeoh", None) => Law::ReducedPolynomial(3),
             ("arruda-boyce", None) => Law::ArrudaBoyce,
+            ("gent", None) => Law::Gent,
+            ("veronda-westmann", None) => Law::VerondaWestmann,
+            ("humphrey", None) => Law::Humphrey,
             ("reduced-polynomial", Some(n)) => {
                 if !(1..=MAX_POLYNOMIAL_ORDER).contains(&n) {
                     return Err(MaterialError::BadOrder {

@@ -88,9 +88,18 @@ pub fn drucker_matrix(law: &Law, p: &[f64], lam: [f64; 3]) -> [[f64; 2]; 2] {
 }
 
 /// True when [`drucker_matrix`] is positive definite (`D_11 > 0` and `det D > 0`).
+///
+/// The determinant is taken of the matrix divided by its largest entry, so that a stiff law
+/// (an exponential at large `I1`, entries beyond `1e154`) does not overflow it; a NaN entry
+/// (a law outside its domain, Gent beyond `Jm`) is unstable.
 pub fn is_stable(law: &Law, p: &[f64], lam: [f64; 3]) -> bool {
     let d = drucker_matrix(law, p, lam);
-    d[0][0] > 0.0 && d[0][0] * d[1][1] - d[0][1] * d[1][0] > 0.0
+    let scale = d.iter().flatten().fold(0.0f64, |m, v| m.max(v.abs()));
+    if !(scale > 0.0 && scale.is_finite()) {
+        return false;
+    }
+    let e = d.map(|row| row.map(|v| v / scale));
+    e[0][0] > 0.0 && e[0][0] * e[1][1] - e[0][1] * e[1][0] > 0.0
 }
 
 /// Grid steps per decade of the scan.

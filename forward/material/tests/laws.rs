@@ -64,6 +64,12 @@ fn cases() -> Vec<(Law, Vec<f64>)> {
         (Law::Ogden(1), vec![0.5, 2.0]),
         (Law::Ogden(2), vec![0.3, 3.0, 0.2, -2.5]),
         (Law::Ogden(3), ogden_treloar()),
+        (Law::Gent, vec![0.5, 20.0]),
+        (Law::Gent, vec![0.4, 100.0]),
+        (Law::VerondaWestmann, vec![2.0, 0.25]),
+        (Law::VerondaWestmann, vec![0.5, 1.2]),
+        (Law::Humphrey, vec![1.0, 0.25]),
+        (Law::Humphrey, vec![0.1, 2.0]),
     ];
     for n in 1..=6 {
         cases.push((Law::ReducedPolynomial(n), poly[..n].to_vec()));
@@ -72,6 +78,25 @@ fn cases() -> Vec<(Law, Vec<f64>)> {
         law.check(p).unwrap_or_else(|e| panic!("{law} {p:?}: {e}"));
     }
     cases
+}
+
+/// `(dW/dI1, dW/dI2)` of Gent, Veronda-Westmann and Humphrey at `x = I1 - 3`, written from the
+/// published energies (not from the law files): Gent `W = -(mu Jm / 2) ln(1 - x / Jm)`,
+/// Veronda-Westmann `W = C1 (e^(C2 x) - 1) - C1 C2 / 2 (I2 - 3)`, Humphrey `W = C1 (e^(C2 x) - 1)`.
+fn w1_w2(law: Law, p: &[f64], x: f64) -> (f64, f64) {
+    match law {
+        Law::Gent => (p[0] * p[1] / (2.0 * (p[1] - x)), 0.0),
+        Law::VerondaWestmann => (p[0] * p[1] * (p[1] * x).exp(), -0.5 * p[0] * p[1]),
+        Law::Humphrey => (p[0] * p[1] * (p[1] * x).exp(), 0.0),
+        other => panic!("no closed form here for {other}"),
+    }
+}
+
+fn new_laws() -> Vec<(Law, Vec<f64>)> {
+    cases()
+        .into_iter()
+        .filter(|(l, _)| matches!(l, Law::Gent | Law::VerondaWestmann | Law::Humphrey))
+        .collect()
 }
 
 fn vols(law: &Law, p: &[f64]) -> [Volumetric; 2] {
@@ -332,7 +357,10 @@ fn homogeneous_formulas_agree_with_the_generic_tensor_path() {
     for (law, p) in cases() {
         // Large bulk modulus: the compressible lateral-stress-free solve tends to the incompressible formula.
         let k = 1e6 * law.shear_modulus(&p);
-        let stretches: &[f64] = if law == Law::ArrudaBoyce && p[1] < 1.1 {
+        // Near the locking stretch (AB lambda_m = 1.05) or with a steep exponential (C2 > 1) a
+        // volume change of stress / K moves the stress by more than 1e-4: small stretches only.
+        let steep = matches!(law, Law::VerondaWestmann | Law::Humphrey) && p[1] > 1.0;
+        let stretches: &[f64] = if law == Law::ArrudaBoyce && p[1] < 1.1 || steep {
             &[0.9, 0.97, 1.02]
         } else {
             &[0.5, 0.8, 1.3, 2.0]
@@ -576,6 +604,9 @@ fn names_parse_and_print() {
         ("reduced-polynomial:2", Law::ReducedPolynomial(2)),
         ("arruda-boyce", Law::ArrudaBoyce),
         ("ogden:3", Law::Ogden(3)),
+        ("gent", Law::Gent),
+        ("veronda-westmann", Law::VerondaWestmann),
+        ("humphrey", Law::Humphrey),
     ] {
         assert_eq!(text.parse::<Law>().unwrap(), law);
         assert_eq!(law.to_string(), text);
@@ -612,12 +643,18 @@ fn params_are_named_in_commercial_convention_with_valid_initial_values() {
     assert_eq!(names(Law::MooneyRivlin), "C10,C01");
     assert_eq!(names(Law::ArrudaBoyce), "mu,lambda_m");
     assert_eq!(names(Law::Ogden(2)), "mu1,alpha1,mu2,alpha2");
+    assert_eq!(names(Law::Gent), "mu,Jm");
+    assert_eq!(names(Law::VerondaWestmann), "C1,C2");
+    assert_eq!(names(Law::Humphrey), "C1,C2");
     for law in [
         Law::NeoHookean,
         Law::MooneyRivlin,
         Law::ArrudaBoyce,
         Law::Ogden(1),
         Law::Ogden(4),
+        Law::Gent,
+        Law::VerondaWestmann,
+        Law::Humphrey,
     ]
     .into_iter()
     .chain((1..=6).map(Law::ReducedPolynomial))
@@ -758,4 +795,236 @@ fn ogden_terms_are_bounded_like_polynomial_orders() {
         assert!(e.contains("1..=6"), "{bad}: {e}");
     }
     assert!(Law::Ogden(7).check(&[0.0; 14]).is_err());
+}
+
+/// Gent, Veronda-Westmann and Humphrey in every homogeneous mode against the closed forms
+/// (incompressible; Ogden 1984 sec. 7.2, Treloar 1975): uniaxial `P = 2 (s - s^-2)(W1 + W2 / s)`,
+/// equibiaxial `P = 2 (s - s^-5)(W1 + s^2 W2)`, planar `P = 2 (s - s^-3)(W1 + W2)`, simple shear
+/// `P12 = 2 g (W1 + W2)` with `I1 - 3 = g^2` (the pressure does not enter `P12`), to 1e-10.
+#[test]
+fn new_laws_match_closed_forms_in_every_homogeneous_mode() {
+    let close = |got: f64, want: f64, what: &str| {
+        assert!(
+            (got - want).abs() <= 1e-10 * want.abs(),
+            "{what}: {got:e} vs closed form {want:e}"
+        );
+    };
+    for (law, p) in new_laws() {
+        for s in [0.35, 0.5, 0.8, 0.95, 1.05, 1.3, 2.0, 3.0] {
+            let (w1, w2) = w1_w2(law, &p, s * s + 2.0 / s - 3.0);
+            let want = 2.0 * (s - s.powi(-2)) * (w1 + w2 / s);
+            close(
+                homogeneous::uniaxial(&law, &p, s),
+                want,
+                &format!("{law} {p:?} uniaxial {s}"),
+            );
+            let (w1, w2) = w1_w2(law, &p, 2.0 * s * s + s.powi(-4) - 3.0);
+            let want = 2.0 * (s - s.powi(-5)) * (w1 + s * s * w2);
+            if s > 0.45 || law != Law::Gent {
+                close(
+                    homogeneous::equibiaxial(&law, &p, s),
+                    want,
+                    &format!("{law} {p:?} equibiaxial {s}"),
+                );
+            }
+            let (w1, w2) = w1_w2(law, &p, s * s + s.powi(-2) - 2.0);
+            let want = 2.0 * (s - s.powi(-3)) * (w1 + w2);
+            close(
+                homogeneous::planar(&law, &p, s),
+                want,
+                &format!("{law} {p:?} planar {s}"),
+            );
+            for (mode, lam) in [(Mode::Uniaxial, s), (Mode::Planar, s)] {
+                let checked = homogeneous::checked(&law, &p, mode, lam).unwrap();
+                assert_eq!(
+                    checked,
+                    match mode {
+                        Mode::Uniaxial => homogeneous::uniaxial(&law, &p, lam),
+                        _ => homogeneous::planar(&law, &p, lam),
+                    }
+                );
+            }
+        }
+        for g in [-1.5, -0.2, 0.1, 0.7, 2.0] {
+            let (w1, w2) = w1_w2(law, &p, g * g);
+            let want = 2.0 * g * (w1 + w2);
+            let f = Matrix3::new(1.0, g, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+            let st = law.stress_tangent(&p, Volumetric::Incompressible, &f);
+            close(st.p[(0, 1)], want, &format!("{law} {p:?} simple shear {g}"));
+            let principal = law.stress_tangent_principal(&p, Volumetric::Incompressible, &f);
+            close(
+                principal.p[(0, 1)],
+                want,
+                &format!("{law} {p:?} simple shear (principal) {g}"),
+            );
+        }
+        // At rest: no stress, and Young's modulus 3 mu0 with mu0 = 2 (W1 + W2)(I1 = 3).
+        assert_eq!(homogeneous::uniaxial(&law, &p, 1.0), 0.0);
+        let (w1, w2) = w1_w2(law, &p, 0.0);
+        close(
+            law.shear_modulus(&p),
+            2.0 * (w1 + w2),
+            &format!("{law} mu0"),
+        );
+    }
+}
+
+/// Gent's Drucker range ends where its energy does, at `I1 - 3 = Jm` (`W1, W11 > 0` below it);
+/// Humphrey is stable wherever its exponential is finite; Veronda-Westmann with the Ecoflex 00-10
+/// parameters of the phantom database (`C1 = 95.5 kPa, C2 = 0.2455`) is stable in the uniaxial
+/// compression it was fitted to, but not beyond uniaxial tension 1.53, equibiaxial compression
+/// 0.81 and planar 0.60 / 1.67 (its `I2` term is a negative Mooney-Rivlin `C01 = -C10 / 2`).
+#[test]
+fn drucker_ranges_of_the_new_laws() {
+    let (mu, jm) = (0.3, 20.0);
+    let r = drucker(&Law::Gent, &[mu, jm]);
+    // Uniaxial limit: s^2 + 2 / s - 3 = Jm, by bisection on each side of 1.
+    let g = |s: f64| s * s + 2.0 / s - 3.0 - jm;
+    let root = |mut inside: f64, mut outside: f64| {
+        for _ in 0..200 {
+            let mid = 0.5 * (inside + outside);
+            if g(mid) < 0.0 {
+                inside = mid
+            } else {
+                outside = mid
+            }
+        }
+        inside
+    };
+    let upper = root(1.0, 10.0);
+    assert!((r.uniaxial.upper - upper).abs() < 1e-9, "{r:?} vs {upper}");
+    assert_eq!(
+        r.uniaxial.lower, 0.1,
+        "I1 - 3 = 17 at s = 0.1, inside Jm = 20"
+    );
+    let biaxial_lower = {
+        let (mut inside, mut outside) = (1.0f64, 0.1f64);
+        for _ in 0..200 {
+            let mid = 0.5 * (inside + outside);
+            if 2.0 * mid * mid + mid.powi(-4) - 3.0 < jm {
+                inside = mid
+            } else {
+                outside = mid
+            }
+        }
+        inside
+    };
+    assert!((r.biaxial.lower - biaxial_lower).abs() < 1e-9, "{r:?}");
+
+    // (C2 = 0.05 keeps C2 (I1 - 3) < 709 over the whole scan; with C2 = 0.25 the exponential
+    // overflows in equibiaxial compression below s = 0.137 and the scan stops there.)
+    let r = drucker(&Law::Humphrey, &[0.02, 0.05]);
+    for range in [r.uniaxial, r.biaxial, r.planar] {
+        assert_eq!((range.lower, range.upper), (0.1, 10.0), "{r:?}");
+    }
+    let r = drucker(&Law::Humphrey, &[0.02, 0.25]);
+    assert!(r.biaxial.lower > 0.13 && r.biaxial.lower < 0.14, "{r:?}");
+    assert!(Law::Humphrey
+        .check_stretches(&[0.02, 0.25], Mode::Biaxial.stretches(0.13))
+        .is_err());
+    // Edges bracketed independently (central differences of the Cauchy stress of the
+    // published energy, numpy, on the grid 0.5, 0.6, 0.8, 0.81, 1.52, 1.55, 1.65, 1.7).
+    let r = drucker(&Law::VerondaWestmann, &[95.5e-3, 0.2455]);
+    let (u, b, p) = (r.uniaxial, r.biaxial, r.planar);
+    assert!(u.lower == 0.1 && u.upper > 1.52 && u.upper < 1.55, "{r:?}");
+    assert!(b.lower > 0.80 && b.lower < 0.81 && b.upper == 10.0, "{r:?}");
+    assert!(
+        p.lower > 0.5 && p.lower < 0.6 && p.upper > 1.65 && p.upper < 1.7,
+        "{r:?}"
+    );
+}
+
+/// Bad parameters and stretches outside a law's domain are named errors; the `f64` evaluations
+/// give NaN there (never a finite stress from past Gent's pole).
+#[test]
+fn new_laws_name_bad_parameters_and_the_gent_limit() {
+    let named = |law: Law, p: &[f64], name: &str| {
+        let err = law.check(p).unwrap_err().to_string();
+        assert!(
+            err.contains(name),
+            "{law} {p:?}: `{err}` should name {name}"
+        );
+    };
+    named(Law::Gent, &[0.1, 0.0], "Jm");
+    named(Law::Gent, &[0.1, -5.0], "Jm");
+    named(Law::Gent, &[0.0, 5.0], "mu");
+    named(Law::Gent, &[0.1, f64::NAN], "Jm");
+    named(Law::VerondaWestmann, &[-0.1, 0.2], "C1");
+    named(Law::VerondaWestmann, &[0.1, 0.0], "C2");
+    named(Law::Humphrey, &[0.1, -0.2], "C2");
+    named(Law::Humphrey, &[0.0, 0.2], "C1");
+    assert!(matches!(
+        Law::Humphrey.check(&[0.1]),
+        Err(MaterialError::WrongCount {
+            expected: 2,
+            got: 1,
+            ..
+        })
+    ));
+
+    // Gent beyond its limit: uniaxial s = 5 has I1 - 3 = 22.4 > Jm = 20.
+    let p = [0.3, 20.0];
+    let lam = Mode::Uniaxial.stretches(5.0);
+    let err = Law::Gent.check_stretches(&p, lam).unwrap_err();
+    let text = err.to_string();
+    assert!(
+        matches!(err, MaterialError::OutsideDomain { .. })
+            && text.contains("Jm = 20")
+            && text.contains("I1 - 3 = 22.4"),
+        "{text}"
+    );
+    assert!(Law::Gent
+        .check_stretches(&p, Mode::Uniaxial.stretches(4.5))
+        .is_ok());
+    let checked = homogeneous::checked(&Law::Gent, &p, Mode::Uniaxial, 5.0).unwrap_err();
+    assert!(checked.to_string().contains("limit Jm"), "{checked}");
+    assert!(homogeneous::uniaxial(&Law::Gent, &p, 5.0).is_nan());
+    assert!(Law::Gent.isochoric_energy(&p, lam).is_nan());
+    let st = Law::Gent.stress_tangent(
+        &p,
+        Volumetric::D1(0.1),
+        &Matrix3::from_diagonal(&lam.into()),
+    );
+    assert!(st.psi.is_nan() && st.p.iter().all(|v| v.is_nan()) && st.a.iter().all(|v| v.is_nan()));
+    // Exactly at the limit the energy is infinite: NaN stresses, a named error.
+    let s_lim = {
+        let (mut a, mut b) = (1.0f64, 10.0f64);
+        for _ in 0..200 {
+            let m = 0.5 * (a + b);
+            if m * m + 2.0 / m - 3.0 < 20.0 {
+                a = m
+            } else {
+                b = m
+            }
+        }
+        b
+    };
+    assert!(homogeneous::checked(&Law::Gent, &p, Mode::Uniaxial, s_lim).is_err());
+    assert!(!homogeneous::uniaxial(&Law::Gent, &p, s_lim).is_finite());
+
+    // An exponential that overflows is named too.
+    let err = Law::Humphrey
+        .check_stretches(&[0.1, 49.0], Mode::Uniaxial.stretches(6.0))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("overflows"), "{err}");
+    assert!(homogeneous::checked(&Law::VerondaWestmann, &[0.1, 49.0], Mode::Planar, 6.0).is_err());
+    assert!(matches!(
+        homogeneous::checked(&Law::Humphrey, &[0.1, 0.2], Mode::Uniaxial, -1.0),
+        Err(MaterialError::BadStretch { .. })
+    ));
+    assert!(matches!(
+        homogeneous::checked(&Law::Humphrey, &[0.1, -0.2], Mode::Uniaxial, 1.2),
+        Err(MaterialError::OutOfRange { .. })
+    ));
+    // Every other law is defined at every positive stretch.
+    for (law, p) in cases() {
+        if law != Law::Gent {
+            assert!(
+                law.check_stretches(&p, Mode::Uniaxial.stretches(0.5))
+                    .is_ok(),
+                "{law}"
+            );
+        }
+    }
 }
