@@ -224,12 +224,15 @@ mod tests {
     #[test]
     fn two_dimensional_fast_path_equals_the_full_tangent() {
         let f = Matrix3::new(1.3, 0.25, 0.0, -0.15, 0.8, 0.0, 0.0, 0.0, 1.1);
-        let cases: [(&str, Vec<f64>); 5] = [
+        let cases: [(&str, Vec<f64>); 8] = [
             ("neo-hookean", vec![0.5]),
             ("mooney-rivlin", vec![0.3, 0.1]),
             ("reduced-polynomial:2", vec![0.4, 0.2]),
             ("arruda-boyce", vec![0.6, 1.5]),
             ("ogden:1", vec![0.5, 3.0]),
+            ("gent", vec![0.5, 10.0]),
+            ("veronda-westmann", vec![2.0, 0.25]),
+            ("humphrey", vec![1.0, 0.8]),
         ];
         for (law, p) in cases {
             let m = LawMaterial::new(law.parse().unwrap(), p).unwrap();

@@ -27,7 +27,7 @@ use palpate_fe::kinematics::Kinematics;
 use palpate_fe::material::{NeoHookeanIso, PointMaterial};
 use palpate_fe::mesh::{CellType, Mesh};
 use palpate_fe::{stepper, LawMaterial, LoadPath, SolverOptions, System};
-use palpate_material::{homogeneous, Law, Volumetric};
+use palpate_material::{arruda_boyce, homogeneous, Law, Volumetric};
 
 const C10: f64 = 0.01;
 const MU: f64 = 2.0 * C10;
@@ -174,6 +174,27 @@ fn patch<const D: usize>(
     free: Free,
     f: [[f64; D]; D],
 ) -> f64 {
+    patch_with(
+        mooney_rivlin(),
+        mesh,
+        kinematics,
+        pressure,
+        volumetric,
+        free,
+        f,
+    )
+}
+
+/// [`patch`] with a given material (its shear modulus near [`MU`]).
+fn patch_with<const D: usize>(
+    material: Arc<dyn PointMaterial>,
+    mesh: Mesh,
+    kinematics: Kinematics,
+    pressure: PressureSpace,
+    volumetric: Volumetric,
+    free: Free,
+    f: [[f64; D]; D],
+) -> f64 {
     let exact = matches!(volumetric, Volumetric::Incompressible);
     let mut mesh = mesh;
     let lo: [f64; 3] = std::array::from_fn(|c| {
@@ -226,7 +247,7 @@ fn patch<const D: usize>(
     body.set_material(
         "body",
         RegionMaterial {
-            material: mooney_rivlin(),
+            material,
             volumetric,
         },
     )
@@ -367,6 +388,70 @@ fn patch_three_d() {
     }
 }
 
+/// The patch tests of every law with a shear modulus of [`MU`]: plane strain
+/// (Q1/P0 and Q2/P1, exact and penalty incompressibility) and the exact 3D
+/// column (Hex8/P0), with parameters that make each law's nonlinear terms
+/// matter at the patch's stretches (Gent's `Jm` of 1.5 is reached at
+/// `I1 - 3 = 1.5`; the patch's `I1 - 3` is about 0.2).
+#[test]
+fn patch_with_every_law() {
+    let laws: [(Law, Vec<f64>); 9] = [
+        (Law::NeoHookean, vec![C10]),
+        (Law::MooneyRivlin, vec![0.8 * C10, 0.2 * C10]),
+        (Law::ReducedPolynomial(3), vec![C10, -0.1 * C10, 0.05 * C10]),
+        (
+            Law::ArrudaBoyce,
+            vec![MU / arruda_boyce::initial_shear_modulus(1.0, 1.5), 1.5],
+        ),
+        (Law::Ogden(2), vec![0.7 * MU, 3.0, 0.3 * MU, -2.0]),
+        (Law::Gent, vec![MU, 1.5]),
+        (Law::VerondaWestmann, vec![MU / 2.0, 2.0]),
+        (Law::Humphrey, vec![MU / 4.0, 2.0]),
+        (Law::Humphrey, vec![MU / 40.0, 20.0]),
+    ];
+    let k = Kinematics::PlaneStrain { thickness: 2.0 };
+    for (law, params) in laws {
+        let material: Arc<dyn PointMaterial> =
+            Arc::new(LawMaterial::new(law, params.clone()).unwrap());
+        assert!((material.shear_modulus() - MU).abs() < 1e-12 * MU, "{law}");
+        for (cell, pressure) in [
+            (CellType::Quad4, PressureSpace::P0),
+            (CellType::Quad9, PressureSpace::P1),
+        ] {
+            for vol in [Volumetric::Incompressible, d1()] {
+                let (f, free) = if matches!(vol, Volumetric::Incompressible) {
+                    (isochoric(F2), Free::TopNormal)
+                } else {
+                    (F2, Free::Nothing)
+                };
+                let err = patch_with(
+                    material.clone(),
+                    patch_2d(cell, 0.0),
+                    k,
+                    pressure,
+                    vol,
+                    free,
+                    f,
+                );
+                assert_patch(
+                    err,
+                    &format!("{law} {params:?} plane strain {cell:?} {vol:?}"),
+                );
+            }
+        }
+        let err = patch_with(
+            material,
+            patch_3d(),
+            Kinematics::ThreeD,
+            PressureSpace::P0,
+            Volumetric::Incompressible,
+            Free::Column,
+            isochoric(F3_COLUMN),
+        );
+        assert_patch(err, &format!("{law} {params:?} 3D Hex8"));
+    }
+}
+
 /// The unit cube of 2 x 2 x 2 hexahedra (centre node moved) with the
 /// symmetry planes x = 0, y = 0, z = 0 held in their normal component, of
 /// incompressible neo-Hookean `C10`, and exact incompressibility.
@@ -493,9 +578,12 @@ fn cube_uniaxial_and_equibiaxial() {
 #[test]
 fn plane_stress_strip_uniaxial() {
     let (l, h, t) = (3.0, 1.0, 0.4);
-    let laws: [(Law, Vec<f64>); 2] = [
+    let laws: [(Law, Vec<f64>); 5] = [
         (Law::NeoHookean, vec![C10]),
         (Law::ReducedPolynomial(3), vec![C10, -0.1 * C10, 0.05 * C10]),
+        (Law::Gent, vec![MU, 1.5]),
+        (Law::VerondaWestmann, vec![MU / 2.0, 2.0]),
+        (Law::Humphrey, vec![MU / 4.0, 2.0]),
     ];
     for cell in [CellType::Quad4, CellType::Quad9] {
         for (law, params) in &laws {
