@@ -6,6 +6,10 @@
 //! identifiable. Both sides run the same deterministic starting points and
 //! keep the best SSE.
 //!
+//! Gent, Veronda-Westmann and Humphrey are compared the same way with
+//! `docs/validation/laws/treloar_scipy_laws.py` (output
+//! `docs/validation/laws/treloar_scipy_laws.json`).
+//!
 //! `TRELOAR_TABLE=1 cargo test -p palpate-tests --test integration treloar_fits:: -- --nocapture`
 //! prints the markdown table of `docs/validation/treloar.md`.
 
@@ -47,6 +51,9 @@ fn law_of(name: &str) -> Law {
         "yeoh" => Law::ReducedPolynomial(3),
         "arruda_boyce" => Law::ArrudaBoyce,
         "ogden3" => Law::Ogden(3),
+        "gent" => Law::Gent,
+        "veronda_westmann" => Law::VerondaWestmann,
+        "humphrey" => Law::Humphrey,
         other => panic!("unknown law {other}"),
     }
 }
@@ -99,7 +106,14 @@ fn best_fit(case: &Value) -> FitReport {
 }
 
 fn reference() -> Value {
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../docs/validation/treloar_scipy.json");
+    reference_at("treloar_scipy.json")
+}
+
+/// A reference JSON under `docs/validation/`.
+fn reference_at(file: &str) -> Value {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../docs/validation")
+        .join(file);
     serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap()
 }
 
@@ -131,7 +145,11 @@ fn canonical(params: Vec<(String, f64)>) -> Vec<(String, f64)> {
 }
 
 fn check(law: &str) {
-    let reference = reference();
+    check_against(law, &reference());
+}
+
+fn check_against(law: &str, reference: &Value) {
+    let mut cases = 0;
     let table = std::env::var("TRELOAR_TABLE").is_ok();
     for case in reference["fits"]
         .as_array()
@@ -139,6 +157,7 @@ fn check(law: &str) {
         .iter()
         .filter(|c| c["law"] == law)
     {
+        cases += 1;
         let r = best_fit(case);
         let label = format!("{} / {} / {}", law, case["data"], case["residual"]);
         let sse_ref = case["sse"].as_f64().unwrap();
@@ -198,6 +217,7 @@ fn check(law: &str) {
             }
         }
     }
+    assert_eq!(cases, 4, "{law}: the reference has 4 fits of each law");
 }
 
 #[test]
@@ -281,4 +301,23 @@ fn ogden3_matches_scipy_with_one_exponent_on_its_bound_and_is_not_identifiable_o
     // (mu2 ~ 2e-9), reported not identifiable.
     let r = best_fit(&case("relative"));
     assert!(!r.identifiability.identifiable, "{:?}", r.identifiability);
+}
+
+fn laws_reference() -> Value {
+    reference_at("laws/treloar_scipy_laws.json")
+}
+
+#[test]
+fn gent_matches_scipy() {
+    check_against("gent", &laws_reference());
+}
+
+#[test]
+fn veronda_westmann_matches_scipy() {
+    check_against("veronda_westmann", &laws_reference());
+}
+
+#[test]
+fn humphrey_matches_scipy() {
+    check_against("humphrey", &laws_reference());
 }
