@@ -11,6 +11,7 @@ use palpate_enrich::{
     richer_law, MaterialForm, TensionCompressionAsymmetry, Viscoelastic, ZeroOffset,
     DEFAULT_PRONY_TERMS,
 };
+use palpate_material::stability::Mode as StretchMode;
 use palpate_material::{homogeneous, Law};
 use std::sync::Arc;
 
@@ -74,10 +75,17 @@ impl Evaluator for HomogeneousEvaluator<'_> {
             }
             *o = m.stress(theta, s);
             if !o.is_finite() {
-                return Err(ForwardError::Unphysical {
-                    drive: s,
-                    reason: format!("{} stress is not finite", m.law),
-                });
+                // The law's own diagnosis where it has one (Gent's limit, an overflowing exponential).
+                let principal = match m.mode {
+                    Mode::Uniaxial => StretchMode::Uniaxial,
+                    Mode::Equibiaxial => StretchMode::Biaxial,
+                    Mode::Planar => StretchMode::Planar,
+                };
+                let reason = match m.law.check_stretches(theta, principal.stretches(s)) {
+                    Err(e) => e.to_string(),
+                    Ok(()) => format!("{} stress is not finite", m.law),
+                };
+                return Err(ForwardError::Unphysical { drive: s, reason });
             }
         }
         Ok(())

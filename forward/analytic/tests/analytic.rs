@@ -68,6 +68,31 @@ fn neo_hookean_homogeneous_closed_forms() {
     }
 }
 
+/// A stretch at or beyond Gent's limit is an error that names the limit (not a NaN stress, not
+/// a finite stress from beyond the pole); inside it the model answers.
+#[test]
+fn gent_beyond_its_limit_is_a_named_error() {
+    let m = Homogeneous::new(Law::Gent, Mode::Uniaxial);
+    let p = [0.3, 20.0];
+    let inside = m
+        .predict(
+            &p,
+            &Loading::quasi_static(Drive::Stretch, vec![0.5, 2.0, 4.5]),
+        )
+        .unwrap();
+    assert!(inside.iter().all(|v| v.is_finite()));
+    // s = 5: I1 - 3 = 22.4 > Jm = 20.
+    let err = m
+        .predict(&p, &Loading::quasi_static(Drive::Stretch, vec![2.0, 5.0]))
+        .unwrap_err();
+    let text = err.to_string();
+    assert!(
+        matches!(err, ForwardError::Unphysical { drive, .. } if drive == 5.0)
+            && text.contains("limit Jm = 20"),
+        "{text}"
+    );
+}
+
 #[test]
 fn c1_force_matches_the_reference_table_at_2_mm() {
     let table = Table::read(test_data("calculix/c1/analytic_uniaxial.csv")).unwrap();

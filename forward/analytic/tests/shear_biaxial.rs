@@ -15,6 +15,9 @@ fn laws() -> Vec<(Law, Vec<f64>)> {
         (Law::ArrudaBoyce, vec![0.4, 3.0]),
         (Law::Ogden(1), vec![0.5, -8.0]),
         (Law::Ogden(2), vec![0.4, 2.5, 0.05, -3.0]),
+        (Law::Gent, vec![0.4, 10.0]),
+        (Law::VerondaWestmann, vec![1.0, 0.3]),
+        (Law::Humphrey, vec![0.5, 0.6]),
     ]
 }
 
