@@ -45,7 +45,8 @@ use std::path::PathBuf;
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N (N = 1..6),
-    /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N.
+    /// yeoh (= reduced-polynomial:3), arruda-boyce, ogden:N, gent, veronda-westmann,
+    /// humphrey.
     /// Not with --experiment, whose description names its laws; with
     /// --benchmark N1 or N3 it replaces the preset's law.
     #[arg(

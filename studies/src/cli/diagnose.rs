@@ -60,7 +60,8 @@ pub struct Args {
     #[arg(long, value_name = "TEST=FILE")]
     pub data: String,
     /// Base material law (neo-hookean, mooney-rivlin, reduced-polynomial:N,
-    /// yeoh, arruda-boyce, ogden:N). `--law` is the same option.
+    /// yeoh, arruda-boyce, ogden:N, gent, veronda-westmann, humphrey). `--law` is
+    /// the same option.
     #[arg(long, visible_alias = "law", default_value = "neo-hookean")]
     pub base: String,
     /// Candidate effects, comma separated. Default: those listed above for

@@ -74,7 +74,8 @@ pub struct BuildArgs {
     /// docs/validation/realtime.md.
     #[arg(long)]
     pub friction: Option<f64>,
-    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N,
+    /// gent, veronda-westmann, humphrey.
     #[arg(long)]
     pub law: String,
     /// A law parameter, e.g. --param C10=0.0016 (MPa); repeat for each.

@@ -51,7 +51,8 @@ use std::path::{Path, PathBuf};
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
-    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N.
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N,
+    /// gent, veronda-westmann, humphrey.
     #[arg(long)]
     pub law: String,
     /// Data: TEST=FILE for homogeneous tests, or FILE with --benchmark C1. Repeatable.

@@ -53,7 +53,7 @@ pub struct Args {
     /// A lab's own experiment instead of a benchmark: an experiment file (TOML) or a preset's name (palpate experiment list; docs/guide/experiment.md). The description holds the specimen, materials, tool, supports, protocol and mesh, so the benchmark options are refused with it; --param NAME=VALUE sets a parameter (default: its start in the description).
     #[arg(long, value_name = "FILE|PRESET", conflicts_with_all = EXPERIMENT_HOLDS)]
     pub experiment: Option<String>,
-    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N (required, except R2: the tissue law, default arruda-boyce with rtv6166-ab's mu=0.00498, lambda_m=1.05).
+    /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N, gent, veronda-westmann, humphrey (required, except R2: the tissue law, default arruda-boyce with rtv6166-ab's mu=0.00498, lambda_m=1.05).
     #[arg(long)]
     pub law: Option<String>,
     /// A law parameter in MPa (or 1), e.g. --param C10=0.001101295; repeat for each parameter of the law.

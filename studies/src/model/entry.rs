@@ -24,7 +24,8 @@ pub struct ModelEntry {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ModelForm {
     /// `law = "..."`: `neo-hookean`, `mooney-rivlin`, `reduced-polynomial:N`,
-    /// `yeoh`, `arruda-boyce`, `ogden:N`, in the model of each data set's test
+    /// `yeoh`, `arruda-boyce`, `ogden:N`, `gent`, `veronda-westmann`, `humphrey`, in the
+    /// model of each data set's test
     /// ([`super::for_test`]).
     Law(String),
     /// One model kind with its settings.

@@ -252,7 +252,7 @@ pub enum InclusionShape {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MaterialSpec {
     /// `neo-hookean`, `mooney-rivlin`, `yeoh`, `reduced-polynomial:N`,
-    /// `arruda-boyce`, `ogden:N`.
+    /// `arruda-boyce`, `ogden:N`, `gent`, `veronda-westmann`, `humphrey`.
     pub law: String,
     /// Incompressibility: `"exact"` (default) or a bulk-to-shear ratio
     /// (`K / mu0`, e.g. 1000 as in CalculiX decks).

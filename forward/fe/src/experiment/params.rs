@@ -251,7 +251,7 @@ pub fn material_law(name: &str, m: &MaterialSpec) -> Result<Law, FeError> {
         bad(
             format!("materials.{name}.law"),
             format!(
-                "{e}; valid: neo-hookean, mooney-rivlin, yeoh, reduced-polynomial:N, arruda-boyce, ogden:N"
+                "{e}; valid: neo-hookean, mooney-rivlin, yeoh, reduced-polynomial:N, arruda-boyce, ogden:N, gent, veronda-westmann, humphrey"
             ),
         )
     })
