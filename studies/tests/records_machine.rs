@@ -126,8 +126,22 @@ fn the_phantom_file_loads_with_its_metadata_sign_and_units() {
     assert!((b3.observed.last().unwrap() + 0.128142159).abs() < 1e-12);
 }
 
+/// A neo-Hookean tension record (mu = 10 kPa) to 67 % strain, with `head`
+/// (metadata lines) before its header: a curve that softens as it stretches.
+fn neo_hookean_tension(name: &str, head: &str) -> PathBuf {
+    let mut s = format!("{head}Engineering Strain [-],Engineering Stress (kPa)\n");
+    for i in 0..=100 {
+        let e = 0.0067 * i as f64;
+        let l = 1.0 + e;
+        s.push_str(&format!("{e},{}\n", 10.0 * (l - 1.0 / (l * l))));
+    }
+    let p = scratch("tension").join(name);
+    std::fs::write(&p, s).unwrap();
+    p
+}
+
 #[test]
-fn compression_written_positive_is_refused_unless_declared_then_read_the_same() {
+fn compression_written_positive_is_recognised_from_the_file_and_its_curve() {
     let original = read(&phantom(A1), &[]).unwrap();
     // Strains and stresses positive in compression (the force columns as they are).
     let positive = rewrite(
@@ -137,17 +151,72 @@ fn compression_written_positive_is_refused_unless_declared_then_read_the_same() 
         negate(&[3, 4, 5, 6]),
         ",",
     );
-    let e = err(&positive, &[]);
+    // The file says `Compression test` and the curve stiffens as compression
+    // does: read as compression, to the same numbers, and the report says why.
+    let d = read(&positive, &[]).unwrap();
+    assert_eq!(d.observed, original.observed);
+    assert_eq!(d.loading.drive, original.loading.drive);
     for says in [
-        "positive.csv:",
+        "compression, written positive in the file (line 2 says `Compression test`;",
+        "the curve stiffens as a compression does: area ratio 0.",
+        "to strain 0.667",
+        "converted",
+    ] {
+        assert!(d.sign.contains(says), "{}", d.sign);
+    }
+    assert!(d.describe().contains("sign: compression, written positive"));
+    // Declared a compression test, whichever sign: the same.
+    for file in [&positive, &phantom(A1)] {
+        let d = read(file, &[("compression", "yes")]).unwrap();
+        assert_eq!(d.observed, original.observed);
+    }
+    // A curve that softens as tension does, in a file that says compression:
+    // ambiguous, refused naming the options.
+    let soft = neo_hookean_tension("says_compression.csv", "Compression test\n");
+    let e = err(&soft, &[]);
+    for says in [
+        "says_compression.csv:",
         "ambiguous",
-        "line 2 says `Compression test`",
+        "line 1 says `Compression test`",
+        "the curve area ratio 1.1",
         "compression=positive",
         "--compression positive",
         "compression=none",
     ] {
         assert!(e.contains(says), "{e}");
     }
+    // Tension declared as compression: refused, saying why.
+    let tension = neo_hookean_tension("tension.csv", "");
+    assert_eq!(read(&tension, &[]).unwrap().sign, "tension");
+    for declared in ["positive", "yes"] {
+        let e = err(&tension, &[("compression", declared)]);
+        for says in [
+            "tension.csv:102:",
+            &format!("declared a compression test written positive (compression={declared})"),
+            "its curve softens as the strain grows (area ratio 1.1",
+            "as a tension test does",
+            "set compression=none",
+        ] {
+            assert!(e.contains(says), "{e}");
+        }
+    }
+    // A strain of 1 or more is tension whatever the convention.
+    let far = scratch("tension").join("far.csv");
+    std::fs::write(&far, "strain,stress_MPa\n0,0\n0.5,0.2\n1.5,0.5\n").unwrap();
+    let e = err(&far, &[("compression", "yes")]);
+    assert!(
+        e.contains("far.csv:4: `strain` is 1.5 but the record is declared a compression test (compression=yes)"),
+        "{e}"
+    );
+    let stretch = scratch("tension").join("stretch.csv");
+    std::fs::write(&stretch, "stretch,stress_MPa\n1,0\n1.2,0.2\n").unwrap();
+    let e = err(&stretch, &[("compression", "yes")]);
+    assert!(
+        e.contains(
+            "stretch.csv:3: declared a compression test (compression=yes), but `stretch` is 1.2"
+        ),
+        "{e}"
+    );
     let d = read(&positive, &[("compression", "positive")]).unwrap();
     assert_eq!(d.observed, original.observed);
     assert_eq!(d.loading.drive, original.loading.drive);
@@ -369,25 +438,50 @@ fn calibrate_reads_the_phantom_file_and_its_positive_copy_to_the_same_fit() {
         ",",
     );
     let data = format!("uniaxial={}", positive.display());
+    // Recognised from the file and its curve, and said so; declared, the same.
     let out = palpate(&["calibrate", "--law", "neo-hookean", "--data", &data]);
-    assert!(!out.status.success());
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("--compression positive"), "{stderr}");
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "sign: compression, written positive in the file (line 2 says `Compression test`;"
+        ),
+        "{stderr}"
+    );
+    assert_eq!(String::from_utf8_lossy(&out.stdout), original);
+    for sign in ["positive", "yes"] {
+        let out = palpate(&[
+            "calibrate",
+            "--law",
+            "neo-hookean",
+            "--data",
+            &data,
+            "--compression",
+            sign,
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert_eq!(String::from_utf8_lossy(&out.stdout), original);
+    }
+    // A tension record declared as compression is refused.
+    let tension = neo_hookean_tension("cli.csv", "");
     let out = palpate(&[
         "calibrate",
         "--law",
         "neo-hookean",
         "--data",
-        &data,
+        &format!("uniaxial={}", tension.display()),
         "--compression",
-        "positive",
+        "yes",
     ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+        !out.status.success() && stderr.contains("as a tension test does"),
+        "{stderr}"
     );
-    assert_eq!(String::from_utf8_lossy(&out.stdout), original);
     // Columns chosen on the command line, overridden in brackets.
     let out = palpate(&[
         "calibrate",
@@ -455,4 +549,195 @@ skip_rows = 7
         toml::from_str("file = \"x.csv\"\ntest = \"uniaxial\"\ncompression = \"up\"\n").unwrap();
     let e = format!("{:#}", bad.read_options().unwrap_err());
     assert!(e.contains("compression `up`: expected negative"), "{e}");
+}
+
+/// Ecoflex 00-10 without thinner, casts A and B, three tests each
+/// (`EF10_0T_{A,B}{1,2,3}.csv`). Reference values: each file's neo-Hookean
+/// C10 by linear least squares on its 1202 rows (P = 2 C10 (l - l^-2)),
+/// and `scipy.stats.ttest_ind(B, A, equal_var=False)` (scipy 1.x).
+const C10: [(&str, f64); 6] = [
+    ("EF10_0T_A1", 0.011061784672224757),
+    ("EF10_0T_A2", 0.011112203856170054),
+    ("EF10_0T_A3", 0.01113580228635267),
+    ("EF10_0T_B1", 0.010828449926298984),
+    ("EF10_0T_B2", 0.010943450795859637),
+    ("EF10_0T_B3", 0.010564889866369243),
+];
+
+#[test]
+fn replicates_are_fitted_pooled_and_one_by_one_with_the_batch_test() {
+    use palpate_studies::model::calibration::{calibrate, Request};
+    let records: Vec<TestData> = C10
+        .iter()
+        .map(|(f, _)| read(&phantom(&format!("{f}.csv")), &[]).unwrap())
+        .collect();
+    let law: palpate_material::Law = "neo-hookean".parse().unwrap();
+    let pooled = calibrate(Request {
+        law,
+        model: None,
+        fitted: &records,
+        predict: &[],
+        residual: palpate_inverse::ResidualKind::Absolute,
+        method: palpate_inverse::Method::LevenbergMarquardt(Default::default()),
+        fixed: Vec::new(),
+        observer: None,
+        viscous: None,
+    })
+    .unwrap();
+    let r = palpate_studies::steps::replicates::analyse(law, &records, &pooled).unwrap();
+    let close = |a: f64, b: f64, tol: f64| (a - b).abs() <= tol * b.abs();
+    for (fit, (name, c10)) in r.fits.iter().zip(C10) {
+        assert_eq!(fit.record, name);
+        assert_eq!(fit.batch.as_deref(), Some(&name[8..9]));
+        assert!(close(fit.values[0], c10, 1e-6), "{name}: {}", fit.values[0]);
+    }
+    assert!(
+        close(r.mean[0], 0.010941096900545892, 1e-6),
+        "{}",
+        r.mean[0]
+    );
+    assert!(close(r.sd[0], 0.00021724637163923673, 1e-4), "{}", r.sd[0]);
+    assert!(
+        close(r.pooled[0], 0.01094015969123547, 1e-6),
+        "{}",
+        r.pooled[0]
+    );
+    // The pooled standard error is ten times smaller than the spread of
+    // the specimens.
+    let se = r.pooled_se[0].unwrap();
+    assert!(r.sd[0] / se > 5.0, "SD {} SE {se}", r.sd[0]);
+    let b = r.batches.as_ref().unwrap();
+    assert_eq!((b.a.as_str(), b.b.as_str(), b.n_a, b.n_b), ("A", "B", 3, 3));
+    assert_eq!(b.source, "file names");
+    let w = b.tests[0].unwrap();
+    assert!(close(w.t, -2.841103217821117, 1e-4), "{}", w.t);
+    assert!(close(w.df, 2.1515990107941065, 1e-4), "{}", w.df);
+    assert!(close(w.p, 0.09644479955522474, 1e-4), "{}", w.p);
+
+    // The CLI: a file pattern declares replicates; the table says the same.
+    let pattern = phantom("EF10_0T_*.csv");
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &format!("uniaxial={}", pattern.display()),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for says in [
+        "replicates: 6 records, neo-hookean fitted pooled and one by one",
+        "EF10_0T_B3",
+        "0.01056",
+        "rep. mean",
+        "0.01094",
+        "2.172e-4",
+        "batch A (3 records) against batch B (3 records), batches from the file names",
+        "-2.841",
+        "9.644e-2",
+    ] {
+        assert!(stdout.contains(says), "{says}:\n{stdout}");
+    }
+    // Declared batches override the names; a file without one is refused.
+    let dir = phantom("");
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &format!(
+            "uniaxial[batch=early]={}",
+            dir.join("EF10_0T_?1.csv").display()
+        ),
+        "--data",
+        &format!(
+            "uniaxial[batch=late]={}",
+            dir.join("EF10_0T_?2.csv").display()
+        ),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains(
+            "batch early (2 records) against batch late (2 records), batches from the declared"
+        ),
+        "{stdout}{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--replicates",
+        "--data",
+        &format!("uniaxial[batch=A]={}", dir.join("EF10_0T_A1.csv").display()),
+        "--data",
+        &format!("uniaxial={}", dir.join("EF10_0T_B1.csv").display()),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success() && stderr.contains("EF10_0T_B1.csv has no batch while others do"),
+        "{stderr}"
+    );
+    let out = palpate(&[
+        "calibrate",
+        "--law",
+        "neo-hookean",
+        "--data",
+        &format!("uniaxial={}", dir.join("EF99_*.csv").display()),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        !out.status.success()
+            && stderr.contains("no file of")
+            && stderr.contains("matches `EF99_*.csv`"),
+        "{stderr}"
+    );
+}
+
+/// The AR(1) posterior of a full, dense phantom record (1202 smooth rows,
+/// whose second differences put the noise at 1e-5 MPa while the
+/// neo-Hookean misfit is 1e-2 MPa): the residuals are a smooth curve, the
+/// correlation of successive ones within 1e-4 of 1. The Laplace start of
+/// the chains used to fail there; the chains converge (R-hat < 1.01).
+/// About 9 s of CPU.
+#[test]
+fn sample_ar1_on_a_full_phantom_record_converges() {
+    let json = scratch("ar1").join("post.json");
+    let out = palpate(&[
+        "sample",
+        "--law",
+        "neo-hookean",
+        "--ar1",
+        "--data",
+        &format!("uniaxial={}", phantom(A1).display()),
+        "--json",
+        json.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
+    let c = &v["convergence"];
+    assert_eq!(c["converged"], true, "{v}");
+    assert!(c["rhat_max"].as_f64().unwrap() < 1.01, "{c}");
+    assert!(
+        stdout.contains("between-sample correlation of `uniaxial` (AR(1) phi): 1 - "),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("innovation SD sigma sqrt(1 - phi^2)"),
+        "{stdout}"
+    );
+    let phi = v["params"]["phi"]["mean"]
+        .as_f64()
+        .unwrap_or_else(|| panic!("{v}"));
+    assert!(phi > 0.9999 && phi < 1.0, "{phi}");
 }

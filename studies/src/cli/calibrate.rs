@@ -70,6 +70,14 @@ pub struct Args {
     pub data: Vec<String>,
     #[command(flatten)]
     pub reading: crate::cli::reading::ReadingArgs,
+    /// The --data files are replicates of one material (implied by a FILE
+    /// with wildcards, --data 'uniaxial=tests/EF10_0T_*.csv'): fitted pooled
+    /// and one by one; the report gives each parameter's replicate mean and
+    /// SD beside the pooled standard error, and batch A against batch B
+    /// (Welch's t-test), the batches declared (--data 'uniaxial[batch=A]=...')
+    /// or read from the file names (EF10_0T_A1 ... EF10_0T_B5).
+    #[arg(long)]
+    pub replicates: bool,
     /// Viscoelastic homogeneous tests (timed records, column time_s):
     /// qlv:N (quasi-linear viscoelasticity, N Prony terms on the nominal
     /// stress) or finite:N (uniaxial only: Prony terms on the isochoric second
@@ -252,14 +260,26 @@ pub fn read_data_opts(
         ),
         None => {
             for d in data {
-                let (test, options, path) = split_data_with(d, defaults)?;
+                let (test, options, pattern) = split_data_with(d, defaults)?;
                 let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
-                let name = if out.iter().any(|o: &TestData| o.name == test) {
-                    format!("{test}#{}", out.len() + 1)
+                // A FILE with wildcards: every file it matches.
+                let files = if record_for(pattern, arrays)?.is_some() {
+                    vec![pattern.to_string()]
                 } else {
-                    test.to_string()
+                    crate::records::replicates::expand(pattern)
+                        .with_context(|| format!("--data {d}"))?
+                        .iter()
+                        .map(|p| p.display().to_string())
+                        .collect()
                 };
-                out.push(read(&name, kind, path, options)?);
+                for path in &files {
+                    let name = if out.iter().any(|o: &TestData| o.name == test) {
+                        format!("{test}#{}", out.len() + 1)
+                    } else {
+                        test.to_string()
+                    };
+                    out.push(read(&name, kind, path, options.clone())?);
+                }
             }
         }
     }
@@ -274,20 +294,30 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     // the options are checked (and the data read) by the fit first
     let result = fit(&args, &[])?;
-    // How each file was read (metadata, columns, sign), when there is
-    // anything to say beyond palpate's own format.
-    for d in read_data_opts(
+    let records = read_data_opts(
         &args.data,
         args.benchmark.as_deref(),
         &[],
         &args.reading.defaults()?,
-    )? {
+    )?;
+    // How each file was read (metadata, columns, sign), when there is
+    // anything to say beyond palpate's own format.
+    for d in &records {
         let about = d.describe();
         if !about.is_empty() {
             eprint!("{} ({} rows):\n{about}", d.file, d.observed.len());
         }
     }
     print!("{}", calibration_table(&result));
+    if replicates_declared(&args) {
+        anyhow::ensure!(
+            args.experiment.is_none() && args.viscoelastic.is_none() && args.fix.is_empty(),
+            "--replicates (or a --data FILE with wildcards): the replicate fits take a law's parameters, \
+             not with --experiment, --viscoelastic or --fix"
+        );
+        let replicates = crate::steps::replicates::analyse(law_of(&args)?, &records, &result)?;
+        print!("{}", replicates.table());
+    }
     if let Some(p) = &args.json {
         write_json(p, &result)?;
         eprintln!("wrote {}", p.display());
@@ -297,6 +327,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         eprintln!("wrote {}", p.display());
     }
     Ok(())
+}
+
+/// Whether the `--data` files are replicates of one material: declared
+/// with --replicates, or a FILE with wildcards.
+fn replicates_declared(args: &Args) -> bool {
+    args.replicates
+        || args
+            .data
+            .iter()
+            .any(|d| split_data(d).is_ok_and(|(_, _, p)| crate::records::replicates::is_pattern(p)))
 }
 
 /// The parsed `--law`.

@@ -16,9 +16,13 @@ pub struct ReadingArgs {
     #[arg(long = "column", value_name = "ROLE=NAME")]
     pub column: Vec<String>,
     /// How the --data files write compression: negative (strain and stress
-    /// negative, palpate's convention), positive (converted) or none (a
-    /// tension test). Default: read from the data; a compression test whose
-    /// strain and stress are positive is refused as ambiguous.
+    /// negative, palpate's convention), positive (converted), yes (a
+    /// compression test, whichever sign: read from the data) or none (a
+    /// tension test). Default: read from the data; strain and stress both
+    /// positive are compression only when the file says it is a compression
+    /// test and the curve stiffens as compression does (otherwise refused as
+    /// ambiguous). A declared compression whose curve softens as tension's
+    /// does is refused.
     #[arg(long, value_name = "SIGN")]
     pub compression: Option<String>,
     /// Lines at the top of every --data file before its header (kept as

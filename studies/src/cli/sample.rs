@@ -481,6 +481,43 @@ pub fn draw(
             s.name, s.mean, s.sd, s.hdi_3, s.hdi_97, s.rhat, s.ess_bulk, s.ess_tail, lap_mean[k], lap_sd[k]
         );
     }
+    if args.ar1 {
+        // The AR(1) coefficient of each data set: the correlation of
+        // successive residuals, and the SD of the innovations it leaves.
+        for (k, s) in summary.iter().enumerate() {
+            let Some(set) = s.name.strip_prefix("phi") else {
+                continue;
+            };
+            let set = set.strip_prefix('_').unwrap_or(&post.datasets()[0].name);
+            let sigma = names
+                .iter()
+                .position(|n| n == &format!("sigma{}", &s.name[3..]))
+                .map(|j| lap_mean[j])
+                .or(args.sigma);
+            // Near 1, the distance to 1 is what tells values apart.
+            let shown = |v: f64| {
+                if v > 0.999 {
+                    format!("1 - {:.3e}", 1.0 - v)
+                } else {
+                    format!("{v:.4}")
+                }
+            };
+            let phi = lap_mean[k];
+            println!(
+                "between-sample correlation of `{set}` (AR(1) phi): {} [{}, {}]{}",
+                shown(s.mean),
+                shown(s.hdi_3),
+                shown(s.hdi_97),
+                match sigma {
+                    Some(sd) => format!(
+                        "; innovation SD sigma sqrt(1 - phi^2) {} at the Laplace mode",
+                        crate::steps::replicates::sig4(sd * (1.0 - phi * phi).max(0.0).sqrt())
+                    ),
+                    None => String::new(),
+                }
+            );
+        }
+    }
     if names.len() > 1 {
         println!("posterior correlation:");
         for (i, row) in corr.iter().enumerate() {

@@ -10,6 +10,7 @@
 pub mod arrays;
 pub mod columns;
 pub mod machine;
+pub mod replicates;
 pub mod sign;
 
 pub use machine::{Metadata, Role, SpecimenSize};
@@ -98,6 +99,8 @@ pub struct TestData {
     /// How the record's sign was read, e.g. `compression, written negative
     /// as palpate's` (empty when there is nothing to say).
     pub sign: String,
+    /// The batch of a replicate, when declared (`batch=A`).
+    pub batch: Option<String>,
 }
 
 /// How to read a data file beyond its test kind (all optional).
@@ -119,6 +122,9 @@ pub struct ReadOptions {
     /// Lines at the top of the file before the header (kept as metadata);
     /// `None`: the header is found.
     pub skip_rows: Option<usize>,
+    /// The batch of a replicate (a cast, a day, a machine), for the
+    /// batch-to-batch comparison of replicates.
+    pub batch: Option<String>,
 }
 
 impl Default for ReadOptions {
@@ -130,6 +136,7 @@ impl Default for ReadOptions {
             compression: None,
             columns: Vec::new(),
             skip_rows: None,
+            batch: None,
         }
     }
 }
@@ -137,8 +144,8 @@ impl Default for ReadOptions {
 impl ReadOptions {
     /// Parses the options of a `--data KIND[key=value,...]=FILE` or a
     /// manifest data set: `weight`, `axial_stretch`, `stress_unit` (MPa,
-    /// kPa, Pa), `compression` (negative, positive, none), `skip_rows` (a
-    /// count of lines), or a column chosen by name: `time`, `displacement`,
+    /// kPa, Pa), `compression` (negative, positive, yes, none), `skip_rows`
+    /// (a count of lines), `batch` (a replicate's batch), or a column chosen by name: `time`, `displacement`,
     /// `force`, `stretch`, `strain`, `true_strain`, `stress`, `true_stress`
     /// (`force=Load`).
     pub fn set(&mut self, key: &str, value: &str) -> anyhow::Result<()> {
@@ -180,13 +187,21 @@ impl ReadOptions {
                 })
             }
             "compression" => self.compression = Some(Compression::parse(value)?),
+            "batch" => {
+                let b = value.trim();
+                anyhow::ensure!(
+                    !b.is_empty(),
+                    "batch=: expected the name of the replicate's batch, e.g. batch=A"
+                );
+                self.batch = Some(b.to_string());
+            }
             "skip_rows" => {
                 self.skip_rows = Some(value.trim().parse::<usize>().map_err(|_| {
                     anyhow::anyhow!("skip_rows `{value}`: expected a count of lines (0, 1, 2, ...)")
                 })?)
             }
             other => anyhow::bail!(
-                "unknown data option `{other}`; expected weight, axial_stretch, stress_unit, compression, skip_rows \
+                "unknown data option `{other}`; expected weight, axial_stretch, stress_unit, compression, skip_rows, batch \
                  or a column chosen by name ({})",
                 Role::ALL.map(|r| format!("{}=NAME", r.key())).join(", ")
             ),
@@ -356,6 +371,7 @@ impl TestData {
             metadata: Metadata::default(),
             columns_read: Vec::new(),
             sign,
+            batch: options.batch,
         })
     }
 

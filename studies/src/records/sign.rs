@@ -11,13 +11,18 @@
 //!   compression**.
 //!
 //! Testing machines write compression either way. The `compression` option
-//! of a record ([`Compression`]) says how its file writes it; without it,
-//! the record's sign is read from its data and refused when it is
-//! ambiguous: a file that says it is a compression test (a metadata line or
-//! a column named `Compression`) whose strain and stress are both positive
-//! could be a tension test or compression written positive, and the error
-//! names the option to set. A record whose data contradict the declared
-//! convention is refused.
+//! of a record ([`Compression`]) says how its file writes it, or only that
+//! the record is a compression test (`yes`); without it, the record's sign
+//! is read from its data. Strain and stress both negative: compression.
+//! Both positive: tension, unless the file says it is a compression test
+//! (a metadata line or a column named `Compression`) and its curve
+//! stiffens as every elastomer's does in compression ([`Bend`]): then
+//! compression written positive, converted, and the report says why. A
+//! file that says compression but whose curve does not tell is refused as
+//! ambiguous, naming the option to set. A record whose data contradict the
+//! declared convention is refused: strain and stress of the wrong sign, a
+//! declared compression with a strain of 1 or more, or one whose curve
+//! softens as the strain grows, as a tension test's does.
 
 use super::machine::Metadata;
 use super::TestKind;
@@ -35,6 +40,10 @@ pub enum Compression {
     Positive,
     /// The record is a tension test: positive strains and stresses.
     None,
+    /// The record is a compression test, whichever sign its file writes
+    /// (read from the data; refused when the curve softens as a tension
+    /// test's does).
+    Yes,
 }
 
 impl Compression {
@@ -44,11 +53,88 @@ impl Compression {
             "negative" => Ok(Compression::Negative),
             "positive" => Ok(Compression::Positive),
             "none" | "tension" => Ok(Compression::None),
+            "yes" => Ok(Compression::Yes),
             other => anyhow::bail!(
                 "compression `{other}`: expected negative (the file writes compression as negative strain and stress), \
-                 positive (as positive values) or none (a tension test)"
+                 positive (as positive values), yes (a compression test, whichever sign: read from the data) or none \
+                 (a tension test)"
             ),
         }
+    }
+
+    /// The option's value (`negative`, `positive`, `none`, `yes`).
+    pub fn key(self) -> &'static str {
+        match self {
+            Compression::Negative => "negative",
+            Compression::Positive => "positive",
+            Compression::None => "none",
+            Compression::Yes => "yes",
+        }
+    }
+}
+
+/// How a homogeneous record's curve bends: twice the area under the
+/// stress-strain curve of its loading (up to the largest strain) over the
+/// triangle of that end point, magnitudes only. Below 1 the curve stiffens
+/// (every elastomer in compression: a neo-Hookean solid gives 0.96 at 10 %
+/// compression, 0.53 at 67 %), above 1 it softens (rubber in moderate
+/// tension: 1.03 at 10 %, 1.12 at 67 %). Tissues in tension stiffen too,
+/// so stiffening alone never makes a record a compression test.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bend {
+    /// The area ratio.
+    pub ratio: f64,
+    /// The largest strain magnitude.
+    pub strain: f64,
+}
+
+impl Bend {
+    /// Softer than this ratio: softens as tension does (a neo-Hookean
+    /// solid stretched by 20 % gives 1.05).
+    const SOFTENS: f64 = 1.05;
+    /// Stiffer than this ratio: stiffens as compression does (neo-Hookean
+    /// at 8 % compression).
+    const STIFFENS: f64 = 0.97;
+
+    /// The bend of the signed strains `e` and stresses `p` (one row each);
+    /// `None` when the record does not leave zero.
+    pub fn of(e: &[f64], p: &[f64]) -> Option<Bend> {
+        let (k, e_max) = extreme(e);
+        let mut pts: Vec<(f64, f64)> = e[..=k]
+            .iter()
+            .zip(&p[..=k])
+            .map(|(e, p)| (e.abs(), p.abs()))
+            .collect();
+        pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let end = p[k].abs();
+        if e_max == 0.0 || end == 0.0 {
+            return None;
+        }
+        // The trapezoidal rule: a closed form, no quadrature crate needed.
+        let area: f64 = pts
+            .windows(2)
+            .map(|w| 0.5 * (w[1].0 - w[0].0) * (w[1].1 + w[0].1))
+            .sum();
+        Some(Bend {
+            ratio: 2.0 * area / (e_max.abs() * end),
+            strain: e_max.abs(),
+        })
+    }
+
+    fn softens(&self) -> bool {
+        self.ratio > Self::SOFTENS
+    }
+
+    fn stiffens(&self) -> bool {
+        self.ratio < Self::STIFFENS
+    }
+
+    /// `area ratio 0.42 to strain 0.67` for messages and reports.
+    pub fn describe(&self) -> String {
+        format!(
+            "area ratio {:.2} to strain {:.3}, 1 for a straight line",
+            self.ratio, self.strain
+        )
     }
 }
 
@@ -135,13 +221,14 @@ pub fn resolve(
         }
         TestKind::Homogeneous(_) => {
             let (strains, stresses) = strain_and_stress(table);
-            if declared == Some(Compression::Positive) {
+            let negate = |table: &mut Table| {
                 for n in strains.iter().chain(&stresses) {
                     let k = table.names.iter().position(|x| x == n).expect("present");
                     table.columns[k].iter_mut().for_each(|v| *v = -*v);
                 }
-            }
-            // The deformation as a signed strain (stretch - 1) and the stress.
+            };
+            // The deformation as a signed strain (stretch - 1) and the
+            // stress, as the file writes them.
             let strain: Option<(String, Vec<f64>)> = strains
                 .first()
                 .map(|n| (n.clone(), table.column(n).expect("present").to_vec()))
@@ -160,17 +247,38 @@ pub fn resolve(
                 });
             let (Some((sname, e)), Some(pname)) = (strain, stresses.first()) else {
                 // Missing columns are reported by the column reader.
+                if declared == Some(Compression::Positive) {
+                    negate(table);
+                }
                 return Ok(String::new());
             };
-            if sname != "true_strain" && e.iter().any(|&x| x <= -1.0 || x.is_nan()) {
-                // A stretch of zero or below: the column reader names it.
-                return Ok(String::new());
-            }
-            if declared == Some(Compression::Positive) && sname == Column::STRETCH {
-                anyhow::bail!(
-                    "{shown}: compression=positive converts strains, but the file gives a stretch, which is below 1 in compression \
-                     whatever the machine's convention; leave compression unset (or negative)"
-                );
+            let says_compression =
+                matches!(declared, Some(Compression::Positive | Compression::Yes));
+            if sname == Column::STRETCH {
+                if declared == Some(Compression::Positive) {
+                    anyhow::bail!(
+                        "{shown}: compression=positive converts strains, but the file gives a stretch, which is below 1 in compression \
+                         whatever the machine's convention; leave compression unset (or negative)"
+                    );
+                }
+            } else if sname != "true_strain" {
+                if e.iter().any(|&x| x <= -1.0 || x.is_nan()) {
+                    // A stretch of zero or below: the column reader names it.
+                    if declared == Some(Compression::Positive) {
+                        negate(table);
+                    }
+                    return Ok(String::new());
+                }
+                if let (true, Some(k)) = (says_compression, e.iter().position(|&x| x >= 1.0)) {
+                    anyhow::bail!(
+                        "{shown}:{}: `{sname}` is {} but the record is declared a compression test (compression={}): an engineering \
+                         strain of magnitude 1 or more is a stretch of 2 or more, which only tension reaches; if this is a tension \
+                         test set compression=none",
+                        table.lines[k],
+                        e[k],
+                        declared.expect("declared").key()
+                    );
+                }
             }
             let p = table.column(pname).expect("present").to_vec();
             let (k, e_max) = extreme(&e);
@@ -181,6 +289,9 @@ pub fn resolve(
             let e_top = e.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
             let both_ways = e_min < -0.05 * e_max.abs() && e_top > 0.05 * e_max.abs();
             if e_max == 0.0 || p_scale == 0.0 {
+                if declared == Some(Compression::Positive) {
+                    negate(table);
+                }
                 return Ok(String::new());
             }
             // The stress follows the strain where the record goes furthest.
@@ -191,11 +302,14 @@ pub fn resolve(
                      columns is written in another convention (negate it, or choose the columns by name)"
                 );
             }
-            let written = match declared {
-                Some(Compression::Positive) => "written positive in the file, converted",
-                _ => "written negative as palpate's",
-            };
             if both_ways {
+                if declared == Some(Compression::Positive) {
+                    negate(table);
+                }
+                let written = match declared {
+                    Some(Compression::Positive) => "written positive in the file, converted",
+                    _ => "written negative as palpate's",
+                };
                 if declared == Some(Compression::None) {
                     anyhow::bail!(
                         "{shown}:{line}: compression=none (a tension test), but the record also goes into compression \
@@ -204,35 +318,70 @@ pub fn resolve(
                 }
                 return Ok(format!("tension and compression, compression {written}"));
             }
+            // How the curve bends, read as a compression (engineering
+            // strain and stress only: a true pair bends otherwise).
+            let bend = (sname == "strain").then(|| Bend::of(&e, &p)).flatten();
             let compressed = e_max < 0.0;
+            if sname == Column::STRETCH && !compressed && declared == Some(Compression::Yes) {
+                anyhow::bail!(
+                    "{shown}:{line}: declared a compression test (compression=yes), but `stretch` is {}: above 1, which is \
+                     tension whatever the machine's convention; if this is a tension test, set compression=none",
+                    1.0 + e_max
+                );
+            }
             match (declared, compressed) {
-                (Some(Compression::Negative | Compression::Positive), true) => {
-                    Ok(format!("compression, {written}"))
+                (Some(Compression::Negative | Compression::Yes), true) | (None, true) => {
+                    Ok("compression, written negative as palpate's".into())
                 }
+                (Some(Compression::Positive), true) => anyhow::bail!(
+                    "{shown}:{line}: compression=positive, but `{sname}` is {e_max} in the file: negative, so the file writes \
+                     compression as negative (palpate's convention) or the record is a tension test written negative; \
+                     set compression=negative (or leave it unset)"
+                ),
                 (Some(Compression::Negative), false) => anyhow::bail!(
                     "{shown}:{line}: compression=negative, but `{sname}` is {e_max} and `{pname}` {p_at}: positive, so \
                      this record is a tension test or its file writes compression as positive; set compression=positive \
                      or compression=none (a tension test)"
                 ),
-                (Some(Compression::Positive), false) => anyhow::bail!(
-                    "{shown}:{line}: compression=positive, but `{sname}` is {} in the file: negative, so the file writes \
-                     compression as negative (palpate's convention) or the record is a tension test written negative; \
-                     set compression=negative (or leave it unset)",
-                    -e_max
-                ),
+                (Some(Compression::Positive | Compression::Yes), false) => {
+                    if let Some(b) = bend.filter(|b| b.softens()) {
+                        anyhow::bail!(
+                            "{shown}:{line}: declared a compression test written positive (compression={}), but its curve softens as \
+                             the strain grows ({}), as a tension test does: every elastomer stiffens in compression. If this is a \
+                             tension test, set compression=none",
+                            declared.expect("declared").key(),
+                            b.describe()
+                        );
+                    }
+                    negate(table);
+                    Ok("compression, written positive in the file, converted".into())
+                }
                 (Some(Compression::None), true) => anyhow::bail!(
                     "{shown}:{line}: compression=none (a tension test), but `{sname}` is {e_max}: negative, which is \
                      compression in palpate's convention; set compression=negative if this is a compression test"
                 ),
                 (Some(Compression::None), false) => Ok("tension, as declared".into()),
-                (None, true) => Ok("compression, written negative as palpate's".into()),
                 (None, false) => match compression_evidence(table, meta, header) {
-                    Some(why) => anyhow::bail!(
-                        "{shown}:{line}: the sign of this record is ambiguous: the file looks like a compression test \
-                         ({why}), but `{sname}` ({e_max}) and `{pname}` ({p_at}) are positive, which palpate reads as \
-                         tension. If the machine writes compression as positive, {set}; if this is a tension test, set \
-                         compression=none"
-                    ),
+                    Some(why) => match bend {
+                        Some(b) if b.stiffens() => {
+                            negate(table);
+                            Ok(format!(
+                                "compression, written positive in the file ({why}; the curve stiffens as a compression \
+                                 does: {}), converted",
+                                b.describe()
+                            ))
+                        }
+                        b => anyhow::bail!(
+                            "{shown}:{line}: the sign of this record is ambiguous: the file looks like a compression test \
+                             ({why}), but `{sname}` ({e_max}) and `{pname}` ({p_at}) are positive, which palpate reads as \
+                             tension{}. If the machine writes compression as positive, {set}; if this is a tension test, set \
+                             compression=none",
+                            match b {
+                                Some(b) => format!(", and the curve {}", b.describe()),
+                                None => String::new(),
+                            }
+                        ),
+                    },
                     None => Ok("tension".into()),
                 },
             }

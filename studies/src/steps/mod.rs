@@ -43,6 +43,10 @@ macro_rules! registry {
     };
 }
 
+/// Replicates of one material: pooled and per-record fits, the batch test
+/// (not a step kind: the calibrate command and step use it).
+pub mod replicates;
+
 registry! {
     calibrate => Calibrate(CalibrateStep),
     diagnose => Diagnose(DiagnoseStep),
