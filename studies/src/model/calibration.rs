@@ -228,7 +228,6 @@ pub fn calibrate(mut req: Request<'_>) -> anyhow::Result<Calibration> {
         },
         observer: req.observer.clone(),
         start,
-        ..FitOptions::default()
     };
     let report = fit(&objective, &options).with_context(|| format!("fitting {}", req.law))?;
     let theta = report.theta();
