@@ -294,14 +294,18 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     }
     // the options are checked (and the data read) by the fit first
     let result = fit(&args, &[])?;
-    let records = read_data_opts(
-        &args.data,
-        args.benchmark.as_deref(),
-        &[],
-        &args.reading.defaults()?,
-    )?;
     // How each file was read (metadata, columns, sign), when there is
     // anything to say beyond palpate's own format.
+    let records = if experiment_of(&args)?.is_some() {
+        read_experiment_data(&args, &[])?
+    } else {
+        read_data_opts(
+            &args.data,
+            args.benchmark.as_deref(),
+            &[],
+            &args.reading.defaults()?,
+        )?
+    };
     for d in &records {
         let about = d.describe();
         if !about.is_empty() {
@@ -457,27 +461,16 @@ fn fit_experiment(
         .law_text()
         .parse()
         .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
-    let mut data = Vec::new();
-    for d in &args.data {
-        // FILE, or force=FILE
-        let path = d
-            .split_once('=')
-            .filter(|(t, _)| t.eq_ignore_ascii_case("force") || t.eq_ignore_ascii_case("n1"))
-            .map_or(d.as_str(), |(_, p)| p);
-        let name = format!("record{}", data.len() + 1);
-        let record = match record_for(path, arrays).with_context(|| format!("--data {path}"))? {
-            Some(r) => TestData::from_table(
-                &name,
-                TestKind::N1,
-                r.table(&format!("{name} arrays"))?,
-                ReadOptions::default(),
-            )?,
-            None => {
-                TestData::read_with(&name, TestKind::N1, Path::new(path), ReadOptions::default())?
-            }
-        };
-        data.push(record);
-    }
+    let data = read_experiment_data(args, arrays)?;
+    // The mesh is sized for the deepest displacement of the records when
+    // the description's protocol is the record's (no segments of its own).
+    let deepest = data
+        .iter()
+        .flat_map(|d| d.loading.drive.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut spec = spec;
+    spec.experiment.size_for_depth(deepest);
+    spec.check()?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
     crate::run::output::check_outputs(&inputs, &outputs)?;
@@ -496,6 +489,44 @@ fn fit_experiment(
         observer: None,
         viscous: None,
     })
+}
+
+/// The force records of an experiment's calibration: each `--data` is
+/// `FILE`, `force=FILE` or `force[key=value,...]=FILE` (columns
+/// `displacement_mm, force_N`, optionally `time_s`; the reading options of
+/// `--column`, `--compression`, `--skip-rows` and the brackets apply), or
+/// `<array:K>` for records given as arrays.
+pub fn read_experiment_data(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Vec<TestData>> {
+    let defaults = args.reading.defaults()?;
+    let mut data = Vec::new();
+    for d in &args.data {
+        let (path, options) = if d.contains('=') && !Path::new(d).is_file() {
+            let (test, options, path) = split_data_with(d, &defaults)?;
+            anyhow::ensure!(
+                test.eq_ignore_ascii_case("force") || test.eq_ignore_ascii_case("n1"),
+                "--data {d}: an experiment is fitted to force records: FILE or force=FILE (columns displacement_mm, force_N), not {test}=FILE"
+            );
+            (path, options)
+        } else {
+            (d.as_str(), defaults.clone())
+        };
+        let name = if args.data.len() == 1 {
+            "force".to_string()
+        } else {
+            format!("force#{}", data.len() + 1)
+        };
+        let record = match record_for(path, arrays).with_context(|| format!("--data {path}"))? {
+            Some(r) => TestData::from_table(
+                &name,
+                TestKind::N1,
+                r.table(&format!("{name} arrays"))?,
+                options,
+            )?,
+            None => TestData::read_with(&name, TestKind::N1, Path::new(path), options)?,
+        };
+        data.push(record);
+    }
+    Ok(data)
 }
 
 /// Whether `--benchmark Q1` (the staged identification, files only).

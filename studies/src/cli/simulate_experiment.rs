@@ -92,7 +92,7 @@ pub(crate) fn compute(
                 .map_err(|e| anyhow!("{title}: {e}"))?;
             comments.push(format!(
                 "mesh: level {}, {:?} elements ({} cells, {} unknowns)",
-                m.mesh.level,
+                m.sizing.map_or(m.mesh.level as f64, |s| s.level),
                 m.element,
                 solver.mesh.cell_count(),
                 solver.equations()

@@ -8,7 +8,7 @@ use crate::records::{TestData, TestKind};
 use anyhow::Context;
 use palpate_core::ForwardModel;
 use palpate_inverse::{
-    fit, DataSet, FitOptions, FitReport, Method, MultiStart, Objective, ResidualKind,
+    fit, DataSet, FdOptions, FitOptions, FitReport, Method, MultiStart, Objective, ResidualKind,
     SharedObserver,
 };
 use palpate_material::stability::{drucker, DruckerReport};
@@ -181,6 +181,7 @@ pub fn calibrate(mut req: Request<'_>) -> anyhow::Result<Calibration> {
         .iter()
         .map(|d| Ok(d.dataset(req.model_of(d)?)))
         .collect::<anyhow::Result<_>>()?;
+    let expensive = sets.iter().any(|s| s.model.expensive());
     let objective = Objective::new(sets, req.residual, &req.fixed).context("setting up the fit")?;
     // Laws with exponents (Ogden, Arruda-Boyce) have several local minima: start from several points.
     let mut starts = match req.law {
@@ -205,15 +206,28 @@ pub fn calibrate(mut req: Request<'_>) -> anyhow::Result<Calibration> {
                 && p.len() == objective.space().len()
         }),
     };
+    // An FE model's force carries its solver's tolerance (~1e-9 relative)
+    // and is costly: forward differences (one run per parameter instead of
+    // two) with a step (1e-4) well above that noise, as the staged Q1 fit.
+    // (Exact sensitivities, when a model gives them, replace both.)
+    let fd = if expensive {
+        FdOptions {
+            relative_step: 1e-4,
+            central: false,
+            parallel: true,
+        }
+    } else {
+        FdOptions::default()
+    };
     let options = FitOptions {
         method: req.method,
+        fd,
         multistart: MultiStart {
             starts,
             spread: 1.0,
         },
         observer: req.observer.clone(),
         start,
-        ..FitOptions::default()
     };
     let report = fit(&objective, &options).with_context(|| format!("fitting {}", req.law))?;
     let theta = report.theta();

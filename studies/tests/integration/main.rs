@@ -13,6 +13,7 @@ mod bad_input_messages;
 mod cli;
 mod common;
 mod diagnose_homogeneous;
+mod experiment_calibrate;
 mod experiment_cli;
 mod homogeneous_kinds;
 mod localize_pipeline;

@@ -277,6 +277,27 @@ impl Experiment {
         }))
     }
 
+    /// Sizes the mesh for records reaching `depth` (mm) when the protocol
+    /// is the record's: a description without segments (and not a wheel's)
+    /// takes one ramp to `depth` as its protocol, the design depth of the
+    /// cylinder's mesh rule (`models/cylinder.rs`), instead of the tool's
+    /// default. A description with segments is left as it is (its mesh is
+    /// designed for them), as is a non-positive or non-finite depth.
+    pub fn size_for_depth(&mut self, depth: f64) {
+        let wheel = matches!(self.tool, Tool::Wheel(_));
+        if !wheel
+            && self.protocol.segments.is_empty()
+            && self.protocol.from_record.is_none()
+            && depth > 0.0
+            && depth.is_finite()
+        {
+            self.protocol.segments = vec![super::Segment {
+                ramp_to: Some(depth),
+                ..Default::default()
+            }];
+        }
+    }
+
     /// Whether C1's setup models this experiment: one material on the
     /// axisymmetric cylinder, no inclusions, platens both frictionless (a
     /// sliding base, tool friction 0) or both bonded.

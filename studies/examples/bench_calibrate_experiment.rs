@@ -1,0 +1,203 @@
+//! Benchmark of `palpate calibrate --experiment FILE --data force=RECORD.csv`
+//! (Levenberg-Marquardt, the description's fitted parameters, the default
+//! options) on synthetic records made on a finer mesh than the fit's, with
+//! seeded Gaussian noise, for two experiments:
+//!
+//! * `n1`: the N1 needle (a 70 x 80 mm cylinder, bonded base, the
+//!   sphere-cone needle) with the neo-Hookean C10 and the needle's Coulomb
+//!   friction both fitted (truth C10 = 1.101295e-3 MPa, friction 0.8; start
+//!   2e-3 and 0.4), record to 6 mm;
+//! * `gel`: a 2.5 mm sphere on a bonded gel disc 10 mm thick and 40 mm
+//!   across (truth C10 = 5e-3 MPa, start 2e-3), record to 2 mm.
+//!
+//! The fit's mesh is 9-node Q2/P1 at level 1 of the cylinder's sizing rule
+//! (`forward/fe/src/models/cylinder.rs`; `--level N` for another), the
+//! record's one level finer. Prints, per case, the record's cost, then the fit's FE
+//! runs (objective evaluations: one FE run each), LM iterations, CPU
+//! seconds of this process, and each estimate with its standard error and
+//! its distance from the truth in standard errors. The command line runs
+//! in-process (`palpate_studies::cli`, parsed by the CLI's own clap
+//! definitions), so the fit is the one `palpate calibrate` makes.
+//!
+//! ```text
+//! nice cargo run -p palpate-studies --example bench_calibrate_experiment -- [n1] [gel] [--noise 0.005] [--level 1]
+//! ```
+
+use clap::Parser;
+use palpate_core::{Drive, Loading};
+use palpate_fe::experiment::Experiment;
+use palpate_studies::cli::{dispatch, Cli};
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+
+#[path = "../../forward/fe/examples/common/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
+
+struct Case {
+    name: &'static str,
+    /// The description as a user writes it (fitted parameters as starts).
+    description: String,
+    truth: Vec<(&'static str, f64)>,
+    depth: f64,
+    samples: usize,
+}
+
+fn cases() -> Vec<Case> {
+    vec![
+        Case {
+            name: "n1",
+            description: r#"# N1 with the needle's friction fitted
+[specimen]
+shape = "cylinder"
+radius = 35.0
+height = 80.0
+support = "bonded"
+
+[materials.ecoflex]
+law = "neo-hookean"
+C10 = { start = 2e-3 }
+
+[tool]
+shape = "needle"
+friction = { start = 0.4, upper = 2.0 }
+"#
+            .into(),
+            truth: vec![("C10", 1.101295e-3), ("friction", 0.8)],
+            depth: 6.0,
+            samples: 12,
+        },
+        Case {
+            name: "gel",
+            description: r#"# a 2.5 mm sphere on a bonded gel disc
+[specimen]
+shape = "cylinder"
+radius = 20.0
+height = 10.0
+support = "bonded"
+
+[materials.gel]
+law = "neo-hookean"
+C10 = { start = 2e-3 }
+
+[tool]
+shape = "sphere"
+radius = 2.5
+"#
+            .into(),
+            truth: vec![("C10", 5e-3)],
+            depth: 2.0,
+            samples: 10,
+        },
+    ]
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let noise = args
+        .iter()
+        .position(|a| a == "--noise")
+        .and_then(|k| args.get(k + 1))
+        .map_or(0.005, |v| v.parse().expect("--noise: a number"));
+    let level: usize = args
+        .iter()
+        .position(|a| a == "--level")
+        .and_then(|k| args.get(k + 1))
+        .map_or(1, |v| v.parse().expect("--level: a level 1, 2, ..."));
+    let chosen: Vec<&String> = args
+        .iter()
+        .filter(|a| !a.starts_with("--") && a.parse::<f64>().is_err())
+        .collect();
+    let dir = tempfile::tempdir().expect("temporary folder");
+    println!(
+        "palpate calibrate --experiment on synthetic records (fit on mesh level {level}, record on level {}, noise {noise} of the largest force); {} cores",
+        level + 1,
+        std::thread::available_parallelism().map_or(0, |n| n.get())
+    );
+    for case in cases() {
+        if !chosen.is_empty() && !chosen.iter().any(|c| *c == case.name) {
+            continue;
+        }
+        // the record, on a finer mesh
+        let t0 = cpu_seconds(false);
+        let fine: Experiment = toml::from_str(&format!(
+            "{}\n[protocol]\nsegments = [{{ ramp_to = {} }}]\n\n[mesh]\nlevel = {}\n",
+            case.description,
+            case.depth,
+            level + 1
+        ))
+        .expect("the record's description");
+        let model = fine.model().expect("the record's model");
+        let depths: Vec<f64> = (1..=case.samples)
+            .map(|k| case.depth * k as f64 / case.samples as f64)
+            .collect();
+        let theta: Vec<f64> = case.truth.iter().map(|t| t.1).collect();
+        let forces = model
+            .as_forward()
+            .predict(
+                &theta,
+                &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
+            )
+            .expect("the record's run");
+        let top = forces.iter().fold(0.0f64, |m, f| m.max(f.abs()));
+        let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(11);
+        let normal = Normal::new(0.0, noise * top).expect("noise");
+        let mut csv = String::from("displacement_mm,force_N\n");
+        for (d, f) in depths.iter().zip(&forces) {
+            csv += &format!("{d},{:.12e}\n", f + normal.sample(&mut rng));
+        }
+        let record = dir.path().join(format!("{}.csv", case.name));
+        let file = dir.path().join(format!("{}.toml", case.name));
+        let json = dir.path().join(format!("{}.json", case.name));
+        std::fs::write(&record, csv).expect("write the record");
+        std::fs::write(
+            &file,
+            format!("{}\n[mesh]\nlevel = {level}\n", case.description),
+        )
+        .expect("write the description");
+        let record_cpu = cpu_seconds(false) - t0;
+        println!(
+            "\n== {}: record to {} mm, {} samples, F max {top:.4e} N, on {} ({record_cpu:.1} s CPU)",
+            case.name,
+            case.depth,
+            case.samples,
+            model.name()
+        );
+        // the fit, as the command line makes it
+        let line = [
+            "palpate".to_string(),
+            "calibrate".into(),
+            "--experiment".into(),
+            file.display().to_string(),
+            "--data".into(),
+            format!("force={}", record.display()),
+            "--json".into(),
+            json.display().to_string(),
+        ];
+        println!("$ {}", line[..].join(" "));
+        let cli = Cli::try_parse_from(&line).expect("the command line");
+        let (t0, w0) = (cpu_seconds(false), std::time::Instant::now());
+        if let Err(e) = dispatch(cli) {
+            println!("calibrate failed: {e:#}");
+            continue;
+        }
+        let (cpu, wall) = (cpu_seconds(false) - t0, w0.elapsed().as_secs_f64());
+        let fit: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&json).expect("the fit's JSON"))
+                .expect("JSON");
+        println!(
+            "{}: {} FE runs, {} iterations, converged {}, {cpu:.1} s CPU ({wall:.1} s wall)",
+            case.name, fit["evaluations"], fit["iterations"], fit["converged"]
+        );
+        for (name, t) in &case.truth {
+            let p = &fit["params"][name];
+            let v = p["value"].as_f64().unwrap_or(f64::NAN);
+            let se = p["standard_error"].as_f64().unwrap_or(f64::NAN);
+            println!(
+                "  {name} = {v:.6e} +- {se:.2e} (truth {t:.6e}: {:+.2} %, {:+.2} SE)",
+                100.0 * (v / t - 1.0),
+                (v - t) / se
+            );
+        }
+    }
+}
