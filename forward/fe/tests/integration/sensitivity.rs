@@ -93,8 +93,19 @@ fn depths(d: &[f64]) -> Loading {
 #[test]
 fn cylinder_neo_hookean_bonded_sphere() {
     let m = cylinder("neo-hookean", sphere(), 0.3);
-    let dev = deviations(&m, &[C10], &depths(&[0.5, 1.0, 1.5]), 1e-4, false);
+    let loading = depths(&[0.5, 1.0, 1.5]);
+    let dev = deviations(&m, &[C10], &loading, 1e-4, false);
     assert!(dev.iter().all(|d| *d < 1e-6), "{dev:?}");
+    // the capability estimators see gives the force and its columns
+    let (forces, columns) = m
+        .as_sensitivities()
+        .expect("every FE model offers sensitivities")
+        .predict_with_jacobian(&[C10], &loading)
+        .unwrap();
+    let sim = m.simulate_sensitivities(&[C10], &loading).unwrap();
+    assert_eq!(forces, sim.forces);
+    let first: Vec<f64> = sim.derivatives.iter().map(|d| d[0][0]).collect();
+    assert_eq!(columns, vec![first]);
 }
 
 /// Reduced polynomial (C10, C20) with a bulk modulus of 100 mu (the penalty
