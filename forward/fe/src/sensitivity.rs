@@ -33,10 +33,9 @@
 //! accuracy of any finite difference of whole runs: with `e = 1e-4 |p|`
 //! the tests find 1e-8 relative or better (a step of `1e-6 |p|` left
 //! 2e-5 of round-off in a friction derivative, the stick slip being a
-//! small difference of arc lengths). It costs four residual assemblies per parameter
-//! per increment instead of two tangent-free loops over the quadrature
-//! points; a run with sensitivities costs about two to three runs, against
-//! `2 P` more runs for central differences.
+//! small difference of arc lengths). It costs, per increment, one more tangent assembly and factorisation
+//! and, per parameter, four residual assemblies and one back-substitution,
+//! against `2 P` more whole runs for central differences.
 //!
 //! What is differentiated is the discrete run with its increments held: the
 //! same increments (the nominal run's step control), the Uzawa update of the
