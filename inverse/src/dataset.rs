@@ -66,6 +66,16 @@ impl DataSet {
         self
     }
 
+    /// The same set with the exact sensitivities of its model when the
+    /// model offers them ([`palpate_core::ForwardModel::as_sensitivities`]),
+    /// unchanged (finite differences) otherwise.
+    pub fn with_model_sensitivities(self) -> Self {
+        match crate::ModelSensitivities::of(&self.model) {
+            Some(s) => self.with_sensitivities(s),
+            None => self,
+        }
+    }
+
     /// Checks lengths, finiteness, the weight and the loading.
     pub fn validate(&self) -> Result<(), InverseError> {
         if self.observed.len() != self.loading.len() {

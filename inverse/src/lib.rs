@@ -68,5 +68,5 @@ pub use problem::{EvaluationCount, LeastSquaresProblem};
 pub use report::{BoundSide, FitReport, ParameterEstimate, SetReport};
 pub use residual::ResidualKind;
 pub use run::{Method, QuasiNewtonOptions};
-pub use sensitivities::Sensitivities;
+pub use sensitivities::{ModelSensitivities, Sensitivities};
 pub use termination::Termination;

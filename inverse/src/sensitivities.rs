@@ -1,19 +1,43 @@
-//! The hook for models that give exact sensitivities (STYLE.md 3).
+//! Exact sensitivities for the estimators: the trait is palpate-core's
+//! ([`palpate_core::Sensitivities`], re-exported here), offered by a model
+//! through [`palpate_core::ForwardModel::as_sensitivities`];
+//! [`ModelSensitivities`] makes that capability of a shared model the
+//! `Arc` a [`crate::DataSet`] carries.
 
-use palpate_core::{ForwardError, Loading};
+use std::sync::Arc;
 
-/// Exact derivatives of a model's predictions with respect to its physical
-/// parameters. A data set that carries one (see
-/// [`crate::DataSet::with_sensitivities`]) replaces finite differences; when
-/// any set of an objective has none, the whole Jacobian is computed by
-/// finite differences.
-pub trait Sensitivities: Send + Sync {
-    /// `(predictions, columns)` at `theta`, with `columns[j][i]` =
-    /// d prediction_i / d theta_j (column-major, one column per parameter
-    /// of the model's space).
+pub use palpate_core::Sensitivities;
+use palpate_core::{ForwardError, ForwardModel, Loading};
+
+/// The exact sensitivities of a shared model that offers them
+/// ([`ForwardModel::as_sensitivities`]).
+pub struct ModelSensitivities {
+    model: Arc<dyn ForwardModel>,
+}
+
+impl ModelSensitivities {
+    /// `Some` when `model` offers exact sensitivities, `None` otherwise
+    /// (the estimators then use finite differences).
+    pub fn of(model: &Arc<dyn ForwardModel>) -> Option<Arc<dyn Sensitivities>> {
+        model.as_sensitivities()?;
+        Some(Arc::new(ModelSensitivities {
+            model: Arc::clone(model),
+        }))
+    }
+}
+
+impl Sensitivities for ModelSensitivities {
     fn predict_with_jacobian(
         &self,
         theta: &[f64],
         loading: &Loading,
-    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError>;
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
+        match self.model.as_sensitivities() {
+            Some(s) => s.predict_with_jacobian(theta, loading),
+            None => Err(ForwardError::InvalidConfig {
+                field: "sensitivities".into(),
+                reason: format!("{} offers no exact sensitivities", self.model.name()),
+            }),
+        }
+    }
 }

@@ -645,3 +645,52 @@ fn an_optimum_on_an_admissibility_limit_is_reached_along_it() {
     let json = serde_json::to_value(&r).unwrap();
     assert_eq!(json["on_limit"], true);
 }
+
+/// The exponential decay offering [`ExpSensitivities`] as its capability.
+struct ExpWithSensitivities(Arc<dyn ForwardModel>);
+impl ForwardModel for ExpWithSensitivities {
+    fn name(&self) -> String {
+        self.0.name()
+    }
+    fn space(&self) -> &ParamSpace {
+        self.0.space()
+    }
+    fn observable(&self) -> palpate_core::Observable {
+        self.0.observable()
+    }
+    fn evaluator(&self) -> Box<dyn palpate_core::Evaluator + '_> {
+        self.0.evaluator()
+    }
+    fn as_sensitivities(&self) -> Option<&dyn Sensitivities> {
+        Some(&ExpSensitivities)
+    }
+}
+
+/// `with_model_sensitivities` takes a model's capability when it offers
+/// one (the Jacobian is then its, one evaluation) and leaves a set on
+/// finite differences otherwise.
+#[test]
+fn model_sensitivities_are_used_when_the_model_offers_them() {
+    let truth = [2.5, 0.7, -0.3];
+    let plain = set(exp_decay(), times(30, 6.0), &truth);
+    assert!(plain
+        .clone()
+        .with_model_sensitivities()
+        .sensitivities
+        .is_none());
+    let offering = DataSet {
+        model: Arc::new(ExpWithSensitivities(exp_decay())),
+        ..plain.clone()
+    }
+    .with_model_sensitivities();
+    assert!(offering.sensitivities.is_some());
+    let fd_obj = Objective::new(vec![plain], ResidualKind::Absolute, &[]).unwrap();
+    let ex_obj = Objective::new(vec![offering], ResidualKind::Absolute, &[]).unwrap();
+    let z = fd_obj.unbounded_from_theta(&[2.0, 0.9, 0.1]).unwrap();
+    let jf = jacobian_unbounded(&fd_obj, &z, None, &FdOptions::default()).unwrap();
+    let je = jacobian_unbounded(&ex_obj, &z, None, &FdOptions::default()).unwrap();
+    assert_eq!((jf.evaluations, je.evaluations), (6, 1));
+    for (a, b) in jf.matrix.iter().zip(je.matrix.iter()) {
+        assert!((a - b).abs() < 1e-7 * (1.0 + b.abs()), "{a} vs {b}");
+    }
+}

@@ -12,6 +12,8 @@
 //!   (most models have one; [`ForwardModel::outputs`]).
 //! * [`Effect`] — the canonical names of unmodelled effects (see `GAP.md`);
 //!   [`Enrichable`] — the capability of a model that can add them.
+//! * [`Sensitivities`] — the capability of a model that gives the exact
+//!   derivatives of its predictions ([`ForwardModel::as_sensitivities`]).
 //! * [`fd`] — finite-difference Jacobians (one step rule for every crate).
 //! * [`data`] — reading the project's CSV data files with errors naming file,
 //!   line and column.
@@ -27,6 +29,7 @@ pub mod fd;
 pub mod loading;
 pub mod model;
 pub mod param;
+pub mod sensitivities;
 
 pub use data::{Column, DataError, Table, TextTable};
 pub use effect::Effect;
@@ -35,3 +38,4 @@ pub use error::ForwardError;
 pub use loading::{Drive, Loading, Observable, Output};
 pub use model::{check_output_slots, Evaluator, ForwardModel, ModelExt};
 pub use param::{ParamRole, ParamSpace, ParamSpec, Transform};
+pub use sensitivities::Sensitivities;

@@ -67,7 +67,7 @@
 //! [`Observable`], and its `predict_into`.
 
 use crate::fd::{fd_jacobian, FdRule};
-use crate::{Enrichable, ForwardError, Loading, Observable, Output, ParamSpace};
+use crate::{Enrichable, ForwardError, Loading, Observable, Output, ParamSpace, Sensitivities};
 
 /// A per-thread evaluator. It may keep state between calls (a symbolic
 /// factorisation, a mesh) but every call starts the loading history afresh,
@@ -157,6 +157,14 @@ pub trait ForwardModel: Send + Sync {
     /// the model has it. Default: `None`; a model that implements
     /// [`Enrichable`] returns `Some(self)`.
     fn as_enrichable(&self) -> Option<&dyn Enrichable> {
+        None
+    }
+
+    /// The [`Sensitivities`] capability (exact derivatives of the
+    /// predictions with respect to the parameters), when the model has it.
+    /// Default: `None`, and estimators difference the model; a wrapper
+    /// that changes the predictions must not pass on the wrapped model's.
+    fn as_sensitivities(&self) -> Option<&dyn Sensitivities> {
         None
     }
 

@@ -351,6 +351,19 @@ impl Contribution for SolidBody {
     /// from the committed one.
     fn rollback(&mut self) {}
 
+    fn history(&self) -> Vec<f64> {
+        self.history.concat()
+    }
+
+    fn set_history(&mut self, h: &[f64]) {
+        let mut at = 0;
+        for v in self.history.iter_mut() {
+            let n = v.len();
+            v.copy_from_slice(&h[at..at + n]);
+            at += n;
+        }
+    }
+
     /// Zero history for the materials set now.
     fn reset(&mut self, _x0: &[[f64; 3]]) {
         let nq = self.kernel.quadrature_points();

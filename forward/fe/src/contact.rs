@@ -97,6 +97,9 @@ pub enum ContactPoints {
     EdgeSplit,
 }
 
+/// Numbers per contact point in [`Contribution::history`].
+const HISTORY: usize = 10;
+
 /// Largest number of facet nodes a contact point interpolates.
 const MAX_NODES: usize = 9;
 
@@ -743,6 +746,45 @@ impl Contribution for RigidContact {
         self.forces
             .iter_mut()
             .for_each(|f| *f = PointForce::default());
+    }
+
+    /// Per contact point: whether it has a 2D stick point and the stick
+    /// point, whether it has a 3D one and its coordinates, the multiplier
+    /// of the increment, and the position at the last commit.
+    fn history(&self) -> Vec<f64> {
+        let flag = |b: bool| if b { 1.0 } else { 0.0 };
+        let mut v = Vec::with_capacity(HISTORY * self.committed.len());
+        for (c, l) in self.committed.iter().zip(&self.lambda) {
+            let sp = c.stick_point.unwrap_or_default();
+            v.extend_from_slice(&[
+                flag(c.stick.is_some()),
+                c.stick.unwrap_or(0.0),
+                flag(c.stick_point.is_some()),
+                sp[0],
+                sp[1],
+                sp[2],
+                *l,
+                c.pos[0],
+                c.pos[1],
+                c.pos[2],
+            ]);
+        }
+        v
+    }
+
+    fn set_history(&mut self, h: &[f64]) {
+        for ((c, l), v) in self
+            .committed
+            .iter_mut()
+            .zip(self.lambda.iter_mut())
+            .zip(h.chunks_exact(HISTORY))
+        {
+            c.stick = (v[0] > 0.5).then_some(v[1]);
+            c.stick_point = (v[2] > 0.5).then_some([v[3], v[4], v[5]]);
+            *l = v[6];
+            c.lambda = v[6];
+            c.pos = [v[7], v[8], v[9]];
+        }
     }
 
     fn tool_force(&self, axis: [f64; 3]) -> Option<f64> {

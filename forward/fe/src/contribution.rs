@@ -142,6 +142,19 @@ pub trait Contribution: Send + std::any::Any {
     fn rollback(&mut self);
     /// Forgets all history (a new loading history starts at the reference state).
     fn reset(&mut self, x0: &[[f64; 3]]);
+    /// The committed history as numbers (material internal variables,
+    /// stick points, multipliers), for the direct differentiation of a run
+    /// ([`crate::sensitivity`]), which carries their derivatives from
+    /// increment to increment. A discrete part (in contact or not) is
+    /// stored as 0 or 1 and read back as `> 0.5`. Default: none (a
+    /// contribution whose residual depends on nothing committed).
+    fn history(&self) -> Vec<f64> {
+        Vec::new()
+    }
+    /// Replaces the committed history by `h` (as [`Contribution::history`]
+    /// returned it, possibly perturbed); the trial state follows at the
+    /// next assembly.
+    fn set_history(&mut self, _h: &[f64]) {}
     /// Force the tool exerts on the body along `axis` at the last assembly
     /// (N; minus the body's reaction on the tool): a tool pressed down
     /// reports its compression force on `axis = -y`, and a tool dragging the

@@ -82,6 +82,7 @@ pub mod motion;
 pub mod predictor;
 pub mod quadrature;
 pub mod self_contact;
+pub mod sensitivity;
 pub mod shape;
 pub mod sparse;
 pub mod stepper;

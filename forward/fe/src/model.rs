@@ -9,6 +9,7 @@
 use palpate_core::{
     check_output_slots, enrichable::not_applicable, Drive, Effect, Enrichable, Evaluator,
     ForwardError, ForwardModel, Loading, Observable, Output, ParamRole, ParamSpace, ParamSpec,
+    Sensitivities,
 };
 use palpate_material::{Law, Volumetric};
 
@@ -20,6 +21,7 @@ use crate::kernel::PressureSpace;
 use crate::material::LawMaterial;
 use crate::material::PointMaterial;
 use crate::mesh::{CellType, Grading};
+use crate::sensitivity::Differentiation;
 use crate::stepper::{self, LoadPath, Progress, RunFailure};
 use crate::system::{RunStats, SolverOptions, System};
 use crate::viscoelastic::{Prony, Viscoelastic};
@@ -75,6 +77,10 @@ pub struct Simulation {
     /// Every output at each sample.
     pub outputs: Vec<Vec<f64>>,
     pub stats: RunStats,
+    /// With sensitivities ([`FeModel::simulate_sensitivities`]):
+    /// `derivatives[i][j][k]`, the derivative of output `k` at sample `i`
+    /// with respect to parameter `j`; empty otherwise.
+    pub derivatives: Vec<Vec<Vec<f64>>>,
 }
 
 /// The cell of a 2D (axisymmetric or plane) mesh made from a grading.
@@ -295,8 +301,66 @@ impl<S: Setup> FeModel<S> {
             loading,
             progress,
             false,
+            None,
         )?;
         Ok((sim, sys))
+    }
+
+    /// Runs one history with the exact derivatives of every output at every
+    /// sample with respect to every parameter of the model's space
+    /// ([`Simulation::derivatives`]), by direct differentiation through the
+    /// converged increments ([`crate::sensitivity`]): each increment costs
+    /// one more factorisation and, per parameter, one back-substitution and
+    /// four residual assemblies. Every parameter of an FE model is one that
+    /// [`Setup::prepare`] or [`Setup::prony_for`] sets (materials, Prony
+    /// terms, friction coefficients, penalties through the shear modulus);
+    /// parameters that move geometry (a nodule's position, a specimen's
+    /// size) are settings of the setup, not parameters, and stay on finite
+    /// differences of whole runs by whoever varies them. What is
+    /// differentiated is the run with its increments (the nominal run's),
+    /// so a model whose step control depends on a parameter (the time step
+    /// of a Prony series whose times are parameters, when
+    /// `SolverOptions::max_time_step` is unset) differs from differences of
+    /// whole runs by the change of its increments.
+    pub fn simulate_sensitivities(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+    ) -> Result<Simulation, ForwardError> {
+        self.run_sensitivities(theta, loading, false)
+    }
+
+    /// [`FeModel::simulate_sensitivities`] with the history's derivatives
+    /// dropped (held at zero): wrong for any path-dependent run, which is
+    /// what the tests show with it.
+    #[doc(hidden)]
+    pub fn simulate_sensitivities_without_history(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+    ) -> Result<Simulation, ForwardError> {
+        self.run_sensitivities(theta, loading, true)
+    }
+
+    fn run_sensitivities(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+        drop_history: bool,
+    ) -> Result<Simulation, ForwardError> {
+        self.setup.check_loading(loading)?;
+        let (mut sys, parts) = self.setup.build().map_err(to_forward)?;
+        simulate_with(
+            &self.setup,
+            self.space(),
+            &mut sys,
+            &parts,
+            theta,
+            loading,
+            None,
+            true,
+            Some(drop_history),
+        )
     }
 
     /// The model with its setup changed by `change`, as the coarser
@@ -374,6 +438,28 @@ impl<S: Setup> ForwardModel for FeModel<S> {
     fn as_enrichable(&self) -> Option<&dyn Enrichable> {
         self.setup.effects().map(|_| self as &dyn Enrichable)
     }
+    /// Every FE model differentiates its runs
+    /// ([`FeModel::simulate_sensitivities`]).
+    fn as_sensitivities(&self) -> Option<&dyn Sensitivities> {
+        Some(self)
+    }
+}
+
+/// The force (first output) and its derivatives by direct differentiation
+/// ([`FeModel::simulate_sensitivities`]): one run with sensitivities
+/// instead of one run per finite-difference step.
+impl<S: Setup> Sensitivities for FeModel<S> {
+    fn predict_with_jacobian(
+        &self,
+        theta: &[f64],
+        loading: &Loading,
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
+        let sim = self.simulate_sensitivities(theta, loading)?;
+        let columns = (0..theta.len())
+            .map(|j| sim.derivatives.iter().map(|d| d[j][0]).collect())
+            .collect();
+        Ok((sim.forces, columns))
+    }
 }
 
 impl<S: Setup> Enrichable for FeModel<S> {
@@ -433,9 +519,54 @@ fn failure(mut f: RunFailure, all_outputs: bool, preload: usize) -> ForwardError
     }
 }
 
+/// The material of the law's region for the parameters `theta`, and the
+/// shortest relaxation time of its Prony series (`None`: elastic).
+fn law_material<S: Setup>(
+    setup: &S,
+    theta: &[f64],
+) -> Result<(RegionMaterial, Option<f64>), FeError> {
+    let law = setup.law();
+    let n_law = law.params().len();
+    let mat = LawMaterial::new(*law, theta[..n_law].to_vec())?;
+    let mu = law.shear_modulus(&theta[..n_law]);
+    let (point, shortest): (Arc<dyn PointMaterial>, _) = match setup.prony_for(&theta[n_law..])? {
+        None => (Arc::new(mat), None),
+        Some(prony) => {
+            let shortest = prony.shortest_time();
+            (Arc::new(Viscoelastic::new(mat, prony)), Some(shortest))
+        }
+    };
+    Ok((
+        RegionMaterial {
+            material: point,
+            volumetric: setup.bulk().volumetric(mu),
+        },
+        shortest,
+    ))
+}
+
+/// Sets what the parameters `theta` set on a built system (materials,
+/// penalties, friction), leaving its history as it is.
+fn set_parameters<S: Setup>(
+    setup: &S,
+    sys: &mut System,
+    parts: &S::Parts,
+    theta: &[f64],
+) -> Result<(), FeError> {
+    let n_law = setup.law().params().len();
+    let (material, _) = law_material(setup, theta)?;
+    let history = sys.histories();
+    setup.prepare(sys, parts, material, &theta[n_law..])?;
+    sys.set_histories(&history, &history, 0.0);
+    Ok(())
+}
+
 /// Runs one loading history on `sys` (built by `setup`, with the handles
 /// `parts`); a failure keeps the first output of the converged samples, or
-/// with `all_outputs` every output (samples x outputs, row-major).
+/// with `all_outputs` every output (samples x outputs, row-major). With
+/// `sensitivities`, every station's outputs are followed by their
+/// derivatives with respect to each parameter (parameter by parameter), and
+/// `Some(true)` drops the history's derivatives ([`crate::sensitivity`]).
 #[allow(clippy::too_many_arguments)]
 fn simulate_with<S: Setup>(
     setup: &S,
@@ -446,45 +577,70 @@ fn simulate_with<S: Setup>(
     loading: &Loading,
     progress: Option<&mut dyn FnMut(&Progress)>,
     all_outputs: bool,
+    sensitivities: Option<bool>,
 ) -> Result<Simulation, ForwardError> {
     space.check(theta)?;
     loading.validate().map_err(ForwardError::InvalidLoading)?;
-    let law = setup.law();
-    let n_law = law.params().len();
-    let mat = LawMaterial::new(*law, theta[..n_law].to_vec()).map_err(to_forward)?;
-    let mu = law.shear_modulus(&theta[..n_law]);
+    let n_law = setup.law().params().len();
     let mut opts = setup.options();
-    let point: Arc<dyn PointMaterial> =
-        match setup.prony_for(&theta[n_law..]).map_err(to_forward)? {
-            None => Arc::new(mat),
-            Some(prony) => {
-                if loading.time.is_none() {
-                    return Err(ForwardError::InvalidLoading(
-                        "a viscoelastic material needs the time of each sample".into(),
-                    ));
-                }
-                if opts.max_time_step.is_none() {
-                    opts.max_time_step = Some(0.1 * prony.shortest_time());
-                }
-                Arc::new(Viscoelastic::new(mat, prony))
-            }
-        };
-    let material = RegionMaterial {
-        material: point,
-        volumetric: setup.bulk().volumetric(mu),
-    };
+    let (material, shortest) = law_material(setup, theta).map_err(to_forward)?;
+    if let Some(shortest) = shortest {
+        if loading.time.is_none() {
+            return Err(ForwardError::InvalidLoading(
+                "a viscoelastic material needs the time of each sample".into(),
+            ));
+        }
+        if opts.max_time_step.is_none() {
+            opts.max_time_step = Some(0.1 * shortest);
+        }
+    }
     setup
         .prepare(sys, parts, material, &theta[n_law..])
         .map_err(to_forward)?;
     let Path { path, preload } = setup.path(loading, &opts)?;
-    let mut observe = |s: &System| setup.observe(s, parts);
-    let mut outputs = stepper::run(sys, &path, &opts, &mut observe, progress)
-        .map_err(|f| failure(f, all_outputs, preload))?;
+    let mut outputs = match sensitivities {
+        None => {
+            let mut observe = |s: &System| setup.observe(s, parts);
+            stepper::run(sys, &path, &opts, &mut observe, progress)
+        }
+        Some(drop_history) => {
+            let k = setup.outputs().len();
+            let mut set = |s: &mut System, t: &[f64]| set_parameters(setup, s, parts, t);
+            let mut diff = Differentiation::new(sys, theta, k, &mut set).map_err(to_forward)?;
+            diff.drop_history = drop_history;
+            let diff = std::cell::RefCell::new(diff);
+            let observe_only = |s: &System| setup.observe(s, parts);
+            let mut observe = |s: &System| {
+                let mut o = setup.observe(s, parts);
+                o.extend(diff.borrow().outputs.concat());
+                o
+            };
+            let mut hook = |s: &mut System, target: &crate::system::Target| {
+                diff.borrow_mut()
+                    .increment(s, target, &mut set, &observe_only)
+            };
+            stepper::run_with_hook(sys, &path, &opts, &mut observe, progress, Some(&mut hook))
+        }
+    }
+    .map_err(|f| failure(f, all_outputs, preload))?;
     outputs.drain(..preload.min(outputs.len()));
+    let derivatives = if sensitivities.is_some() {
+        let k = outputs.first().map_or(0, |o| o.len() / (1 + theta.len()));
+        outputs
+            .iter_mut()
+            .map(|o| {
+                let d = o.split_off(k);
+                d.chunks(k.max(1)).map(<[f64]>::to_vec).collect()
+            })
+            .collect()
+    } else {
+        Vec::new()
+    };
     Ok(Simulation {
         forces: outputs.iter().map(|o| o[0]).collect(),
         outputs,
         stats: sys.stats,
+        derivatives,
     })
 }
 
@@ -528,6 +684,7 @@ impl<S: Setup> FeEvaluator<'_, S> {
             loading,
             None,
             all_outputs,
+            None,
         )
     }
 }

@@ -218,7 +218,25 @@ pub fn run(
     path: &LoadPath,
     opts: &SolverOptions,
     observe: &mut Observer,
+    progress: Option<&mut dyn FnMut(&Progress)>,
+) -> Result<Vec<Vec<f64>>, RunFailure> {
+    run_with_hook(sys, path, opts, observe, progress, None)
+}
+
+/// What runs after every converged increment, before its commit, with the
+/// system at the converged state and the committed history of the
+/// increment's start ([`crate::sensitivity`]); it must leave the system as
+/// it found it, trial state included. An error stops the run.
+pub(crate) type IncrementHook<'a> = dyn FnMut(&mut System, &Target) -> Result<(), FeError> + 'a;
+
+/// [`run`] with a hook after every converged increment.
+pub(crate) fn run_with_hook(
+    sys: &mut System,
+    path: &LoadPath,
+    opts: &SolverOptions,
+    observe: &mut Observer,
     mut progress: Option<&mut dyn FnMut(&Progress)>,
+    mut hook: Option<&mut IncrementHook>,
 ) -> Result<Vec<Vec<f64>>, RunFailure> {
     let channels = sys.committed.channels.len();
     let fail =
@@ -285,7 +303,14 @@ pub fn run(
                 sys.predictor = Some(p);
             }
             let it0 = sys.stats.iterations;
-            match sys.solve_increment(&target, opts) {
+            let solved = sys.solve_increment(&target, opts);
+            if let (Ok(()), Some(h)) = (&solved, hook.as_deref_mut()) {
+                if let Err(e) = h(sys, &target) {
+                    let drive = sys.committed.channels.first().copied().unwrap_or(0.0);
+                    return Err(fail(k, drive, cuts, e, &outputs));
+                }
+            }
+            match solved {
                 Ok(()) => {
                     sys.commit(&target);
                     let du: Vec<f64> = sys.u.iter().zip(&u_c).map(|(a, b)| a - b).collect();

@@ -775,6 +775,67 @@ impl System {
         self.committed = target.clone();
     }
 
+    /// The residual of the last assembly, per equation.
+    pub(crate) fn residual(&self) -> &[f64] {
+        &self.residual
+    }
+
+    /// Factorises the tangent of the last assembly (which must have
+    /// assembled it) for [`System::solve_factored`].
+    pub(crate) fn factorize_tangent(&mut self) -> Result<(), FeError> {
+        let values = std::mem::take(&mut self.values);
+        let t0 = std::time::Instant::now();
+        let r = self.lu.factorize(&values);
+        self.stats.solve_seconds += t0.elapsed().as_secs_f64();
+        self.values = values;
+        r
+    }
+
+    /// Overwrites `rhs` (per equation) with the solution for the last
+    /// factorised tangent.
+    pub(crate) fn solve_factored(&mut self, rhs: &mut [f64]) -> Result<(), FeError> {
+        let t0 = std::time::Instant::now();
+        let r = self.lu.solve_factored(rhs);
+        self.stats.solve_seconds += t0.elapsed().as_secs_f64();
+        r
+    }
+
+    /// The state `u0 + a du` on the unknowns (`du` per equation), `u0` on
+    /// the prescribed entries.
+    pub(crate) fn set_state(&mut self, u0: &[f64], du: &[f64], a: f64) {
+        self.apply(du, a, u0);
+    }
+
+    /// Every contribution's committed history ([`Contribution::history`]).
+    pub(crate) fn histories(&self) -> Vec<Vec<f64>> {
+        self.contributions.iter().map(|c| c.history()).collect()
+    }
+
+    /// Replaces every contribution's committed history by `h[c] + a dh[c]`.
+    pub(crate) fn set_histories(&mut self, h: &[Vec<f64>], dh: &[Vec<f64>], a: f64) {
+        for ((c, h), dh) in self.contributions.iter_mut().zip(h).zip(dh) {
+            if a == 0.0 {
+                c.set_history(h);
+            } else {
+                let v: Vec<f64> = h.iter().zip(dh).map(|(h, d)| h + a * d).collect();
+                c.set_history(&v);
+            }
+        }
+    }
+
+    /// The contributions accept the trial history of the last assembly
+    /// (the system's committed loading state is left as it is).
+    pub(crate) fn commit_contributions(&mut self, target: &Target) {
+        let mut contributions = std::mem::take(&mut self.contributions);
+        {
+            let ctx = self.context(target);
+            for c in contributions.iter_mut() {
+                c.commit(&ctx);
+            }
+        }
+        self.contributions = contributions;
+    }
+
     /// Restores the contributions' history of the last commit (the state
     /// vector is the stepper's to restore).
     pub(crate) fn rollback(&mut self) {

@@ -179,7 +179,9 @@ pub fn calibrate(mut req: Request<'_>) -> anyhow::Result<Calibration> {
     let sets: Vec<DataSet> = req
         .fitted
         .iter()
-        .map(|d| Ok(d.dataset(req.model_of(d)?)))
+        // exact sensitivities where the model offers them (FE models),
+        // finite differences otherwise
+        .map(|d| Ok(d.dataset(req.model_of(d)?).with_model_sensitivities()))
         .collect::<anyhow::Result<_>>()?;
     let expensive = sets.iter().any(|s| s.model.expensive());
     let objective = Objective::new(sets, req.residual, &req.fixed).context("setting up the fit")?;

@@ -909,3 +909,22 @@ fn band_material(m: &BandMaterial, p: &[f64]) -> Result<RegionMaterial, FeError>
         volumetric: m.bulk.volumetric(mu),
     })
 }
+
+/// Parameters for exact sensitivities and their benches
+/// ([`FeModel::simulate_sensitivities`]): the tool's friction and the law's
+/// Prony terms made parameters directly (as the `friction` effect and a
+/// description's Prony parameters do), keeping the model an [`N1Needle`].
+impl N1Setup {
+    /// Makes the tool's friction coefficient the parameter after the
+    /// law's and Prony's, starting at [`N1Setup::friction`] (the
+    /// `friction` effect's model), or fixes it again.
+    pub fn set_friction_parameter(&mut self, on: bool) {
+        self.friction_is_parameter = on;
+    }
+
+    /// Takes the law's Prony series from `terms` terms of parameters after
+    /// the law's (`g1, tau1_s, ...`; 0: the fixed [`N1Setup::prony`]).
+    pub fn set_prony_parameters(&mut self, terms: usize) {
+        self.prony_parameters = terms;
+    }
+}

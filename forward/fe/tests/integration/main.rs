@@ -18,3 +18,4 @@ mod q1_punch;
 mod r2_rolling;
 mod regions;
 mod regression_original_solver;
+mod sensitivity;
