@@ -2,7 +2,7 @@
 //! compression than in tension.
 
 use crate::convert::split;
-use palpate_core::enrichable::not_applicable;
+use crate::wrap::{enrich_wrapper, wrapper_effects};
 use palpate_core::{
     Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
     ParamSpace, ParamSpec,
@@ -89,11 +89,22 @@ impl ForwardModel for TensionCompressionAsymmetry {
 }
 
 impl Enrichable for TensionCompressionAsymmetry {
+    /// The drive/response wrappers the wrapped model offers (relaxation,
+    /// a zero offset): they act on the asymmetric response as on any other.
     fn effects(&self) -> Vec<Effect> {
-        Vec::new()
+        wrapper_effects(self.base.as_ref(), Effect::TensionCompressionAsymmetry)
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        Err(not_applicable(effect, &self.name()))
+        let this = Arc::new(TensionCompressionAsymmetry {
+            base: self.base.clone(),
+            space: self.space.clone(),
+        });
+        enrich_wrapper(
+            this,
+            self.base.as_ref(),
+            Effect::TensionCompressionAsymmetry,
+            effect,
+        )
     }
     /// Base parameters, then a = 0.
     fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
@@ -153,5 +164,23 @@ mod tests {
         let f = m.predict(&[2.0, 0.5], &l).unwrap();
         assert!((f[0] - 1.5 * 2.0 * -0.2).abs() < 1e-12 && f[1] == 0.0);
         assert!((f[2] - 0.4).abs() < 1e-12);
+    }
+
+    /// Wrapped in a zero offset, the asymmetric response gets an offset of
+    /// the stretch (not of a displacement: its observable is a stress), off
+    /// at 0.
+    #[test]
+    fn it_offers_the_stretch_offset_and_relaxation() {
+        let l = Loading::quasi_static(Drive::Stretch, vec![0.8, 1.0, 1.2]);
+        let tca = TensionCompressionAsymmetry::from_arc(Arc::new(Linear(ParamSpace::new(vec![
+            ParamSpec::new("E", "MPa", 0.0, 10.0, 1.0),
+        ]))));
+        let shifted = crate::wrap(Effect::ZeroOffset, Arc::new(tca)).unwrap();
+        assert_eq!(shifted.space().names(), ["E", "asymmetry", "d0_stretch"]);
+        let off = shifted.as_enrichable().unwrap().embed(&[2.0, 0.5]);
+        assert_eq!(off, [2.0, 0.5, 0.0]);
+        // a stretch offset of 0.1: the true stretch is the recorded one minus 0.1
+        let f = shifted.predict(&[2.0, 0.5, 0.1], &l).unwrap();
+        assert!((f[1] - 1.5 * 2.0 * -0.1).abs() < 1e-12, "{f:?}");
     }
 }

@@ -4,7 +4,7 @@
 
 use crate::{ToolCompliance, Viscoelastic, ZeroOffset};
 use palpate_core::enrichable::{effects_of, not_applicable};
-use palpate_core::{Effect, ForwardError, ForwardModel};
+use palpate_core::{Effect, ForwardError, ForwardModel, Observable};
 use std::sync::Arc;
 
 /// Effects that are added by wrapping a model (rather than by changing its law).
@@ -18,12 +18,18 @@ pub const WRAPPER_EFFECTS: [Effect; 3] = [
 pub const DEFAULT_PRONY_TERMS: usize = 2;
 
 /// `model` enriched with one wrapper effect (one of [`WRAPPER_EFFECTS`]).
+/// The zero offset of a model that predicts a nominal stress (a
+/// stretch-driven homogeneous test) is an offset of the stretch
+/// ([`ZeroOffset::on_stretch`]), of any other model one of the displacement.
 pub fn wrap(
     effect: Effect,
     model: Arc<dyn ForwardModel>,
 ) -> Result<Box<dyn ForwardModel>, ForwardError> {
     match effect {
         Effect::Viscoelasticity => Ok(Box::new(Viscoelastic::from_arc(model, DEFAULT_PRONY_TERMS))),
+        Effect::ZeroOffset if model.observable() == Observable::NominalStressMPa => {
+            Ok(Box::new(ZeroOffset::on_stretch(model)))
+        }
         Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(model))),
         Effect::ToolCompliance => Ok(Box::new(ToolCompliance::from_arc(model))),
         _ => Err(not_applicable(effect, &model.name())),

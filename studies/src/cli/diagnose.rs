@@ -141,6 +141,55 @@ pub fn diagnose_record(
         .with_context(|| format!("diagnosing {}", record.file))
 }
 
+/// The explanation set and its remainder, for stdout: one line per member
+/// (parameters with standard errors, shares of the excess misfit), then the
+/// remainder's note.
+pub fn explanation_summary(r: &GapReport) -> String {
+    use std::fmt::Write;
+    let unit = r.plot.data_unit();
+    let mut s = String::new();
+    if r.explanation_set.is_empty() {
+        let _ = writeln!(s, "explanation: none");
+    } else {
+        let names: Vec<&str> = r.explanation_set.iter().map(|m| m.effect.name()).collect();
+        let _ = writeln!(s, "explanation: {{{}}}", names.join(", "));
+    }
+    let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.0} %", 100.0 * v));
+    for (k, m) in r.explanation_set.iter().enumerate() {
+        let params: Vec<String> = m
+            .params
+            .iter()
+            .map(|(n, v)| match m.standard_errors.get(n).copied().flatten() {
+                Some(se) => format!("{n} = {v:.4e} +- {se:.1e}"),
+                None => format!("{n} = {v:.4e}"),
+            })
+            .collect();
+        let _ = writeln!(
+            s,
+            "  {}. {}: {}; share of the excess misfit {} (in order), {} (dropped one out); misfit after {:.4e} {unit}, held-out {:.4e} {unit}{}",
+            k + 1,
+            m.effect,
+            params.join(", "),
+            pct(m.share_marginal),
+            pct(m.share_dropped),
+            m.misfit_after,
+            m.heldout_after,
+            if m.confounded_with.is_empty() {
+                String::new()
+            } else {
+                let c: Vec<&str> = m.confounded_with.iter().map(|e| e.name()).collect();
+                format!("; cannot be told apart from {}", c.join(", "))
+            }
+        );
+    }
+    if !r.dropped.is_empty() {
+        let d: Vec<&str> = r.dropped.iter().map(|e| e.name()).collect();
+        let _ = writeln!(s, "  dropped by the backward check: {}", d.join(", "));
+    }
+    let _ = write!(s, "remainder: {}", r.remainder.note);
+    s
+}
+
 /// Runs `palpate diagnose`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     let mut options = GapOptions {
@@ -169,6 +218,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
     )?;
     let report = diagnose_record(&record, &args.base, &options)?;
     println!("{}", gap_summary(&report));
+    println!("{}", explanation_summary(&report));
     if let Some(p) = &args.json {
         write_json(p, &report)?;
         eprintln!("wrote {}", p.display());

@@ -9,6 +9,7 @@ mod fe_mesh_convergence;
 mod gap_dev;
 mod gap_fe_effects;
 mod gap_n1;
+mod gap_sets;
 mod gap_v2;
 mod trait_objects;
 mod treloar_fits;

@@ -52,6 +52,12 @@ pub(crate) struct Context<'a> {
     pub linearised: bool,
     /// The model is expensive: fewer starts per refit.
     pub expensive: bool,
+    /// When the "base" is a set of effects: each candidate's parameters
+    /// fitted alone, and every relaxation time of the set is started again
+    /// on the grid (an earlier member's fit can sit in a local optimum that
+    /// the new effect's parameters alone cannot leave). Empty for the
+    /// single-effect step.
+    pub solo: BTreeMap<Effect, BTreeMap<String, f64>>,
 }
 
 /// A candidate after assessment: its ranking entry, its full-record fit, its
@@ -63,6 +69,8 @@ pub(crate) struct Assessed {
     pub model: Arc<dyn ForwardModel>,
     /// The enriched model's "off" point at the base optimum.
     pub off: Vec<f64>,
+    /// Held-out (cross-validated) predictions of the enriched model.
+    pub cv: Vec<f64>,
 }
 
 /// Prony terms of a parameter map relabelled by increasing relaxation time:
@@ -70,7 +78,11 @@ pub(crate) struct Assessed {
 /// label switching in reports. Terms are found by their roles
 /// ([`ParamRole::RelaxationWeight`], [`ParamRole::TimeConstant`]); the value
 /// of the k-th shortest term is written under the names of term k.
-fn canonical_prony<T: Clone>(map: &mut BTreeMap<String, T>, specs: &[ParamSpec], theta: &[f64]) {
+pub(crate) fn canonical_prony<T: Clone>(
+    map: &mut BTreeMap<String, T>,
+    specs: &[ParamSpec],
+    theta: &[f64],
+) {
     let mut terms: BTreeMap<usize, (Option<String>, Option<String>, f64)> = BTreeMap::new();
     for (s, &v) in specs.iter().zip(theta) {
         match s.role {
@@ -108,6 +120,57 @@ fn canonical_prony<T: Clone>(map: &mut BTreeMap<String, T>, specs: &[ParamSpec],
             map.insert(name, v);
         }
     }
+}
+
+/// Extra starts of an effect joining a set (`p` parameters of the set,
+/// "off" point `off`): its own parameters at their values fitted alone
+/// (`alone`, by name), and that with every relaxation time of the model
+/// restarted from a twentieth of the record's duration, a decade apart, the
+/// weights at 0.1 (one start: each costs a refit per fold).
+fn set_starts(
+    rich: &dyn ForwardModel,
+    p: usize,
+    off: &[f64],
+    alone: &BTreeMap<String, f64>,
+    duration: f64,
+) -> Vec<Vec<f64>> {
+    let specs = &rich.space().params;
+    let mut own = off.to_vec();
+    for j in p..specs.len() {
+        if let Some(v) = alone.get(&specs[j].name) {
+            if *v > specs[j].lower && *v < specs[j].upper {
+                own[j] = *v;
+            }
+        }
+    }
+    let mut out = vec![own.clone()];
+    let taus: Vec<(usize, usize)> = {
+        let mut t: Vec<(usize, usize)> = specs
+            .iter()
+            .enumerate()
+            .filter_map(|(j, s)| match s.role {
+                ParamRole::TimeConstant { term } => Some((term, j)),
+                _ => None,
+            })
+            .collect();
+        t.sort();
+        t
+    };
+    if !taus.is_empty() && duration > 0.0 {
+        for b in [duration / 20.0] {
+            let mut s = own.clone();
+            for (k, &(_, j)) in taus.iter().enumerate() {
+                s[j] = b * 10f64.powi(k as i32);
+            }
+            for (j, spec) in specs.iter().enumerate() {
+                if matches!(spec.role, ParamRole::RelaxationWeight { .. }) {
+                    s[j] = 0.1;
+                }
+            }
+            out.push(s);
+        }
+    }
+    out
 }
 
 /// The practical size of an effect: misfit/noise before and after, the
@@ -197,6 +260,9 @@ pub(crate) fn assess(
         .map(|t| t[t.len() - 1] - t[0])
         .unwrap_or(0.0);
     let mut starts = candidate_starts(rich.as_ref(), p, &off, &score.step, duration);
+    if let Some(alone) = ctx.solo.get(&effect) {
+        starts.extend(set_starts(rich.as_ref(), p, &off, alone, duration));
+    }
     let mut projected = false;
     if ctx.expensive {
         starts = screen_starts(rich.as_ref(), ctx.loading, ctx.observed, starts);
@@ -390,6 +456,7 @@ pub(crate) fn assess(
         projected,
         model: rich,
         off,
+        cv,
     })
 }
 

@@ -6,12 +6,15 @@
 
 use super::assess::{assess, Assessed, Context};
 use super::base::fit_base;
+use super::compose::Composite;
 use super::crossval::Folds;
 use super::memo::Memo;
 use super::noise::difference_noise_sd;
+use super::plausible::offset_range;
 use super::rank::rank;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport};
 use super::residual::{residuals, rms};
+use super::set::{explain, remainder_of_base, Stage};
 use super::structure::{default_window, discrepancy_band, significant_windows, whiteness};
 use super::undetectable::undetectable;
 use super::verdict::decide;
@@ -159,11 +162,39 @@ pub fn diagnose(
         materiality: options.materiality,
         linearised,
         expensive,
+        solo: Default::default(),
     };
     // Candidates are independent: assessed in parallel, collected in order.
+    // A zero offset fitted where the record carries load is refitted within
+    // what the record permits.
+    let offsets = offset_range(loading, observed, sigma);
     let outcomes: Vec<(Effect, Result<Assessed, GapError>)> = enriched
         .into_par_iter()
-        .map(|(e, rich, f_off)| (e, assess(e, rich, &f_off, &ctx)))
+        .map(|(e, rich, f_off)| {
+            let outcome = assess(e, rich, &f_off, &ctx);
+            let implausible = outcome.as_ref().is_ok_and(|a| offset_outside(a, offsets));
+            if !implausible {
+                return (e, outcome);
+            }
+            let bounded = enrich(base, e).ok().and_then(|inner| {
+                let off = embed(inner.as_ref(), &base_theta);
+                Composite::bounded(inner, &off, p, offsets)
+            });
+            match bounded {
+                Some(c) => {
+                    let again = assess(e, Arc::new(c), &f_off, &ctx).map(|mut a| {
+                        let (lo, hi) = offsets.unwrap_or_default();
+                        a.ranked.evidence.push_str(&format!(
+                            "; zero offset held within [{lo:.4}, {hi:.4}], what the record's unloaded samples permit \
+                             (fitted free, it put the unloaded state where the record carries load)"
+                        ));
+                        a
+                    });
+                    (e, again)
+                }
+                None => (e, outcome),
+            }
+        })
         .collect();
     let mut assessed = Vec::new();
     let mut failed = Vec::new();
@@ -212,6 +243,59 @@ pub fn diagnose(
         expensive,
     );
 
+    // Explain: the verdict as the first member of a set of effects.
+    let stage = Stage {
+        base,
+        base_theta: &base_theta,
+        loading,
+        observed,
+        sigma,
+        folds: &folds,
+        later,
+        alpha: options.alpha,
+        confound_alpha: options.confound_alpha,
+        rel_var_sd2: noise.rel_var_sd2,
+        materiality: options.materiality,
+        linearised,
+        expensive,
+        axis_name: &axis_name,
+        x: &x,
+        window: w,
+        offsets,
+        solo: assessed
+            .iter()
+            .map(|a| (a.ranked.effect, a.ranked.all_params.clone()))
+            .collect(),
+    };
+    let offered: Vec<Effect> = assessed.iter().map(|a| a.ranked.effect).collect();
+    let first = decision
+        .verdict
+        .effect()
+        .and_then(|e| assessed.iter().find(|a| a.ranked.effect == e));
+    let (explanation_set, remainder, dropped, set_fit, explanation) = match first {
+        Some(first) => {
+            let set = explain(&stage, &base_fit.full, &base_fit.cv, first, &offered);
+            let mut text = decision.explanation.clone();
+            if set.members.len() > 1 || !set.dropped.is_empty() {
+                text.push_str(&set_sentence(&set.members, &set.dropped));
+            }
+            text.push(' ');
+            text.push_str(&set.remainder.note);
+            let fit = (set.members.len() > 1).then_some(set.predicted);
+            (set.members, set.remainder, set.dropped, fit, text)
+        }
+        None => {
+            let remainder = remainder_of_base(&stage, &base_fit.full, &base_fit.cv, &offered);
+            (
+                Vec::new(),
+                remainder,
+                Vec::new(),
+                None,
+                decision.explanation.clone(),
+            )
+        }
+    };
+
     let (band_mean, band_lower, band_upper) = discrepancy_band(&base_residual, sigma, w);
     let best_fit = assessed.first();
     let plot = GapPlot {
@@ -225,6 +309,7 @@ pub fn diagnose(
         band_mean,
         band_lower,
         band_upper,
+        set_fit,
         enriched_effect: best_fit.map(|a| a.ranked.effect),
         enriched_fit: best_fit.map(|a| a.fitted.predicted.clone()),
         enriched_residual: best_fit.map(|a| residuals(observed, &a.fitted.predicted)),
@@ -243,7 +328,10 @@ pub fn diagnose(
         immaterial: decision.immaterial,
         partly_explained: decision.partly,
         undetectable,
-        explanation: decision.explanation,
+        explanation,
+        explanation_set,
+        dropped,
+        remainder,
         base: BaseSummary {
             model: base.name(),
             params: base_names.into_iter().zip(base_theta).collect(),
@@ -258,6 +346,54 @@ pub fn diagnose(
         folds: options.folds,
         plot,
     })
+}
+
+/// Whether a candidate's fitted zero offset lies outside what the record
+/// permits.
+fn offset_outside(a: &Assessed, offsets: Option<(f64, f64)>) -> bool {
+    let Some((lo, hi)) = offsets else {
+        return false;
+    };
+    a.model
+        .space()
+        .params
+        .iter()
+        .zip(&a.fitted.theta)
+        .any(|(s, &v)| s.role == palpate_core::ParamRole::Offset && !(lo..=hi).contains(&v))
+}
+
+/// The sentence that names an explanation of several effects and their shares.
+fn set_sentence(members: &[super::SetMember], dropped: &[Effect]) -> String {
+    let parts: Vec<String> = members
+        .iter()
+        .map(|m| {
+            let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.0} %", 100.0 * v));
+            format!(
+                "`{}` ({} of the excess misfit in the order of selection, {} dropped one out)",
+                m.effect,
+                pct(m.share_marginal),
+                pct(m.share_dropped)
+            )
+        })
+        .collect();
+    let mut text = String::new();
+    if members.len() > 1 {
+        text.push_str(&format!(
+            " Explained together by {} effects: {}; the set brings the misfit to {:.3e}, held out {:.3e}.",
+            members.len(),
+            parts.join(", "),
+            members.last().map_or(f64::NAN, |m| m.misfit_after),
+            members.last().map_or(f64::NAN, |m| m.heldout_after)
+        ));
+    }
+    if !dropped.is_empty() {
+        let names: Vec<&str> = dropped.iter().map(|e| e.name()).collect();
+        text.push_str(&format!(
+            " Dropped once the others were in: {} (no longer earns its place).",
+            names.join(", ")
+        ));
+    }
+    text
 }
 
 #[cfg(test)]

@@ -21,9 +21,16 @@
 //!    and confounding between effects whose fits the data cannot tell apart.
 //! 4. **Verdict**: `none` when the base misfit is consistent with noise or no
 //!    effect earns its parameters; else the best effect that does.
+//! 5. **Explanation**: the verdict is the first member of a set; further
+//!    effects join by forward selection with the set as the base, each
+//!    assessed as in step 3, until the misfit is noise or nothing earns its
+//!    place; a backward check drops members the others make redundant
+//!    ([`set`]). Each member's share of the excess misfit, and the
+//!    remainder with where it lies.
 
 mod assess;
 mod base;
+mod compose;
 mod crossval;
 mod diagnose;
 mod error;
@@ -31,11 +38,13 @@ mod fit;
 mod memo;
 pub mod noise;
 mod options;
+mod plausible;
 pub mod profile;
 mod rank;
 mod report;
 mod residual;
 pub mod score;
+mod set;
 mod starts;
 pub mod structure;
 mod undetectable;
@@ -48,6 +57,7 @@ pub use options::{CrossValidation, FoldLayout, GapOptions};
 pub use profile::ProfileInterval;
 pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, PracticalSize, RankedEffect};
 pub use score::{score_test, sensitivities, ScoreTest};
+pub use set::{Remainder, SetMember};
 pub use structure::{discrepancy_band, significant_windows, whiteness, GapWindow, WhitenessTests};
 pub use undetectable::Undetectable;
 pub use verdict::{PartlyExplained, Verdict};

@@ -4,6 +4,7 @@
 use super::noise::NoiseEstimate;
 use super::profile::ProfileInterval;
 use super::score::ScoreTest;
+use super::set::{Remainder, SetMember};
 use super::structure::{GapWindow, WhitenessTests};
 use super::undetectable::Undetectable;
 use super::verdict::{PartlyExplained, Verdict};
@@ -135,6 +136,9 @@ pub struct GapPlot {
     pub band_mean: Vec<f64>,
     pub band_lower: Vec<f64>,
     pub band_upper: Vec<f64>,
+    /// The fit of the whole explanation (when it has two effects or more).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub set_fit: Option<Vec<f64>>,
     /// The best-ranked enrichment's fit and residuals.
     pub enriched_effect: Option<Effect>,
     pub enriched_fit: Option<Vec<f64>>,
@@ -178,8 +182,21 @@ pub struct GapReport {
     /// far each would move the base parameters.
     #[serde(default)]
     pub undetectable: Vec<Undetectable>,
-    /// One paragraph saying why.
+    /// One paragraph saying why (serialised as `summary`).
+    #[serde(rename = "summary")]
     pub explanation: String,
+    /// The explanation as a set of effects (serialised as `explanation`):
+    /// the verdict first, then the effects that joined it by forward
+    /// selection and survived the backward check, in the order of
+    /// selection; empty when the verdict is `none`.
+    #[serde(rename = "explanation", default)]
+    pub explanation_set: Vec<SetMember>,
+    /// Effects forward selection added that the backward check dropped
+    /// (the others make them redundant).
+    #[serde(default)]
+    pub dropped: Vec<Effect>,
+    /// What the explanation (or the base model, for `none`) leaves, and where.
+    pub remainder: Remainder,
     pub base: BaseSummary,
     pub noise: NoiseEstimate,
     /// Samples, and blocks of the cross-validation.
@@ -243,6 +260,7 @@ impl GapReport {
             );
         }
         let _ = writeln!(s, "\n{}\n", self.explanation);
+        s.push_str(&self.explanation_markdown());
         let _ = writeln!(s, "## Base model\n");
         let _ = writeln!(s, "- model: {}", self.base.model);
         let params: Vec<String> = self
@@ -383,6 +401,57 @@ impl GapReport {
                 );
             }
         }
+        s
+    }
+}
+
+impl GapReport {
+    /// The explanation set and its remainder as a markdown section.
+    fn explanation_markdown(&self) -> String {
+        let unit = self.plot.data_unit();
+        let mut s = String::new();
+        let _ = writeln!(s, "## Explanation\n");
+        if self.explanation_set.is_empty() {
+            let _ = writeln!(s, "No effect explains the gap.\n");
+        } else {
+            let _ = writeln!(
+                s,
+                "| step | effect | parameters (physical units) | share of excess, marginal | share, dropped one out | misfit RMS after ({unit}) | held-out RMS after ({unit}) | confounded with |"
+            );
+            let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
+            let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.0} %", 100.0 * v));
+            for (k, m) in self.explanation_set.iter().enumerate() {
+                let params: Vec<String> = m
+                    .params
+                    .iter()
+                    .map(|(n, v)| match m.standard_errors.get(n).copied().flatten() {
+                        Some(se) => format!("{n} = {v:.4e} +- {se:.1e}"),
+                        None => format!("{n} = {v:.4e}"),
+                    })
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "| {} | {} | {} | {} | {} | {:.3e} | {:.3e} | {} |",
+                    k + 1,
+                    m.effect,
+                    params.join(", "),
+                    pct(m.share_marginal),
+                    pct(m.share_dropped),
+                    m.misfit_after,
+                    m.heldout_after,
+                    names(&m.confounded_with).join(", ")
+                );
+            }
+            let _ = writeln!(s);
+        }
+        if !self.dropped.is_empty() {
+            let _ = writeln!(
+                s,
+                "Added and then dropped (the other members make it redundant): `{}`.\n",
+                names(&self.dropped).join("`, `")
+            );
+        }
+        let _ = writeln!(s, "**Remainder**: {}\n", self.remainder.note);
         s
     }
 }

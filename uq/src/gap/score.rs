@@ -93,8 +93,15 @@ pub(crate) fn sensitivities_at(
             let mut ev = model.evaluator();
             let mut f = |t: &[f64], out: &mut [f64]| ev.predict_into(t, loading, out);
             let mut col = vec![0.0; n];
-            fd_column(&mut f, theta, j, step, centre.as_deref(), &mut col)?;
-            Ok(Some(col))
+            match fd_column(&mut f, theta, j, step, centre.as_deref(), &mut col) {
+                Ok(_) => Ok(Some(col)),
+                // The model predicts at `theta` but admits no step of this
+                // parameter either way (a Prony weight at the edge of
+                // sum g_i <= 1 while its own bound lies behind it): no
+                // local sensitivity, a zero column.
+                Err(_) if centre.is_some() => Ok(Some(vec![0.0; n])),
+                Err(e) => Err(e),
+            }
         })
         .collect();
     let mut jac = DMatrix::zeros(n, theta.len());

@@ -1,0 +1,384 @@
+//! Writes the two-effect development records of the gap diagnosis to
+//! `studies/data/gap-dev2/`, each seeded, with its truth in `truth.json`
+//! (used by `tests/tests/integration/gap_sets.rs`):
+//!
+//! * `c1-*`: C1 compression (neo-Hookean base, the analytic model) with two
+//!   planted effects among viscoelasticity (two Prony terms), zero offset,
+//!   material form (reduced polynomial N=2), compressibility (D1) and tool
+//!   compliance, every pair, on a ramp-hold-unload history;
+//! * `uni-*`: homogeneous uniaxial records (nominal stress) with two of
+//!   viscoelasticity, zero offset of the stretch, material form and the
+//!   tension-compression asymmetry (records that cross stretch 1);
+//! * `null-*`: twenty records of the base models with noise only.
+//!
+//! Each effect is planted strong enough that alone it leaves a misfit well
+//! above the noise (the test checks this on the diagnosis: the first
+//! member alone leaves the gap partly explained). `expected` is the set a
+//! correct diagnosis answers (`[]` for the nulls).
+//!
+//! `cargo run -p palpate-tools --bin make_gap_two` (seconds). The records
+//! are committed; rerun only to change them.
+
+use palpate_analytic::{C1Compression, Compressible, Homogeneous, Mode};
+use palpate_core::{Drive, ForwardModel, Loading};
+use palpate_enrich::{TensionCompressionAsymmetry, ToolCompliance, Viscoelastic, ZeroOffset};
+use palpate_material::Law;
+use rand::SeedableRng;
+use rand_distr::{Distribution, Normal};
+use std::fmt::Write;
+use std::sync::Arc;
+
+/// A C1 history sampled every `dt` s: a ramp at `rate` mm/s to `depth`, a
+/// hold of `hold` s and an unloading at the same rate.
+fn c1_history(rate: f64, depth: f64, hold: f64, dt: f64) -> Loading {
+    let ramp = depth / rate;
+    let total = 2.0 * ramp + hold;
+    let n = (total / dt).round() as usize + 1;
+    let t: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let d = t
+        .iter()
+        .map(|&t| {
+            if t <= ramp {
+                rate * t
+            } else if t <= ramp + hold {
+                depth
+            } else {
+                (depth - rate * (t - ramp - hold)).max(0.0)
+            }
+        })
+        .collect();
+    Loading::timed(Drive::DisplacementMm, t, d)
+}
+
+/// A stretch history through `corners` (stretch, time to reach it from the
+/// previous corner, hold after it), from stretch 1 at t = 0, sampled every
+/// `dt` s.
+fn stretch_history(corners: &[(f64, f64, f64)], dt: f64) -> Loading {
+    let mut knots = vec![(0.0, 1.0)];
+    let mut t = 0.0;
+    for &(s, ramp, hold) in corners {
+        t += ramp;
+        knots.push((t, s));
+        if hold > 0.0 {
+            t += hold;
+            knots.push((t, s));
+        }
+    }
+    let n = (t / dt).round() as usize + 1;
+    let times: Vec<f64> = (0..n).map(|i| i as f64 * dt).collect();
+    let stretch = times
+        .iter()
+        .map(|&ti| {
+            let k = knots
+                .windows(2)
+                .position(|w| ti <= w[1].0 + 1e-12)
+                .unwrap_or(knots.len() - 2);
+            let ((t0, s0), (t1, s1)) = (knots[k], knots[k + 1]);
+            if t1 > t0 {
+                s0 + (s1 - s0) * (ti - t0) / (t1 - t0)
+            } else {
+                s1
+            }
+        })
+        .collect();
+    Loading::timed(Drive::Stretch, times, stretch)
+}
+
+/// Gaussian white noise of SD `sd` from `seed`.
+fn noise(n: usize, sd: f64, seed: u64) -> Vec<f64> {
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let normal = Normal::new(0.0, sd).expect("sd");
+    (0..n).map(|_| normal.sample(&mut rng)).collect()
+}
+
+struct Record {
+    name: String,
+    loading: Loading,
+    clean: Vec<f64>,
+    /// Noise SD relative to the peak |response|.
+    relative_noise: f64,
+    seed: u64,
+    /// JSON members of the truth (without the noise).
+    truth: String,
+}
+
+fn nh_c1() -> Box<dyn ForwardModel> {
+    Box::new(C1Compression::new(Law::NeoHookean))
+}
+
+fn c1_rp2() -> Box<dyn ForwardModel> {
+    Box::new(C1Compression::new(Law::ReducedPolynomial(2)))
+}
+
+fn compressible_nh() -> Box<dyn ForwardModel> {
+    Box::new(Compressible::new(Law::NeoHookean))
+}
+
+/// The C1 pair records: every pair of the five effects, two variants each.
+fn c1_records() -> Vec<Record> {
+    // Parameters of each effect (variant 0, variant 1).
+    let c10 = [1.2e-3, 1.0e-3];
+    let prony = [(0.3, 1.5, 0.15, 12.0), (0.25, 0.8, 0.2, 8.0)];
+    let d0 = [0.15, 0.1];
+    let c20 = [2.0e-3, 1.5e-3];
+    let d1 = [600.0, 450.0];
+    let comp = [0.15, 0.2];
+    let pairs: [(&str, &str); 10] = [
+        ("viscoelasticity", "zero_offset"),
+        ("viscoelasticity", "material_form"),
+        ("viscoelasticity", "compressibility"),
+        ("viscoelasticity", "tool_compliance"),
+        ("zero_offset", "material_form"),
+        ("zero_offset", "compressibility"),
+        ("zero_offset", "tool_compliance"),
+        ("material_form", "compressibility"),
+        ("material_form", "tool_compliance"),
+        ("compressibility", "tool_compliance"),
+    ];
+    let mut out = Vec::new();
+    for (k, &(a, b)) in pairs.iter().enumerate() {
+        for v in 0..2 {
+            let has = |e: &str| a == e || b == e;
+            let (g1, tau1, g2, tau2) = prony[v];
+            // The elastic core: the law and compressibility.
+            let (core, mut theta): (Box<dyn ForwardModel>, Vec<f64>) =
+                match (has("material_form"), has("compressibility")) {
+                    (true, true) => (
+                        Box::new(Compressible::new(Law::ReducedPolynomial(2))),
+                        vec![c10[v], c20[v], d1[v]],
+                    ),
+                    (true, false) => (c1_rp2(), vec![c10[v], c20[v]]),
+                    (false, true) => (compressible_nh(), vec![c10[v], d1[v]]),
+                    (false, false) => (nh_c1(), vec![c10[v]]),
+                };
+            let mut model = core;
+            if has("zero_offset") {
+                model = Box::new(ZeroOffset::new(model));
+                theta.push(d0[v]);
+            }
+            if has("viscoelasticity") {
+                model = Box::new(Viscoelastic::new(model, 2));
+                theta.extend([g1, tau1, g2, tau2]);
+            }
+            if has("tool_compliance") {
+                model = Box::new(ToolCompliance::new(model));
+                theta.push(comp[v]);
+            }
+            let (rate, depth, hold) = if v == 0 {
+                (0.2, 2.0, 20.0)
+            } else {
+                (0.25, 2.2, 25.0)
+            };
+            let loading = c1_history(rate, depth, hold, 0.1);
+            let clean = model.predict(&theta, &loading).expect("C1 pair record");
+            let names: Vec<String> = model.space().names();
+            let params: Vec<String> = names
+                .iter()
+                .zip(&theta)
+                .map(|(n, v)| format!("\"{n}\": {v}"))
+                .collect();
+            out.push(Record {
+                name: format!("c1-{:02}", 2 * k + v),
+                loading,
+                clean,
+                relative_noise: 0.005,
+                seed: 1000 + (2 * k + v) as u64,
+                truth: format!(
+                    "\"base\": \"C1\", \"law\": \"neo-hookean\", \"model\": \"{}\", \"protocol\": \"ramp_hold_unload\", \
+                     \"rate_mm_s\": {rate}, \"depth_mm\": {depth}, \"hold_s\": {hold}, \"params\": {{{}}}, \
+                     \"expected\": [\"{a}\", \"{b}\"]",
+                    model.name(),
+                    params.join(", ")
+                ),
+            });
+        }
+    }
+    out
+}
+
+fn uniaxial(law: Law) -> Arc<dyn ForwardModel> {
+    Arc::new(Homogeneous::new(law, Mode::Uniaxial))
+}
+
+/// The homogeneous uniaxial pair records.
+fn uniaxial_records() -> Vec<Record> {
+    // A tension-compression cycle with holds (crosses stretch 1) and a
+    // tension ramp-hold-unload.
+    let cycle = || {
+        stretch_history(
+            &[
+                (0.8, 8.0, 10.0),
+                (1.0, 8.0, 0.0),
+                (1.3, 12.0, 10.0),
+                (1.0, 12.0, 0.0),
+            ],
+            0.1,
+        )
+    };
+    let tension = || stretch_history(&[(1.4, 10.0, 20.0), (1.0, 10.0, 0.0)], 0.1);
+    let pairs: [(&str, &str, bool); 6] = [
+        ("viscoelasticity", "material_form", false),
+        ("viscoelasticity", "zero_offset", false),
+        ("zero_offset", "material_form", false),
+        ("tension_compression_asymmetry", "viscoelasticity", true),
+        ("tension_compression_asymmetry", "zero_offset", true),
+        ("tension_compression_asymmetry", "material_form", true),
+    ];
+    let c10 = [0.05, 0.08];
+    let c20 = [0.08, 0.1];
+    let prony = [(0.3, 1.0, 0.2, 10.0), (0.25, 2.0, 0.15, 15.0)];
+    let d0 = [0.03, -0.025];
+    let asym = [1.0, 1.5];
+    let mut out = Vec::new();
+    for (k, &(a, b, crosses)) in pairs.iter().enumerate() {
+        for v in 0..2 {
+            let has = |e: &str| a == e || b == e;
+            let (mut model, mut theta): (Arc<dyn ForwardModel>, Vec<f64>) = if has("material_form")
+            {
+                (uniaxial(Law::ReducedPolynomial(2)), vec![c10[v], c20[v]])
+            } else {
+                (uniaxial(Law::NeoHookean), vec![c10[v]])
+            };
+            if has("tension_compression_asymmetry") {
+                model = Arc::new(TensionCompressionAsymmetry::from_arc(model));
+                theta.push(asym[v]);
+            }
+            if has("zero_offset") {
+                model = Arc::new(ZeroOffset::on_stretch(model));
+                theta.push(d0[v]);
+            }
+            if has("viscoelasticity") {
+                let (g1, tau1, g2, tau2) = prony[v];
+                model = Arc::new(Viscoelastic::from_arc(model, 2));
+                theta.extend([g1, tau1, g2, tau2]);
+            }
+            let loading = if crosses { cycle() } else { tension() };
+            let clean = model
+                .predict(&theta, &loading)
+                .expect("uniaxial pair record");
+            let params: Vec<String> = model
+                .space()
+                .names()
+                .iter()
+                .zip(&theta)
+                .map(|(n, v)| format!("\"{n}\": {v}"))
+                .collect();
+            out.push(Record {
+                name: format!("uni-{:02}", 2 * k + v),
+                loading,
+                clean,
+                relative_noise: 0.005,
+                seed: 2000 + (2 * k + v) as u64,
+                truth: format!(
+                    "\"base\": \"uniaxial\", \"law\": \"neo-hookean\", \"model\": \"{}\", \"protocol\": \"{}\", \
+                     \"params\": {{{}}}, \"expected\": [\"{a}\", \"{b}\"]",
+                    model.name(),
+                    if crosses { "tension_compression_cycle" } else { "tension_ramp_hold_unload" },
+                    params.join(", ")
+                ),
+            });
+        }
+    }
+    out
+}
+
+/// Twenty records of the base models with noise only.
+fn null_records() -> Vec<Record> {
+    let mut out = Vec::new();
+    for k in 0..10 {
+        let (rate, depth, hold) = [(0.2, 2.0, 20.0), (0.25, 2.2, 25.0), (0.4, 1.8, 10.0)][k % 3];
+        let c10 = 0.9e-3 + 0.1e-3 * k as f64;
+        let loading = c1_history(rate, depth, hold, 0.1);
+        let clean = nh_c1().predict(&[c10], &loading).expect("C1 null");
+        out.push(Record {
+            name: format!("null-c1-{k:02}"),
+            loading,
+            clean,
+            relative_noise: [0.005, 0.01, 0.02][k % 3],
+            seed: 3000 + k as u64,
+            truth: format!(
+                "\"base\": \"C1\", \"law\": \"neo-hookean\", \"model\": \"C1 neo-Hookean\", \"protocol\": \"ramp_hold_unload\", \
+                 \"rate_mm_s\": {rate}, \"depth_mm\": {depth}, \"hold_s\": {hold}, \"params\": {{\"C10\": {c10}}}, \
+                 \"expected\": []"
+            ),
+        });
+    }
+    for k in 0..10 {
+        let crosses = k % 2 == 0;
+        let loading = if crosses {
+            stretch_history(
+                &[
+                    (0.8, 8.0, 10.0),
+                    (1.0, 8.0, 0.0),
+                    (1.3, 12.0, 10.0),
+                    (1.0, 12.0, 0.0),
+                ],
+                0.1,
+            )
+        } else {
+            stretch_history(&[(1.4, 10.0, 20.0), (1.0, 10.0, 0.0)], 0.1)
+        };
+        let c10 = 0.04 + 0.01 * k as f64;
+        let clean = uniaxial(Law::NeoHookean)
+            .predict(&[c10], &loading)
+            .expect("uniaxial null");
+        out.push(Record {
+            name: format!("null-uni-{k:02}"),
+            loading,
+            clean,
+            relative_noise: [0.005, 0.01][k % 2],
+            seed: 4000 + k as u64,
+            truth: format!(
+                "\"base\": \"uniaxial\", \"law\": \"neo-hookean\", \"model\": \"uniaxial neo-Hookean\", \"protocol\": \"{}\", \
+                 \"params\": {{\"C10\": {c10}}}, \"expected\": []",
+                if crosses { "tension_compression_cycle" } else { "tension_ramp_hold_unload" }
+            ),
+        });
+    }
+    out
+}
+
+fn main() {
+    let dir = palpate_tools::repo("studies/data/gap-dev2");
+    std::fs::create_dir_all(&dir).expect("create studies/data/gap-dev2");
+    let mut records = c1_records();
+    records.extend(uniaxial_records());
+    records.extend(null_records());
+    let mut truth = String::from("{\n");
+    for (k, r) in records.iter().enumerate() {
+        let peak = r.clean.iter().fold(0.0f64, |a, v| a.max(v.abs()));
+        let sd = r.relative_noise * peak;
+        let e = noise(r.clean.len(), sd, r.seed);
+        let (drive, response) = match r.loading.drive_kind {
+            Drive::Stretch => ("stretch", "stress_MPa"),
+            _ => ("displacement_mm", "force_N"),
+        };
+        let mut csv = format!(
+            "# gap diagnosis two-effect development record (tools/src/bin/make_gap_two.rs), seed {}, white noise sd {sd:.4e} ({} of the peak)\ntime_s,{drive},{response}\n",
+            r.seed, r.relative_noise
+        );
+        let t = r.loading.time.as_ref().expect("timed record");
+        for i in 0..r.clean.len() {
+            let _ = writeln!(
+                csv,
+                "{:.2},{:.6},{:.6e}",
+                t[i],
+                r.loading.drive[i],
+                r.clean[i] + e[i]
+            );
+        }
+        std::fs::write(dir.join(format!("{}.csv", r.name)), csv).expect("write record");
+        let _ = writeln!(
+            truth,
+            "  \"{}\": {{{}, \"noise_sd\": {sd:.6e}, \"seed\": {}, \"samples\": {}}}{}",
+            r.name,
+            r.truth,
+            r.seed,
+            r.clean.len(),
+            if k + 1 < records.len() { "," } else { "" }
+        );
+        eprintln!("{}: {} samples, noise sd {sd:.3e}", r.name, r.clean.len());
+    }
+    truth.push_str("}\n");
+    std::fs::write(dir.join("truth.json"), truth).expect("write truth.json");
+}
