@@ -62,7 +62,7 @@ fn permutations(items: &[Effect]) -> Vec<Vec<Effect>> {
         }
         for i in 0..k {
             heap(k - 1, a, out);
-            let j = if k % 2 == 0 { i } else { 0 };
+            let j = if k.is_multiple_of(2) { i } else { 0 };
             a.swap(j, k - 1);
         }
     }
@@ -72,15 +72,15 @@ fn permutations(items: &[Effect]) -> Vec<Vec<Effect>> {
     out
 }
 
+/// A chain of effects on a base model: the model, its parameter specs and
+/// its "off" point.
+type Chain = (Box<dyn ForwardModel>, Vec<ParamSpec>, Vec<f64>);
+
 /// The chain of `order` on `base`, its parameter specs (each parameter's
 /// spec where it first appears: the base's own, then each effect's, so
 /// that an effect's narrower bounds survive the steps after it) and the
 /// chain's "off" point for `base_theta`.
-fn chain(
-    base: &dyn ForwardModel,
-    order: &[Effect],
-    base_theta: &[f64],
-) -> Option<(Box<dyn ForwardModel>, Vec<ParamSpec>, Vec<f64>)> {
+fn chain(base: &dyn ForwardModel, order: &[Effect], base_theta: &[f64]) -> Option<Chain> {
     let mut first: Vec<ParamSpec> = base.space().params.clone();
     let mut theta = base_theta.to_vec();
     let mut model: Option<Box<dyn ForwardModel>> = None;
