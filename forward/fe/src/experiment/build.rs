@@ -13,6 +13,7 @@
 
 use palpate_core::{
     Drive, Enrichable, Evaluator, ForwardModel, Loading, Observable, Output, ParamSpace,
+    Sensitivities,
 };
 use palpate_material::Law;
 
@@ -110,6 +111,11 @@ impl<M: ForwardModel> ForwardModel for Described<M> {
     }
     fn expensive(&self) -> bool {
         self.model.expensive()
+    }
+    /// The model's own: the description's parameters are the model's, in
+    /// its order (as the evaluator takes them).
+    fn as_sensitivities(&self) -> Option<&dyn Sensitivities> {
+        self.model.as_sensitivities()
     }
 }
 
