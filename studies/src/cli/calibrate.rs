@@ -64,8 +64,9 @@ pub struct Args {
     /// Data to fit: TEST=FILE or TEST[key=value,...]=FILE for homogeneous
     /// tests (TEST = uniaxial, biaxial, planar, simple_shear; keys weight,
     /// axial_stretch, stress_unit, compression, skip_rows, or a column chosen
-    /// by name such as force=Load), or just FILE with --benchmark C1. Repeat
-    /// to fit jointly.
+    /// by name such as force=Load); FILE or C1=FILE with --benchmark C1;
+    /// FILE or force=FILE (a force record: displacement_mm, force_N) with
+    /// --experiment or --benchmark N1. Repeat to fit jointly.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
     #[command(flatten)]
@@ -256,7 +257,7 @@ pub fn read_data_opts(
             }
         }
         Some(b) => anyhow::bail!(
-            "--benchmark {b}: calibration supports C1 (FE benchmarks are fitted through manifests)"
+            "--benchmark {b}: calibrate takes C1, Q1 or a preset of the experiment descriptions (palpate experiment list)"
         ),
         None => {
             for d in data {
