@@ -156,20 +156,12 @@ pub fn explanation_summary(r: &GapReport) -> String {
     }
     let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.0} %", 100.0 * v));
     for (k, m) in r.explanation_set.iter().enumerate() {
-        let params: Vec<String> = m
-            .params
-            .iter()
-            .map(|(n, v)| match m.standard_errors.get(n).copied().flatten() {
-                Some(se) => format!("{n} = {v:.4e} +- {se:.1e}"),
-                None => format!("{n} = {v:.4e}"),
-            })
-            .collect();
         let _ = writeln!(
             s,
             "  {}. {}: {}; share of the excess misfit {} (in order), {} (dropped one out); misfit after {:.4e} {unit}, held-out {:.4e} {unit}{}",
             k + 1,
             m.effect,
-            params.join(", "),
+            m.params_text(),
             pct(m.share_marginal),
             pct(m.share_dropped),
             m.misfit_after,

@@ -50,17 +50,26 @@ impl CacheStatus {
 /// `$XDG_CACHE_HOME/palpate/surrogates`, else `$HOME/.cache/palpate/surrogates`,
 /// else `.palpate-cache/surrogates` in the working directory.
 pub fn default_cache_dir() -> PathBuf {
-    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty());
-    if let Some(p) = var("PALPATE_CACHE") {
+    if let Some(p) = setting("PALPATE_CACHE") {
         return PathBuf::from(p);
     }
-    if let Some(p) = var("XDG_CACHE_HOME") {
-        return PathBuf::from(p).join("palpate/surrogates");
-    }
-    if let Some(p) = var("HOME") {
-        return PathBuf::from(p).join(".cache/palpate/surrogates");
-    }
-    PathBuf::from(".palpate-cache/surrogates")
+    user_cache()
+        .map(|base| base.join("surrogates"))
+        .unwrap_or_else(|| PathBuf::from(".palpate-cache/surrogates"))
+}
+
+/// A user setting of the caches: the variable `k`, when set and not empty.
+fn setting(k: &str) -> Option<std::ffi::OsString> {
+    std::env::var_os(k).filter(|v| !v.is_empty())
+}
+
+/// The user's palpate cache folder: `$XDG_CACHE_HOME/palpate`, else
+/// `$HOME/.cache/palpate`.
+fn user_cache() -> Option<PathBuf> {
+    let base = setting("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| setting("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(base.join("palpate"))
 }
 
 /// The cache folder of the meshes chosen for an accuracy (`simulate
@@ -68,11 +77,7 @@ pub fn default_cache_dir() -> PathBuf {
 /// `None` without either (no cache). The user settings of the caches are
 /// read here, in one place.
 pub fn mesh_cache_dir() -> Option<PathBuf> {
-    let var = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty());
-    let base = var("XDG_CACHE_HOME")
-        .map(PathBuf::from)
-        .or_else(|| var("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
-    Some(base.join("palpate"))
+    user_cache()
 }
 
 /// The code version in a cache key: the palpate version and the SHA-256 of
@@ -87,7 +92,7 @@ pub fn mesh_cache_dir() -> Option<PathBuf> {
 pub fn code_version() -> &'static str {
     static V: OnceLock<String> = OnceLock::new();
     V.get_or_init(|| {
-        if let Some(v) = std::env::var_os("PALPATE_CODE_VERSION").filter(|v| !v.is_empty()) {
+        if let Some(v) = setting("PALPATE_CODE_VERSION") {
             return format!(
                 "palpate {} code {}",
                 env!("CARGO_PKG_VERSION"),

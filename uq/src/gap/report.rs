@@ -421,20 +421,12 @@ impl GapReport {
             let _ = writeln!(s, "|---|---|---|---|---|---|---|---|");
             let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.0} %", 100.0 * v));
             for (k, m) in self.explanation_set.iter().enumerate() {
-                let params: Vec<String> = m
-                    .params
-                    .iter()
-                    .map(|(n, v)| match m.standard_errors.get(n).copied().flatten() {
-                        Some(se) => format!("{n} = {v:.4e} +- {se:.1e}"),
-                        None => format!("{n} = {v:.4e}"),
-                    })
-                    .collect();
                 let _ = writeln!(
                     s,
                     "| {} | {} | {} | {} | {} | {:.3e} | {:.3e} | {} |",
                     k + 1,
                     m.effect,
-                    params.join(", "),
+                    m.params_text(),
                     pct(m.share_marginal),
                     pct(m.share_dropped),
                     m.misfit_after,

@@ -78,6 +78,23 @@ pub struct SetMember {
     pub evidence: String,
 }
 
+impl SetMember {
+    /// Its parameters as the reports print them: `name = value +- SE`.
+    pub fn params_text(&self) -> String {
+        let params: Vec<String> = self
+            .params
+            .iter()
+            .map(
+                |(n, v)| match self.standard_errors.get(n).copied().flatten() {
+                    Some(se) => format!("{n} = {v:.4e} +- {se:.1e}"),
+                    None => format!("{n} = {v:.4e}"),
+                },
+            )
+            .collect();
+        params.join(", ")
+    }
+}
+
 /// What the explanation leaves unexplained.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Remainder {
