@@ -1,18 +1,42 @@
 //! Q1 mesh study (docs/validation/fe.md, "Q1"): the elastic flat-punch force
 //! at a small depth against Sneddon's 8 G a d on one grading.
-//! `cargo run --release -p palpate-tools --bin convergence_q1 -- H_FINE GROWTH EDGE [DEPTH]`
-//! (env `AUG=20` for an inner augmentation loop, `PEN=` the penalty factor,
-//! `GAUSS=1` contact at fixed Gauss points of the edges, `REFINE=` edge
-//! refinement).
+//! `cargo run --release -p palpate-tools --bin convergence_q1 -- H_FINE GROWTH EDGE [DEPTH]
+//! [--aug 20] [--pen P] [--gauss] [--refine N]` (`--help` says what each is).
+use clap::Parser;
 use palpate_core::{Drive, Loading};
 use palpate_fe::mesh::Grading;
 use palpate_fe::Q1Punch;
+
+/// The elastic flat-punch force of Q1 at a small depth on one grading,
+/// against Sneddon's 8 G a d.
+#[derive(Parser)]
+struct Args {
+    /// Element size at the punch edge (mm).
+    h_fine: f64,
+    /// Growth factor of the grading away from the edge.
+    growth: f64,
+    /// Edge radius of the punch (mm).
+    edge: f64,
+    /// Depth (mm).
+    #[arg(default_value_t = 0.1)]
+    depth: f64,
+    /// Augmentations of the contact's inner loop (the model's default if absent).
+    #[arg(long)]
+    aug: Option<usize>,
+    /// Contact penalty factor (the model's default if absent).
+    #[arg(long)]
+    pen: Option<f64>,
+    /// Contact at fixed Gauss points of the edges instead of the split quadrature.
+    #[arg(long)]
+    gauss: bool,
+    /// Edge refinement count (the model's default if absent).
+    #[arg(long)]
+    refine: Option<usize>,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let h: f64 = args[1].parse().unwrap();
-    let growth: f64 = args[2].parse().unwrap();
-    let edge: f64 = args[3].parse().unwrap();
-    let depth: f64 = args.get(4).map(|s| s.parse().unwrap()).unwrap_or(0.1);
+    let a = Args::parse();
+    let (h, growth, edge, depth) = (a.h_fine, a.growth, a.edge, a.depth);
     let mut m = Q1Punch::new("neo-hookean".parse().unwrap());
     m.grading = Some(Grading {
         h_fine: h,
@@ -20,17 +44,17 @@ fn main() {
         growth,
     });
     m.edge_radius = edge;
-    if let Ok(a) = std::env::var("AUG") {
-        m.options.max_augmentations = a.parse().unwrap();
+    if let Some(n) = a.aug {
+        m.options.max_augmentations = n;
     }
-    if std::env::var("GAUSS").as_deref() == Ok("1") {
+    if a.gauss {
         m.contact_points = palpate_fe::ContactPoints::EdgeGauss;
     }
-    if let Ok(a) = std::env::var("REFINE") {
-        m.edge_refinement = a.parse().unwrap();
+    if let Some(n) = a.refine {
+        m.edge_refinement = n;
     }
-    if let Ok(a) = std::env::var("PEN") {
-        m.penalty = a.parse().unwrap();
+    if let Some(p) = a.pen {
+        m.penalty = p;
     }
     let c10 = 1e-3;
     let g = 2.0 * c10;

@@ -4,65 +4,107 @@
 //! smallest corner Jacobian there, and writing the last converged state as
 //! VTU (`OUT.vtu`) for ParaView (Warp By Vector on `displacement`).
 //!
-//! `cargo run --release -p palpate-tools --bin q1_deep -- LEVEL DEPTH [EDGE] [C10] [OUT.vtu]`
-//! (env `STEP=` sample spacing in mm, default 0.05; `SMOOTH=` the contact
-//! smoothing as a fraction of the element size; `NODES=1` contact at the
-//! nodes; `LINE=slope` the slope line search; `STAG=` the relative
-//! residual at which a stagnating increment is accepted; `HOLD=` seconds: viscoelastic ramp in 0.5 s and hold; `SELF=0` without the
-//! surface's self-contact; `BULK=` a bulk modulus of BULK x mu instead of
-//! the exact constraint; `GAUSS=1` contact at fixed Gauss points of the
-//! edges instead of the split quadrature; `PROX=` the proximal
-//! stabilisation, 0 off; `CURVE=1` prints the force at every sample).
+//! `cargo run --release -p palpate-tools --bin q1_deep -- LEVEL DEPTH [EDGE] [C10] [OUT.vtu]
+//! [OPTIONS]` (`--help` lists the options: sample spacing, contact
+//! smoothing, contact points, line search, stagnation, a viscoelastic hold,
+//! self-contact, a bulk penalty, the proximal stabilisation, the whole curve).
+use clap::Parser;
 use palpate_core::{Drive, ForwardError, Loading};
 use palpate_fe::mesh::jacobian::corner_jacobians;
 use palpate_fe::Q1Punch;
 
+/// Q1's elastic ramp to DEPTH: where it stops, the top surface near the
+/// punch edge, the smallest corner Jacobian there, and the last converged
+/// state as VTU.
+#[derive(Parser)]
+struct Args {
+    /// Mesh level.
+    level: usize,
+    /// Depth of the ramp (mm).
+    depth: f64,
+    /// Edge radius of the punch (mm).
+    #[arg(default_value_t = 0.2)]
+    edge: f64,
+    /// Neo-Hookean C10 (MPa).
+    #[arg(default_value_t = 1e-3)]
+    c10: f64,
+    /// Where to write the last converged state (VTU).
+    out: Option<String>,
+    /// Sample spacing of the ramp (mm).
+    #[arg(long, default_value_t = 0.05)]
+    step: f64,
+    /// Edge refinement count (the model's default if absent).
+    #[arg(long)]
+    refine: Option<usize>,
+    /// Contact smoothing as a fraction of the element size.
+    #[arg(long)]
+    smooth: Option<f64>,
+    /// Contact at the nodes.
+    #[arg(long)]
+    nodes: bool,
+    /// Contact at fixed Gauss points of the edges instead of the split quadrature.
+    #[arg(long)]
+    gauss: bool,
+    /// The proximal stabilisation (0: off).
+    #[arg(long)]
+    prox: Option<f64>,
+    /// The relative residual at which a stagnating increment is accepted.
+    #[arg(long)]
+    stag: Option<f64>,
+    /// The slope line search instead of the default.
+    #[arg(long)]
+    slope_line_search: bool,
+    /// Without the surface's self-contact.
+    #[arg(long)]
+    no_self_contact: bool,
+    /// A mean-dilatation penalty K = BULK mu instead of the exact constraint.
+    #[arg(long)]
+    bulk: Option<f64>,
+    /// Seconds of hold after a 0.5 s viscoelastic ramp (g 0.3 / 0.2, tau 0.5 / 10 s).
+    #[arg(long)]
+    hold: Option<f64>,
+    /// Print the force at every sample.
+    #[arg(long)]
+    curve: bool,
+}
+
 fn main() {
-    let args: Vec<String> = std::env::args().collect();
-    let level: usize = args[1].parse().unwrap();
-    let depth: f64 = args[2].parse().unwrap();
-    let edge: f64 = args.get(3).map(|s| s.parse().unwrap()).unwrap_or(0.2);
-    let c10: f64 = args.get(4).map(|s| s.parse().unwrap()).unwrap_or(1e-3);
-    let out = args.get(5).cloned();
-    let step: f64 = std::env::var("STEP")
-        .ok()
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(0.05);
+    let a = Args::parse();
+    let (level, depth, edge, c10, step) = (a.level, a.depth, a.edge, a.c10, a.step);
+    let out = a.out.clone();
     let mut m = Q1Punch::new("neo-hookean".parse().unwrap());
     m.level = level;
     m.edge_radius = edge;
-    if let Ok(v) = std::env::var("REFINE") {
-        m.edge_refinement = v.parse().unwrap();
+    if let Some(v) = a.refine {
+        m.edge_refinement = v;
     }
-    if let Ok(v) = std::env::var("SMOOTH") {
-        m.contact_smoothing = v.parse().unwrap();
+    if let Some(v) = a.smooth {
+        m.contact_smoothing = v;
     }
-    if let Ok(v) = std::env::var("NODES") {
-        if v == "1" {
-            m.contact_points = palpate_fe::ContactPoints::Nodes;
-        }
+    if a.nodes {
+        m.contact_points = palpate_fe::ContactPoints::Nodes;
     }
-    if let Ok(v) = std::env::var("PROX") {
-        m.options.stabilisation = v.parse().unwrap();
+    if let Some(v) = a.prox {
+        m.options.stabilisation = v;
     }
-    if std::env::var("GAUSS").as_deref() == Ok("1") {
+    if a.gauss {
         m.contact_points = palpate_fe::ContactPoints::EdgeGauss;
     }
-    if let Ok(v) = std::env::var("STAG") {
-        m.options.stagnation_tolerance = v.parse().unwrap();
+    if let Some(v) = a.stag {
+        m.options.stagnation_tolerance = v;
     }
-    if std::env::var("LINE").as_deref() == Ok("slope") {
+    if a.slope_line_search {
         m.options.line_search = palpate_fe::LineSearch::Slope;
     }
-    m.self_contact = std::env::var("SELF").map(|v| v != "0").unwrap_or(true);
-    if let Ok(v) = std::env::var("BULK") {
+    m.self_contact = !a.no_self_contact;
+    if let Some(v) = a.bulk {
         // a mean-dilatation penalty K = BULK mu instead of the exact constraint
-        m.bulk = palpate_fe::Bulk::Ratio(v.parse().unwrap());
+        m.bulk = palpate_fe::Bulk::Ratio(v);
     }
     let n = (depth / step).round().max(1.0) as usize;
     let drive: Vec<f64> = (1..=n).map(|k| depth * k as f64 / n as f64).collect();
     let t0 = std::time::Instant::now();
-    let hold: Option<f64> = std::env::var("HOLD").ok().map(|s| s.parse().unwrap());
+    let hold = a.hold;
     let loading = match hold {
         None => Loading::quasi_static(Drive::DisplacementMm, drive.clone()),
         Some(h) => {
@@ -91,7 +133,7 @@ fn main() {
     };
     let reached = match m.simulate(&[c10], &loading, None) {
         Ok((sim, _)) => {
-            if std::env::var("CURVE").is_ok() {
+            if a.curve {
                 for (d, f) in drive.iter().zip(&sim.forces) {
                     println!("curve {d:.3} {f:.6e}");
                 }

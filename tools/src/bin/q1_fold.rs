@@ -3,30 +3,46 @@
 //! the equilibrium path turn (a fold, where the nodes would run away as the
 //! stop nears) or stay straight up to it?
 //!
-//! `cargo run --release -p palpate-tools --bin q1_fold -- LEVEL FINE_FROM TO FINE_STEP`
-//! (0.05 mm samples to FINE_FROM, then FINE_STEP to TO; env `REFINE=` the
-//! edge refinement, `EDGE=` the edge radius). Prints, per sample from 0.2 mm
+//! `cargo run --release -p palpate-tools --bin q1_fold -- LEVEL FINE_FROM TO FINE_STEP
+//! [--refine N] [--edge MM]` (0.05 mm samples to FINE_FROM, then FINE_STEP
+//! to TO; the edge refinement and edge radius default to the model's). Prints, per sample from 0.2 mm
 //! before FINE_FROM, the depth, the punch force and each watched node's
 //! current `r / z - height`, then where the run stopped.
+use clap::Parser;
 use palpate_core::{Drive, Loading};
 use palpate_fe::stepper::{run, LoadPath};
 use palpate_fe::Q1Punch;
 
+/// Q1's top-surface nodes near the punch edge against depth, sampled finely
+/// before the stop near 2 mm.
+#[derive(Parser)]
+struct Args {
+    /// Mesh level.
+    level: usize,
+    /// Depth (mm) from which the samples are FINE_STEP apart (0.05 mm before).
+    fine_from: f64,
+    /// Final depth (mm).
+    to: f64,
+    /// Sample spacing (mm) from FINE_FROM.
+    fine_step: f64,
+    /// Edge refinement count (the model's default if absent).
+    #[arg(long)]
+    refine: Option<usize>,
+    /// Edge radius of the punch (mm; the model's default if absent).
+    #[arg(long)]
+    edge: Option<f64>,
+}
+
 fn main() {
-    let args: Vec<f64> = std::env::args()
-        .skip(1)
-        .map(|a| a.parse().expect("LEVEL FINE_FROM TO FINE_STEP"))
-        .collect();
-    let [level, fine_from, to, fine] = args[..] else {
-        panic!("usage: q1_fold LEVEL FINE_FROM TO FINE_STEP");
-    };
+    let a = Args::parse();
+    let (fine_from, to, fine) = (a.fine_from, a.to, a.fine_step);
     let mut m = Q1Punch::new("neo-hookean".parse().unwrap());
-    m.level = level as usize;
-    if let Ok(v) = std::env::var("REFINE") {
-        m.edge_refinement = v.parse().expect("REFINE: a count");
+    m.level = a.level;
+    if let Some(v) = a.refine {
+        m.edge_refinement = v;
     }
-    if let Ok(v) = std::env::var("EDGE") {
-        m.edge_radius = v.parse().expect("EDGE: mm");
+    if let Some(v) = a.edge {
+        m.edge_radius = v;
     }
     // a system with the material installed, from a first tiny run
     let tiny = Loading::quasi_static(Drive::DisplacementMm, vec![0.01]);

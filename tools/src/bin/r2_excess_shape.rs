@@ -6,7 +6,9 @@
 //! prints E at the offsets p - x_n.
 //!
 //! `cargo run --release -p palpate-tools --bin r2_excess_shape -- [--rd 6]
-//!  [--x 20,35,50,75] [--depth 10,20] [--step 2]`
+//!  [--x 20,35,50,75] [--depth 10,20] [--step 2] [--press-check]`
+//! (`--press-check`: instead, presses at 12, 16, 22, 46 mm against the
+//! rolled nodule-free pass, the path independence near the end).
 
 use palpate_fe::r2_scan::R2NoduleScan;
 use palpate_fe::R2Rolling;
@@ -21,6 +23,7 @@ fn main() {
     let mut xs = list("20,35,50,75");
     let mut depths = list("10,20");
     let mut step: f64 = 2.0;
+    let mut press_check = false;
     let args: Vec<String> = std::env::args().skip(1).collect();
     let mut it = args.iter();
     while let Some(a) = it.next() {
@@ -30,6 +33,7 @@ fn main() {
             "--x" => xs = list(&value()),
             "--depth" => depths = list(&value()),
             "--step" => step = value().parse().expect("mm"),
+            "--press-check" => press_check = true,
             other => panic!("unknown option {other}"),
         }
     }
@@ -50,7 +54,7 @@ fn main() {
         );
         f0[(p - lo).round() as usize][0]
     };
-    if std::env::var("PRESS_CHECK").is_ok() {
+    if press_check {
         // path independence near the end: a press at p against the rolled F0
         for p in [12.0f64, 16.0, 22.0, 46.0] {
             let mut m = template.clone();
