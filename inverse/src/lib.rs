@@ -49,6 +49,7 @@ pub mod report;
 pub mod residual;
 pub mod run;
 pub mod sensitivities;
+pub mod staged;
 pub mod termination;
 pub mod wall_slide;
 

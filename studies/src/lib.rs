@@ -14,11 +14,13 @@
 //! | [`apps`] | applications: two-stage Q1 identification, R2 localisation |
 //! | [`steps`] | one file per step kind, and the registry a manifest's steps are read into |
 //! | [`study`] | the manifest, the runner that checks it and runs its steps, the merge of shards |
+//! | [`api`] | the typed library API (typed options and results, nothing printed) that the command line and the Python package call |
 //! | [`cli`] | the `palpate` command: one module per subcommand |
 //!
 //! A new step kind is a file in `steps/` implementing [`run::step::Step`]
 //! and one line in the registry of [`steps`].
 
+pub mod api;
 pub mod apps;
 pub mod cli;
 pub mod model;

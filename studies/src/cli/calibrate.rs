@@ -557,7 +557,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
         .residual
         .parse()
         .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
-    let method = parse_method(&args.estimator).context("--estimator")?;
+    let estimator: crate::api::Estimator = args.estimator.parse().context("--estimator")?;
     let mut fixed = Vec::new();
     for f in &args.fix {
         let (name, value) =
@@ -588,17 +588,16 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
     crate::run::output::check_outputs(&inputs, &outputs)?;
-    calibrate(Request {
-        law,
-        model: None,
-        fitted: &data,
-        predict: &[],
-        residual,
-        method,
-        fixed,
-        observer: None,
-        viscous,
-    })
+    crate::api::calibrate(
+        &data,
+        &crate::api::CalibrateOptions {
+            law,
+            residual,
+            estimator,
+            fixed,
+            viscous,
+        },
+    )
 }
 
 /// `palpate calibrate --benchmark Q1`: the staged inverse FE identification

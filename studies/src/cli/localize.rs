@@ -7,10 +7,11 @@ use std::path::PathBuf;
 
 use clap::Parser;
 
+use crate::api::{LocalizeOptions, Localized};
 pub use crate::apps::localize::plot::plot_svg;
-use crate::apps::localize::posterior::{localize, LocOptions, LocRun};
+use crate::apps::localize::posterior::LocRun;
 use crate::apps::localize::record::Record;
-use crate::apps::localize::{LocModel, LocSetup};
+use crate::apps::localize::LocModel;
 use crate::run::output::{check_outputs, given, write_atomic, write_json};
 use crate::run::surrogate::default_cache_dir;
 
@@ -83,27 +84,27 @@ pub struct Args {
     pub scan: String,
 }
 
-/// Runs `palpate localize`.
+/// Runs `palpate localize` ([`crate::api::localize`]).
 pub fn run(a: Args) -> anyhow::Result<()> {
-    let mut setup = match a.scan.as_str() {
-        "along" => LocSetup::r2_along(a.rd),
-        "lean" => LocSetup::r2_lean(a.rd),
-        _ => LocSetup::r2(a.rd),
+    let options = LocalizeOptions {
+        rd: a.rd,
+        scan: a.scan.parse()?,
+        nodules: a.nodules,
+        design: a.design,
+        holdout: a.holdout,
+        seed: a.seed,
+        sampler: a
+            .sampler
+            .parse()
+            .map_err(|e: String| anyhow::anyhow!("--sampler: {e}"))?,
+        cache: a.cache.clone().unwrap_or_else(default_cache_dir),
     };
-    if let Some(n) = a.design {
-        setup.training = n;
+    if let Err((f, r)) = options.setup() {
+        if f == "--nodules" {
+            anyhow::bail!("--nodules {}: {r}", a.nodules);
+        }
+        anyhow::bail!("{f} {}: {r}", option_value(&f, &a));
     }
-    if let Some(n) = a.holdout {
-        setup.holdout = n;
-    }
-    setup
-        .check()
-        .map_err(|(f, r)| anyhow::anyhow!("{f} {}: {r}", option_value(&f, &a)))?;
-    anyhow::ensure!(
-        a.nodules >= 1 && a.nodules <= 8,
-        "--nodules {}: give 1 to 8 nodules",
-        a.nodules
-    );
     check_outputs(
         &[a.data.as_path()],
         &given(&[
@@ -113,22 +114,13 @@ pub fn run(a: Args) -> anyhow::Result<()> {
             ("--draws", &a.draws),
         ]),
     )?;
-    let path = (setup.template.press_x, setup.template.roll_to);
-    let record = Record::read(&a.data, path)?;
-    let cache = a.cache.clone().unwrap_or_else(default_cache_dir);
-    let t0 = std::time::Instant::now();
-    let model = LocModel::load_or_build(&setup, &cache)?;
-    report_model(&model, t0.elapsed().as_secs_f64());
-    let opts = LocOptions {
-        nodules: a.nodules,
-        seed: a.seed,
-        sampler: a
-            .sampler
-            .parse()
-            .map_err(|e: String| anyhow::anyhow!("--sampler: {e}"))?,
-        ..Default::default()
-    };
-    let run = localize(&model, &record.positions, &record.force, &opts, None)?;
+    let Localized {
+        model,
+        record,
+        run,
+        model_ready_s,
+    } = crate::api::localize(&a.data, &options)?;
+    report_model(&model, model_ready_s);
     let text = summary_text(&model, &record, &run);
     print!("{text}");
     if let Some(p) = &a.json {

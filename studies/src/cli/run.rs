@@ -1,7 +1,7 @@
 //! `palpate run STUDY.toml`: run a whole study from one manifest.
 
 use std::io::IsTerminal;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Run a whole study described by one TOML manifest into a run folder
 ///
@@ -54,14 +54,14 @@ pub struct Args {
 /// Runs `palpate run`.
 pub fn run(args: Args) -> anyhow::Result<()> {
     if args.check {
-        let m = crate::study::manifest::Manifest::read(&args.manifest)?.validate(&args.manifest)?;
-        let rows = check_data(&args.manifest, &m)?;
+        let c = crate::api::check_study(&args.manifest)?;
         println!(
-            "{}: ok ({} data sets with {rows} rows, {} models, {} steps)",
+            "{}: ok ({} data sets with {} rows, {} models, {} steps)",
             args.manifest.display(),
-            m.data.len(),
-            m.models.len(),
-            m.steps.len()
+            c.data_sets,
+            c.rows,
+            c.models,
+            c.steps
         );
         return Ok(());
     }
@@ -72,7 +72,7 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         fresh: args.fresh,
         shard: args.shard,
     };
-    let summary = crate::study::runner::run_study_counted(&args.manifest, &options, &observer);
+    let summary = crate::api::run_study(&args.manifest, &options, &observer);
     if let Some(b) = &bar {
         b.finish_and_clear();
     }
@@ -174,23 +174,4 @@ impl crate::study::runner::RunObserver for CliObserver {
             }
         }
     }
-}
-
-/// Reads every data file of a manifest as its test (the errors name the
-/// file, line and column, and the data set); returns the number of rows.
-fn check_data(path: &Path, m: &crate::study::manifest::Manifest) -> anyhow::Result<usize> {
-    use crate::records::{TestData, TestKind};
-    let dir = path.parent().unwrap_or(Path::new("."));
-    let mut rows = 0;
-    for (name, spec) in &m.data {
-        let kind = TestKind::parse(&spec.test)
-            .map_err(|e| anyhow::anyhow!("{}: data.{name}.test: {e}", path.display()))?;
-        let options = spec
-            .read_options()
-            .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
-        let d = TestData::read_with(name, kind, &dir.join(&spec.file), options)
-            .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
-        rows += d.observed.len();
-    }
-    Ok(rows)
 }

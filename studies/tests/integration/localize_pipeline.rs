@@ -24,9 +24,9 @@ use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions, SurrogateRequ
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 
-const F0: f64 = 9.0;
+pub(crate) const F0: f64 = 9.0;
 
-fn excess(o: f64, d: f64) -> f64 {
+pub(crate) fn excess(o: f64, d: f64) -> f64 {
     let a = 6.0 * ((18.0 - d).max(0.0) / 12.0).powi(2);
     let w = 3.0 + 0.4 * d;
     a * (-o * o / (2.0 * w * w)).exp()
@@ -57,7 +57,7 @@ impl ForwardModel for Scan {
     }
 }
 
-fn model() -> LocModel {
+pub(crate) fn model() -> LocModel {
     let setup = LocSetup::r2(6.0);
     let scan = Scan(ParamSpace::new(vec![ParamSpec::new(
         "depth", "mm", 6.0, 24.0, 15.0,

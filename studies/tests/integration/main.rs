@@ -16,6 +16,7 @@ mod diagnose_homogeneous;
 mod experiment_calibrate;
 mod experiment_cli;
 mod homogeneous_kinds;
+mod localize_coverage;
 mod localize_pipeline;
 mod localize_units;
 mod manifest_properties;

@@ -48,6 +48,7 @@
 //! (C1, so the log-posterior is smooth in x_n); E is tapered to zero over
 //! one step past the half-width.
 
+pub mod forward;
 pub mod lean;
 pub mod plot;
 pub mod posterior;
@@ -716,21 +717,66 @@ impl LocModel {
         s: f64,
     ) -> anyhow::Result<(Vec<f64>, Vec<f64>)> {
         let mut grid = vec![0.0; self.scan.loading().len()];
-        let mut f: Vec<f64> = positions.iter().map(|&p| self.baseline_at(p)).collect();
+        let mut f = vec![0.0; positions.len()];
         let mut v = vec![0.0; positions.len()];
+        self.predict_into(positions, nodules, s, &mut f, &mut grid)?;
+        self.error_variance_into(positions, nodules, s, &mut v);
+        Ok((f, v))
+    }
+
+    /// The model force at `positions` for nodules `(x, depth)` and scale
+    /// `s`, into `f`; `grid` is scratch of the scan's length.
+    pub fn predict_into(
+        &self,
+        positions: &[f64],
+        nodules: &[(f64, f64)],
+        s: f64,
+        f: &mut [f64],
+        grid: &mut [f64],
+    ) -> anyhow::Result<()> {
+        for (fi, &p) in f.iter_mut().zip(positions) {
+            *fi = self.baseline_at(p);
+        }
         for &(x, d) in nodules {
-            let m = self.excess_grid(d, x, &mut grid)?;
+            let m = self.excess_grid(d, x, grid)?;
             let shift = self.offset_shift(x, d);
-            for (i, &p) in positions.iter().enumerate() {
-                f[i] += self.excess_at(&grid, p - x + shift, m);
-                v[i] += self.error_variance_at(p - x + shift, m);
+            for (fi, &p) in f.iter_mut().zip(positions) {
+                *fi += self.excess_at(grid, p - x + shift, m);
             }
         }
-        for (fi, vi) in f.iter_mut().zip(v.iter_mut()) {
+        for fi in f.iter_mut() {
             *fi *= s;
+        }
+        Ok(())
+    }
+
+    /// The surrogate's error variance (N^2) at `positions` for nodules
+    /// `(x, depth)` and scale `s` (the variances of the nodules' excesses
+    /// add up; scaled by s^2), into `v`.
+    pub fn error_variance_into(
+        &self,
+        positions: &[f64],
+        nodules: &[(f64, f64)],
+        s: f64,
+        v: &mut [f64],
+    ) {
+        v.iter_mut().for_each(|vi| *vi = 0.0);
+        for &(x, d) in nodules {
+            let m = self.mirrored(x);
+            let shift = self.offset_shift(x, d);
+            for (vi, &p) in v.iter_mut().zip(positions) {
+                *vi += self.error_variance_at(p - x + shift, m);
+            }
+        }
+        for vi in v.iter_mut() {
             *vi *= s * s;
         }
-        Ok((f, v))
+    }
+
+    /// Whether the excess of a nodule at `x` is read from its mirror image
+    /// ([`Self::excess_grid`]'s return value).
+    pub fn mirrored(&self, x: f64) -> bool {
+        self.along_block && x > self.centre
     }
 
     /// FE runs behind the model: the surrogate's design and held-out scans,

@@ -18,10 +18,17 @@
 //! Likelihood: independent Gaussian residuals with variance sigma^2 + the
 //! surrogate's held-out error variance at the record's position
 //! (`Surrogate::validation().error_variance`, summed over the nodules).
+//! The posterior is palpate-uq's
+//! [`ModelErrorPosterior`] of the model as a `ForwardModel`
+//! ([`super::forward::LocForward`], which states that error variance): its
+//! priors, the ordering constraint and the log-uniform densities of s and
+//! sigma as a joint prior term ([`log_prior_terms`]), the bound transforms
+//! (logit of every parameter's box) and their Jacobian those of
+//! palpate-core's `ParamSpace`.
 //!
-//! The sampler moves in logit coordinates of the box (the Jacobian is in
-//! the density); chains start in a small ball around a grid fit (peaks of
-//! the record's excess over F0, then coordinate sweeps over x and depth).
+//! Chains start in a small ball (in the unbounded coordinates) around a
+//! grid fit (peaks of the record's excess over F0, then coordinate sweeps
+//! over x and depth).
 //!
 //! A depth is `identifiable` when its posterior is bounded by the data
 //! inside the box: less than 0.5 % of the draws within 2.5 % of the box
@@ -29,11 +36,15 @@
 //! 24 mm, is the end of the studied range 8-24 mm and the deepest nodule
 //! the block holds; a posterior that reaches it is the paper's "NI").
 
+use super::forward::LocForward;
 use super::LocModel;
+use palpate_core::{Evaluator, ForwardModel, Loading, ParamSpec};
+use palpate_uq::likelihood::Prior;
 use palpate_uq::mcmc::{
-    sample_until_converged, summarize, Chains, Convergence, EnsembleSettings, FnDensity,
-    NutsSettings, Sampler, Start,
+    sample_until_converged, summarize, Chains, Convergence, EnsembleSettings, NutsSettings,
+    Sampler, Start,
 };
+use palpate_uq::model_error::ModelErrorPosterior;
 use serde::{Deserialize, Serialize};
 
 /// Smallest x distance between two nodules' centres (mm): a diameter.
@@ -137,121 +148,43 @@ pub struct LocRun {
     pub evaluations: u64,
 }
 
-struct Bounds {
-    lo: Vec<f64>,
-    hi: Vec<f64>,
-    /// Which coordinates are logs (s, sigma).
-    log: Vec<bool>,
-}
-
-impl Bounds {
-    fn to_physical(&self, z: &[f64]) -> Vec<f64> {
-        z.iter()
-            .enumerate()
-            .map(|(k, &z)| {
-                let u = 1.0 / (1.0 + (-z).exp());
-                let v = self.lo[k] + (self.hi[k] - self.lo[k]) * u;
-                if self.log[k] {
-                    v.exp()
-                } else {
-                    v
-                }
-            })
-            .collect()
-    }
-    fn to_z(&self, x: &[f64]) -> Vec<f64> {
-        x.iter()
-            .enumerate()
-            .map(|(k, &x)| {
-                let v = if self.log[k] { x.ln() } else { x };
-                let u = ((v - self.lo[k]) / (self.hi[k] - self.lo[k])).clamp(1e-6, 1.0 - 1e-6);
-                (u / (1.0 - u)).ln()
-            })
-            .collect()
-    }
-    /// log |d(box coordinate)/dz|: uniform prior on the box coordinate.
-    fn log_jacobian(&self, z: &[f64]) -> f64 {
-        z.iter()
-            .map(|&z| {
-                let a = -(z.abs());
-                // ln u (1 - u) for u = sigmoid(z), stable.
-                a - 2.0 * (1.0 + a.exp()).ln()
-            })
-            .sum()
-    }
-}
-
-#[allow(clippy::too_many_arguments)] // scratch buffers passed in: no allocation per evaluation
-fn log_likelihood(
-    model: &LocModel,
-    x: &[f64],
-    y: &[f64],
-    f0: &[f64],
-    theta: &[f64],
-    n: usize,
-    grid: &mut [f64],
-    pred: &mut [f64],
-    var: &mut [f64],
-) -> f64 {
+/// The joint prior term of the localisation (module docs): `-inf` unless
+/// x_1 < x_2 - [`MIN_SEPARATION`] < ..., plus the log-uniform densities of
+/// the scale and the noise SD (`-ln s - ln sigma`; their boxes are in the
+/// parameters' bounds). `x` holds x_1, d_1, ..., x_N, d_N, s, sigma.
+pub fn log_prior_terms(x: &[f64], n: usize) -> f64 {
     for k in 1..n {
-        if theta[2 * k] - theta[2 * (k - 1)] < MIN_SEPARATION {
+        if x[2 * k] - x[2 * (k - 1)] < MIN_SEPARATION {
             return f64::NEG_INFINITY;
         }
     }
-    let s = theta[2 * n];
-    let sigma = theta[2 * n + 1];
-    pred.copy_from_slice(f0);
-    var.iter_mut().for_each(|v| *v = 0.0);
-    for j in 0..n {
-        let (xn, d) = (theta[2 * j], theta[2 * j + 1]);
-        let Ok(m) = model.excess_grid(d, xn, grid) else {
-            return f64::NEG_INFINITY;
-        };
-        let reach = model.half_width + 2.0 * model.step;
-        let shift = model.offset_shift(xn, d);
-        for (i, &p) in x.iter().enumerate() {
-            let o = p - xn + shift;
-            if o.abs() <= reach {
-                pred[i] += model.excess_at(grid, o, m);
-                var[i] += model.error_variance_at(o, m);
-            }
-        }
-    }
-    let mut ll = 0.0;
-    for i in 0..x.len() {
-        let v = sigma * sigma + s * s * var[i];
-        let r = y[i] - s * pred[i];
-        ll -= 0.5 * (r * r / v + v.ln());
-    }
-    ll
+    -x[2 * n].ln() - x[2 * n + 1].ln()
 }
 
-fn sse(model: &LocModel, x: &[f64], y: &[f64], f0: &[f64], nod: &[(f64, f64)], s: f64) -> f64 {
-    let mut grid = vec![0.0; model.scan.loading().len()];
-    let mut pred = f0.to_vec();
-    for &(xn, d) in nod {
-        let Ok(m) = model.excess_grid(d, xn, &mut grid) else {
-            return f64::INFINITY;
-        };
-        let shift = model.offset_shift(xn, d);
-        for (i, &p) in x.iter().enumerate() {
-            pred[i] += model.excess_at(&grid, p - xn + shift, m);
-        }
+/// Sum of squared residuals of nodules `nod` and scale `s` (infinite when
+/// the model refuses them).
+fn sse(ev: &mut dyn Evaluator, loading: &Loading, y: &[f64], nod: &[(f64, f64)], s: f64) -> f64 {
+    let mut pred = vec![0.0; y.len()];
+    if ev
+        .predict_into(&LocForward::theta(nod, s), loading, &mut pred)
+        .is_err()
+    {
+        return f64::INFINITY;
     }
-    x.iter()
-        .enumerate()
-        .map(|(i, _)| (y[i] - s * pred[i]).powi(2))
-        .sum()
+    y.iter().zip(&pred).map(|(y, p)| (y - p).powi(2)).sum()
 }
 
 /// The grid fit the chains start from: `(nodules, s, sigma)`.
 fn grid_start(
     model: &LocModel,
+    fwd: &LocForward,
     x: &[f64],
     y: &[f64],
     f0: &[f64],
     n: usize,
 ) -> (Vec<(f64, f64)>, f64) {
+    let loading = LocForward::loading(x);
+    let mut ev = fwd.evaluator();
     let (lo, hi) = model.path;
     let (dlo, dhi) = model.depth_box;
     let mid = 0.5 * (dlo + dhi);
@@ -291,7 +224,7 @@ fn grid_start(
     let mut s = 1.0;
     for _sweep in 0..3 {
         for j in 0..n {
-            let mut best = (sse(model, x, y, f0, &nod, s), nod[j]);
+            let mut best = (sse(&mut *ev, &loading, y, &nod, s), nod[j]);
             for &d in &depths {
                 for dx in -8..=8 {
                     let mut t = nod.clone();
@@ -303,7 +236,7 @@ fn grid_start(
                     if !ordered {
                         continue;
                     }
-                    let e = sse(model, x, y, f0, &t, s);
+                    let e = sse(&mut *ev, &loading, y, &t, s);
                     if e < best.0 {
                         best = (e, t[j]);
                     }
@@ -312,9 +245,13 @@ fn grid_start(
             nod[j] = best.1;
         }
         // best scale for these nodules (least squares, clamped to the prior)
-        let (p, _) = model
-            .predict(x, &nod, 1.0)
-            .unwrap_or((f0.to_vec(), Vec::new()));
+        let mut p = vec![0.0; x.len()];
+        if ev
+            .predict_into(&LocForward::theta(&nod, 1.0), &loading, &mut p)
+            .is_err()
+        {
+            p.copy_from_slice(f0);
+        }
         let num: f64 = p.iter().zip(y).map(|(a, b)| a * b).sum();
         let den: f64 = p.iter().map(|a| a * a).sum();
         s = (num / den).clamp(0.51, 1.99);
@@ -360,44 +297,51 @@ pub fn localize(
     let f0: Vec<f64> = x.iter().map(|&p| model.baseline_at(p)).collect();
     let mean_f = y.iter().map(|v| v.abs()).sum::<f64>() / y.len() as f64;
     let (dlo, dhi) = model.depth_box;
-    let mut b = Bounds {
-        lo: Vec::new(),
-        hi: Vec::new(),
-        log: Vec::new(),
-    };
-    let mut names = Vec::new();
-    for j in 0..n {
-        b.lo.extend([lo, dlo]);
-        b.hi.extend([hi, dhi]);
-        b.log.extend([false, false]);
-        names.push(format!("x{}_mm", j + 1));
-        names.push(format!("depth{}_mm", j + 1));
-    }
-    b.lo.extend([0.5f64.ln(), (1e-4 * mean_f).ln()]);
-    b.hi.extend([2.0f64.ln(), (0.2 * mean_f).ln()]);
-    b.log.extend([true, true]);
-    names.push("scale".into());
-    names.push("noise_sd_N".into());
-    let dim = 2 * n + 2;
-
-    let (nod, s) = grid_start(model, x, y, &f0, n);
+    let fwd = LocForward::new(model, n);
+    let (nod, s) = grid_start(model, &fwd, x, y, &f0, n);
     let (p, _) = model.predict(x, &nod, s)?;
     let rms = (p.iter().zip(y).map(|(a, b)| (a - b).powi(2)).sum::<f64>() / y.len() as f64)
         .sqrt()
         .clamp(2e-4 * mean_f, 0.1 * mean_f);
-    let mut start_phys: Vec<f64> = nod.iter().flat_map(|&(a, d)| [a, d]).collect();
-    start_phys.extend([s, rms]);
-    let center = b.to_z(&start_phys);
-
-    let m = model.scan.loading().len();
-    let density = FnDensity::new(dim, |z: &[f64]| {
-        let theta = b.to_physical(z);
-        let mut grid = vec![0.0; m];
-        let mut pred = vec![0.0; x.len()];
-        let mut var = vec![0.0; x.len()];
-        let ll = log_likelihood(model, x, y, &f0, &theta, n, &mut grid, &mut pred, &mut var);
-        ll + b.log_jacobian(z)
-    });
+    let mut model_priors = Vec::with_capacity(2 * n + 1);
+    for _ in 0..n {
+        model_priors.push(Prior::Uniform {
+            lower: lo,
+            upper: hi,
+        });
+        model_priors.push(Prior::Uniform {
+            lower: dlo,
+            upper: dhi,
+        });
+    }
+    // log-uniform on the scale's box: the density is in log_prior_terms
+    model_priors.push(Prior::Flat);
+    let noise = ParamSpec::new("noise_sd_N", "N", 1e-4 * mean_f, 0.2 * mean_f, rms);
+    let posterior = ModelErrorPosterior::new(
+        &fwd,
+        LocForward::loading(x),
+        y.to_vec(),
+        model_priors,
+        noise,
+        Prior::Flat,
+    )
+    .map_err(|e| anyhow::anyhow!("the localisation posterior: {e}"))?
+    .with_joint_prior(Box::new(move |t: &[f64]| log_prior_terms(t, n)));
+    let space = posterior.space().clone();
+    let names = space.names();
+    let mut start_phys = LocForward::theta(&nod, s);
+    start_phys.push(rms);
+    // strictly inside the boxes (the separation sweep may push the last
+    // nodule past the path's end)
+    let center: Vec<f64> = space
+        .params
+        .iter()
+        .zip(&start_phys)
+        .map(|(p, &v)| {
+            let eps = 1e-6 * (p.upper - p.lower);
+            p.to_unbounded(v.clamp(p.lower + eps, p.upper - eps))
+        })
+        .collect();
     let start = Start::ball(center, 0.01);
     let sampler = match o.sampler {
         LocSampler::Nuts => Sampler::Nuts(NutsSettings {
@@ -419,10 +363,10 @@ pub fn localize(
         max_draws: o.max_draws.max(o.draws),
         ..Default::default()
     };
-    let to_phys = |z: &[f64]| b.to_physical(z);
+    let to_phys = |z: &[f64]| space.from_unbounded(z);
     let run = sample_until_converged(
         &sampler,
-        &density,
+        &posterior,
         &start,
         o.seed,
         &conv,

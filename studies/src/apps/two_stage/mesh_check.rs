@@ -25,7 +25,8 @@
 //! at depth), the fixed point is not the check mesh's own optimum (5 mm
 //! record, tau1: docs/validation/two-stage.md).
 
-use crate::apps::two_stage::{run_stage, Q1Record, Say, StageData, StageModels, TwoStageOptions};
+use crate::apps::two_stage::{say_round, stage_result, Q1Record, Say, TwoStageOptions};
+use palpate_inverse::staged::{self, Shift, Stage, StageModels};
 use serde::Serialize;
 use std::sync::Arc;
 
@@ -74,21 +75,24 @@ pub fn check_estimate(
         coarse: Arc::new(options.viscoelastic_model()),
         fine: Some(Arc::new(options.viscoelastic_model_at(h))),
     };
-    let data = StageData {
-        stage: "mesh-check",
-        name: record.name.clone(),
+    let data = Stage {
+        stage: "mesh-check".into(),
+        set: record.name.clone(),
         loading: record.loading(),
         observed: record.force.clone(),
         fixed: Vec::new(),
     };
-    let (round, _) = run_stage(
+    let (out, _) = staged::check_estimate(
         &data,
         &models,
-        theta.to_vec(),
+        theta,
+        se,
         options.correction_rounds,
-        options,
-        say,
-    )?;
+        &options.stage_options(),
+        &mut say_round(say),
+    )
+    .map_err(|e| anyhow::anyhow!("mesh-check: {e}"))?;
+    let (round, _) = stage_result("mesh-check", out);
     let mut check = compare(h, &round.theta, theta, se);
     check.iterations = round.iterations;
     check.rounds = round.mesh_corrections.len();
@@ -104,12 +108,11 @@ pub fn check_estimate(
 /// The shifts of the estimates `theta` from the polish's `polish`, in its
 /// standard errors `se`.
 fn compare(h: f64, theta: &[f64], polish: &[f64], se: &[Option<f64>]) -> MeshCheck {
-    let shift: Vec<f64> = theta.iter().zip(polish).map(|(c, p)| c - p).collect();
-    let shift_se = se
-        .iter()
-        .zip(&shift)
-        .map(|(s, d)| s.filter(|s| *s > 0.0).map(|s| d / s))
-        .collect();
+    let Shift {
+        theta,
+        shift,
+        shift_se,
+    } = Shift::new(theta, polish, se);
     MeshCheck {
         mesh_mm: h,
         iterations: 0,
@@ -120,7 +123,7 @@ fn compare(h: f64, theta: &[f64], polish: &[f64], se: &[Option<f64>]) -> MeshChe
         wall_s: 0.0,
         rms: f64::NAN,
         converged: true,
-        theta: theta.to_vec(),
+        theta,
         shift,
         shift_se,
     }

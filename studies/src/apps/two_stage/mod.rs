@@ -45,10 +45,8 @@ pub mod report;
 use mesh_check::MeshCheck;
 use palpate_core::{Drive, ForwardModel, Loading};
 use palpate_fe::Q1Punch;
-use palpate_inverse::{
-    fit, CorrectedModel, DataSet, FdOptions, FidelityCorrection, FitOptions, FitReport, LmOptions,
-    Method, Objective, ResidualKind,
-};
+use palpate_inverse::staged::{self, Round, Stage, StageModels, StageOptions};
+use palpate_inverse::{DataSet, FdOptions, FitReport, LmOptions, Objective};
 use palpate_material::Law;
 use serde::Serialize;
 use std::sync::Arc;
@@ -59,8 +57,8 @@ pub use ramp::ramp_correction;
 pub use report::report;
 
 /// The correction rounds stop when every estimate moves by less than this
-/// part of its standard error.
-pub const ROUND_TOLERANCE: f64 = 0.1;
+/// part of its standard error (`palpate_inverse::staged`).
+pub use palpate_inverse::staged::{MeshCorrection, ROUND_TOLERANCE};
 
 /// The stages `--stages` can name.
 pub const STAGES: [&str; 2] = ["elastic", "relaxation"];
@@ -427,17 +425,6 @@ pub struct StageResult {
     pub fit: FitReport,
 }
 
-/// One correction of the fit mesh's model to the correcting mesh.
-#[derive(Debug, Clone, Serialize)]
-pub struct MeshCorrection {
-    /// The parameters both meshes ran at.
-    pub anchor: Vec<f64>,
-    /// The largest |fine / coarse - 1| over the samples.
-    pub max_relative_change: f64,
-    /// Wall time of the two runs (s).
-    pub wall_s: f64,
-}
-
 /// The whole identification.
 #[derive(Debug, Clone, Serialize)]
 pub struct TwoStageResult {
@@ -470,163 +457,83 @@ pub(crate) fn lm_fit(
     options: &TwoStageOptions,
     lm: LmOptions,
 ) -> anyhow::Result<(FitReport, f64)> {
-    let t0 = Instant::now();
-    let report = fit(
-        objective,
-        &FitOptions {
-            method: Method::LevenbergMarquardt(lm),
-            fd: options.fd,
-            start: Some(start),
-            ..FitOptions::default()
-        },
-    )?;
-    Ok((report, t0.elapsed().as_secs_f64()))
+    Ok(staged::lm_fit(objective, start, lm, options.fd)?)
 }
 
-/// The models a stage fits: the fit mesh's, and the correcting mesh's when
-/// asked.
-pub(crate) struct StageModels {
-    pub(crate) coarse: Arc<dyn ForwardModel>,
-    pub(crate) fine: Option<Arc<dyn ForwardModel>>,
+impl TwoStageOptions {
+    /// The LM settings of every stage.
+    pub fn stage_options(&self) -> StageOptions {
+        StageOptions {
+            lm: self.lm,
+            fd: self.fd,
+        }
+    }
 }
 
-/// What one stage fits.
-pub(crate) struct StageData<'a> {
-    pub(crate) stage: &'a str,
-    pub(crate) name: String,
-    pub(crate) loading: Loading,
-    pub(crate) observed: Vec<f64>,
-    /// Parameters held, by name.
-    pub(crate) fixed: Vec<(String, f64)>,
+/// The progress line of a correction round (the fit mesh corrected to the
+/// correcting or check mesh).
+pub(crate) fn say_round(say: Say<'_>) -> impl FnMut(&Round<'_>) + '_ {
+    move |r: &Round<'_>| {
+        let (lo, hi) = r.ratio_range;
+        say(&format!(
+            "  round {}: the fit mesh's force corrected by x {lo:.4} .. {hi:.4} at [{}] ({:.0} s)",
+            r.round + 1,
+            r.anchor
+                .iter()
+                .map(|v| format!("{v:.4e}"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            r.wall_s
+        ));
+    }
 }
 
-/// Runs one stage: LM from `start` (every parameter of the models' space).
-/// With a correcting mesh, the fit mesh's model is corrected to it at the
-/// start, then (up to `rounds` rounds) at each round's estimate, until the
-/// estimates move by less than [`ROUND_TOLERANCE`] of their standard
-/// errors. Returns the result and the data set of the last round (the
-/// profiles refit it).
+/// Runs one stage ([`staged::run_stage`]: LM from `start`, with correction
+/// rounds when the models have a correcting mesh). Returns the result and
+/// the data set of the last round (the profiles refit it).
 pub(crate) fn run_stage(
-    data: &StageData<'_>,
+    data: &Stage,
     models: &StageModels,
     start: Vec<f64>,
     rounds: usize,
     options: &TwoStageOptions,
     say: Say<'_>,
 ) -> anyhow::Result<(StageResult, DataSet)> {
-    let mut theta = start.clone();
-    let (mut fe_runs, mut wall_s) = (0, 0.0);
-    let (mut corrections, mut round_iterations) = (Vec::new(), Vec::new());
-    let mut last = None;
-    let (mut settled, mut last_move) = (true, 0.0f64);
-    for round in 0..rounds.max(1) {
-        let model: Arc<dyn ForwardModel> = match &models.fine {
-            None => models.coarse.clone(),
-            Some(fine) => {
-                let t0 = Instant::now();
-                let c = FidelityCorrection::at(
-                    fine.as_ref(),
-                    models.coarse.as_ref(),
-                    &theta,
-                    &data.loading,
-                )
-                .map_err(|e| {
-                    anyhow::anyhow!(
-                        "{}: the correcting mesh's run at {theta:?}: {e}",
-                        data.stage
-                    )
-                })?;
-                let w = t0.elapsed().as_secs_f64();
-                let (lo, hi) = c
-                    .ratio
-                    .iter()
-                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &r| {
-                        (l.min(r), h.max(r))
-                    });
-                say(&format!(
-                    "  round {}: the fit mesh's force corrected by x {lo:.4} .. {hi:.4} at [{}] ({w:.0} s)",
-                    round + 1,
-                    theta
-                        .iter()
-                        .map(|v| format!("{v:.4e}"))
-                        .collect::<Vec<_>>()
-                        .join(", ")
-                ));
-                corrections.push(MeshCorrection {
-                    anchor: theta.clone(),
-                    max_relative_change: c.max_relative_change(),
-                    wall_s: w,
-                });
-                fe_runs += 1;
-                wall_s += w;
-                Arc::new(CorrectedModel::new(
-                    models.coarse.clone(),
-                    c,
-                    data.loading.clone(),
-                    &fine.name(),
-                ))
-            }
-        };
-        let set = DataSet::new(
-            data.name.clone(),
-            model,
-            data.loading.clone(),
-            data.observed.clone(),
-        );
-        let objective = Objective::new(vec![set.clone()], ResidualKind::Absolute, &data.fixed)?;
-        let (report, w) = lm_fit(&objective, theta.clone(), options, options.lm)?;
-        fe_runs += report.evaluations;
-        wall_s += w;
-        round_iterations.push(report.iterations);
-        // the move of each free estimate from the anchor, in its SE (or, with
-        // no SE, in 1e-3 of the value, against the tolerance's scale)
-        last_move = report
-            .parameters
-            .iter()
-            .zip(&theta)
-            .filter(|(e, _)| !e.fixed)
-            .map(|(e, &old)| match e.standard_error {
-                Some(se) if se > 0.0 => (e.value - old).abs() / se,
-                _ => (e.value - old).abs() / (1e-3 * old.abs()) * ROUND_TOLERANCE,
-            })
-            .fold(0.0, f64::max);
-        settled = models.fine.is_none() || rounds <= 1 || last_move <= ROUND_TOLERANCE;
-        theta = report.parameters.iter().map(|p| p.value).collect();
-        let stop = models.fine.is_none() || (round > 0 && settled);
-        last = Some((objective, report, set));
-        if stop {
-            break;
-        }
-    }
-    let (objective, report, set) = last.expect("at least one round");
-    let result = StageResult {
-        stage: data.stage.into(),
-        free: objective.free_names(),
-        samples: objective.n_residuals(),
-        iterations: round_iterations.iter().sum(),
-        fe_runs,
-        wall_s,
-        converged: report.converged,
-        termination: report.termination.to_string(),
-        // (the round trip through LM's unbounded coordinates moves a value
-        // that stayed by round-off)
-        moved: theta
-            .iter()
-            .zip(&start)
-            .any(|(a, b)| (a - b).abs() > 1e-9 * b.abs()),
-        settled,
-        last_round_move_se: if models.fine.is_some() && rounds > 1 {
-            last_move
-        } else {
-            0.0
+    let out = staged::run_stage(
+        data,
+        models,
+        start,
+        rounds,
+        &options.stage_options(),
+        &mut say_round(say),
+    )
+    .map_err(|e| anyhow::anyhow!("{}: {e}", data.stage))?;
+    Ok(stage_result(&data.stage, out))
+}
+
+/// A stage's result from the generic outcome.
+pub(crate) fn stage_result(stage: &str, out: staged::StageOutcome) -> (StageResult, DataSet) {
+    (
+        StageResult {
+            stage: stage.into(),
+            free: out.free,
+            samples: out.samples,
+            iterations: out.iterations,
+            fe_runs: out.runs,
+            wall_s: out.wall_s,
+            converged: out.converged,
+            termination: out.termination,
+            theta: out.theta,
+            correction: None,
+            mesh_corrections: out.corrections,
+            round_iterations: out.round_iterations,
+            moved: out.moved,
+            settled: out.settled,
+            last_round_move_se: out.last_round_move_se,
+            fit: out.fit,
         },
-        theta,
-        correction: None,
-        mesh_corrections: corrections,
-        round_iterations,
-        fit: report,
-    };
-    Ok((result, set))
+        out.set,
+    )
 }
 
 /// Past this depth (mm) a fit mesh coarser than [`DEEP_FIT_MESH`] is stiff
@@ -690,9 +597,9 @@ pub fn identify(
     let names = space.names();
     let n_law = elastic.coarse.space().len();
     let mut theta: Vec<f64> = space.params.iter().map(|p| p.initial).collect();
-    let whole = |stage, fixed| StageData {
-        stage,
-        name: record.name.clone(),
+    let whole = |stage: &str, fixed| Stage {
+        stage: stage.into(),
+        set: record.name.clone(),
         loading: record.loading(),
         observed: record.force.clone(),
         fixed,
@@ -708,9 +615,9 @@ pub fn identify(
         match stage.as_str() {
             "elastic" => {
                 let (loading, observed) = record.ramp();
-                let data = StageData {
-                    stage,
-                    name: format!("{} (ramp)", record.name),
+                let data = Stage {
+                    stage: stage.clone(),
+                    set: format!("{} (ramp)", record.name),
                     loading,
                     observed,
                     fixed: Vec::new(),
