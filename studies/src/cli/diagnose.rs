@@ -126,6 +126,9 @@ pub fn diagnose_record(
     if options.effects.is_none() {
         options.effects = default_effects(&spec, model.as_ref(), &record.loading);
     }
+    if options.paths.is_none() {
+        options.paths = crate::steps::diagnose::noise_paths(record);
+    }
     if let Some(effects) = &options.effects {
         crate::model::check_effects(model.as_ref(), effects)
             .map_err(|e| anyhow::anyhow!("--effects {e} ({} record)", record.name))?;

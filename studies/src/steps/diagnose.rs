@@ -5,6 +5,9 @@
 use crate::model::{ModelForm, ModelSpec};
 use crate::model::{build, default_effects, gap_base_for, parse_effects};
 use crate::run::output::write_atomic;
+use crate::records::{TestData, TestKind};
+use crate::steps::replicates::sig4;
+use palpate_uq::gap::NoisePaths;
 use crate::report::{data_unit, gap_svg, gap_table_header};
 use crate::run::step::{duplicate, keys, At, Run, Step, StepResult, Study};
 use anyhow::Context;
@@ -143,6 +146,56 @@ fn diagnose_model(study: &Study, d: &DiagnoseStep, data: &str) -> Option<ModelSp
 
 
 
+/// The loading paths of a record whose noise must be estimated path by
+/// path: a general biaxial record holds two stresses per row (one per
+/// direction) and runs of rows at one fixed stretch (Kawabata's paths:
+/// lambda1 held, lambda2 varied), so neighbouring samples of the record
+/// belong to different curves. A path is a run of rows that keep lambda1
+/// (or, when lambda1 changes from row to row, lambda2), each direction's
+/// stress its own path, placed along the stretch that varies. `None` for
+/// every other record (one path, in order).
+pub fn noise_paths(record: &TestData) -> Option<NoisePaths> {
+    if record.test != TestKind::GeneralBiaxial {
+        return None;
+    }
+    let rows: Vec<(f64, f64)> = record
+        .loading
+        .drive
+        .chunks_exact(2)
+        .map(|r| (r[0], r[1]))
+        .collect();
+    if rows.len() < 2 {
+        return None;
+    }
+    let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs()).max(1.0);
+    let runs = |first: bool| {
+        rows.windows(2)
+            .filter(|w| {
+                let (a, b) = if first { (w[0].0, w[1].0) } else { (w[0].1, w[1].1) };
+                !same(a, b)
+            })
+            .count()
+    };
+    // The stretch held on a path changes least often from row to row.
+    let held_first = runs(true) <= runs(false);
+    let (mut path, mut along) = (Vec::new(), Vec::new());
+    let mut id = 0;
+    for (i, &(l1, l2)) in rows.iter().enumerate() {
+        let (held, varied) = if held_first { (l1, l2) } else { (l2, l1) };
+        if i > 0 {
+            let prev = if held_first { rows[i - 1].0 } else { rows[i - 1].1 };
+            if !same(prev, held) {
+                id += 1;
+            }
+        }
+        for k in 0..2 {
+            path.push(2 * id + k);
+            along.push(varied);
+        }
+    }
+    Some(NoisePaths { path, along })
+}
+
 /// A diagnosed record as cached.
 #[derive(Debug, Clone, Serialize, Deserialize)]
 struct DiagnoseUnit {
@@ -206,13 +259,14 @@ pub(crate) fn run_diagnose(
                     ),
                     None => default_effects(&spec, model.as_ref(), &d.loading),
                 },
+                paths: noise_paths(d),
                 ..Default::default()
             };
             let gap = palpate_uq::gap::diagnose(model.as_ref(), &d.loading, &d.observed, &options)
                 .with_context(|| format!("step `{}`: diagnosing `{name}`", step.name))?;
             let best = gap.ranking.first();
             let row = format!(
-                "| {name} | **{}**{} | {:.4} | {:.4} | {} | {} | {} |",
+                "| {name} | **{}**{} | {} | {} | {} | {} | {} |",
                 gap.verdict,
                 if gap.confounded.is_empty() {
                     String::new()
@@ -220,12 +274,12 @@ pub(crate) fn run_diagnose(
                     let names: Vec<&str> = gap.confounded.iter().map(|e| e.name()).collect();
                     format!(" (confounded with {})", names.join(", "))
                 },
-                gap.noise_sd,
-                gap.base.misfit,
+                sig4(gap.noise_sd),
+                sig4(gap.base.misfit),
                 best.map(|b| b.effect.to_string()).unwrap_or_default(),
-                best.map(|b| format!("{:.4}", b.misfit_after))
+                best.map(|b| sig4(b.misfit_after))
                     .unwrap_or_default(),
-                best.map(|b| format!("{:.4} / {:.4}", b.heldout_before, b.heldout_after))
+                best.map(|b| format!("{} / {}", sig4(b.heldout_before), sig4(b.heldout_after)))
                     .unwrap_or_default(),
             );
             Ok(DiagnoseUnit {
@@ -254,4 +308,50 @@ pub(crate) fn run_diagnose(
         "name": step.name.clone(),
         "cases": cases,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_general_biaxial_record_gets_its_noise_path_by_path() {
+        // Kawabata's record: paths at fixed lambda1, lambda2 varied, two
+        // stresses per row. Differenced across the interleaved paths the
+        // "noise" is the jump between curves; within each path it is what
+        // the digitised data scatter by.
+        let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data/real/kawabata1981/biaxial.csv");
+        let d = TestData::read("biaxial", TestKind::GeneralBiaxial, &file).unwrap();
+        let paths = noise_paths(&d).unwrap();
+        let labels: std::collections::BTreeSet<usize> = paths.path.iter().copied().collect();
+        let rows = d.loading.len() / 2;
+        assert!(labels.len() >= 20 && labels.len() < rows, "{} paths", labels.len());
+        // within a path the position (lambda2) increases
+        for w in paths.path.windows(3).zip(paths.along.windows(3)) {
+            if w.0[0] == w.0[2] {
+                assert!(w.1[2] >= w.1[0]);
+            }
+        }
+        let across = palpate_uq::gap::difference_noise_sd(&d.observed, None).unwrap();
+        let within = palpate_uq::gap::path_noise_sd(&d.observed, &paths).unwrap();
+        assert!(within.sd < 0.2 * across.sd, "{within:?} against {across:?}");
+        // other records are one path
+        let uni = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("data/real/meunier2008_silicone/uniaxial.csv");
+        let u = TestData::read(
+            "uniaxial",
+            TestKind::Homogeneous(palpate_analytic::Mode::Uniaxial),
+            &uni,
+        )
+        .unwrap();
+        assert!(noise_paths(&u).is_none());
+    }
+
+    #[test]
+    fn small_numbers_keep_their_digits() {
+        // a dense record's noise of ~1e-5 MPa is not printed as 0.0000
+        assert_eq!(sig4(1.234e-5), "1.234e-5");
+        assert_eq!(sig4(0.02213), "0.02213");
+    }
 }

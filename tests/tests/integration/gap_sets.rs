@@ -169,7 +169,7 @@ fn pairs(prefix: &str, least: usize) {
 }
 
 #[test]
-#[ignore = "minutes of CPU in the dev profile, and not every record yet plants both effects above 2 x noise alone (uni-05: material form 1.9 x): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
+#[ignore = "20 diagnoses, about 20 s of CPU (bench_gap_sets), and the records do not yet all plant a visible pair: with compressibility beside an offset or a compliance, or a compliance beside a stiffening law, the partner alone leaves 1.0-1.1 x noise (13 of 20 right): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn c1_records_with_two_planted_effects_get_the_pair() {
     pairs("c1-", 20);
 }
@@ -197,7 +197,6 @@ fn noise_only_records_get_none_and_an_empty_explanation() {
 }
 
 #[test]
-#[ignore = "twelve C1 diagnoses with sets, over 20 s of CPU: cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn one_effect_records_get_a_set_of_one() {
     let gap_dev = Path::new(env!("CARGO_MANIFEST_DIR")).join("../studies/data/gap-dev/c1");
     let truth: serde_json::Value =
@@ -244,7 +243,6 @@ fn one_effect_records_get_a_set_of_one() {
 }
 
 #[test]
-#[ignore = "a two-effect C1 diagnosis with relaxation, over 20 s of CPU in the dev profile: cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn the_json_holds_the_set_after_the_verdict() {
     let name = &names("c1-")[0];
     let r = run(name);

@@ -9,7 +9,7 @@ use super::base::fit_base;
 use super::compose::Composite;
 use super::crossval::Folds;
 use super::memo::Memo;
-use super::noise::difference_noise_sd;
+use super::noise::{difference_noise_sd, path_noise_sd};
 use super::plausible::offset_range;
 use super::rank::rank;
 use super::report::{BaseSummary, FailedCandidate, GapPlot, GapReport};
@@ -24,8 +24,13 @@ use palpate_core::{Effect, ForwardError, ForwardModel, Loading};
 use rayon::prelude::*;
 use std::sync::Arc;
 
-/// Fewest samples the diagnosis works with.
-const MIN_SAMPLES: usize = 16;
+/// Fewest samples the diagnosis works with: the noise estimate from second
+/// differences needs them.
+const MIN_SAMPLES: usize = 8;
+/// Below this many samples a diagnosis is made with a caveat that states
+/// its power (the smallest misfit it can tell from the noise), and the
+/// cross-validation uses fewer folds (two samples at least per fold).
+pub(crate) const SHORT_RECORD: usize = 16;
 
 /// Diagnoses the gap between `base` and `observed` (one value per sample of
 /// `loading`, in the unit of `base.observable()`). See the module docs.
@@ -53,10 +58,14 @@ pub fn diagnose(
             samples: loading.len(),
         });
     }
-    let needed = MIN_SAMPLES.max(2 * options.folds);
-    if n < needed {
-        return Err(GapError::TooFewSamples { got: n, needed });
+    if n < MIN_SAMPLES {
+        return Err(GapError::TooFewSamples {
+            got: n,
+            needed: MIN_SAMPLES,
+        });
     }
+    // A short record keeps at least two samples per fold.
+    let fold_count = options.folds.min(n / 2);
     if let Some(index) = observed.iter().position(|v| !v.is_finite()) {
         return Err(GapError::NonFinite { index });
     }
@@ -70,19 +79,26 @@ pub fn diagnose(
             loading.drive.clone(),
         ),
     };
-    let noise = difference_noise_sd(observed, loading.time.as_deref())?;
+    let noise = match &options.paths {
+        Some(paths) => path_noise_sd(observed, paths)?,
+        None => difference_noise_sd(observed, loading.time.as_deref())?,
+    };
     let sigma = noise.sd;
     if sigma.is_nan() || sigma <= 0.0 {
         return Err(GapError::ZeroNoise);
     }
     let p = base.space().len();
+    let caveat =
+        (n < SHORT_RECORD).then(|| short_record_caveat(n, p, &noise, options.alpha, fold_count));
     let w = options.window.unwrap_or_else(|| default_window(n)).min(n);
-    let folds = Folds::new(options.fold_layout, &loading.drive, options.folds, w);
-    let later = n - n / options.folds;
+    let folds = Folds::new(options.fold_layout, &loading.drive, fold_count, w);
+    let later = n - n / fold_count;
 
     // Base fit on all samples, and its held-out predictions.
     let expensive = base.expensive();
-    let linearised = options.cross_validation.linearised(expensive);
+    let linearised = options
+        .cross_validation
+        .linearised(expensive, options.fold_layout);
     let base_fit = fit_base(base, loading, observed, &folds, linearised)?;
     let base_theta = base_fit.theta.clone();
     let base_residual = residuals(observed, &base_fit.full.predicted);
@@ -316,6 +332,10 @@ pub fn diagnose(
         folds: folds.chunks.clone(),
         base_cv: base_fit.cv.clone(),
     };
+    let explanation = match &caveat {
+        Some(c) => format!("{c} {explanation}"),
+        None => explanation,
+    };
     let base_names = base.space().names();
     let heldout_base = residuals(observed, &base_fit.cv);
     Ok(GapReport {
@@ -343,9 +363,37 @@ pub fn diagnose(
         },
         noise,
         samples: n,
-        folds: options.folds,
+        folds: fold_count,
+        caveat,
         plot,
     })
+}
+
+/// The caveat of a short record (`n` samples, `p` base parameters): the
+/// power of the misfit test, the smallest RMS misfit / noise it tells from
+/// the noise at level `alpha`. Under the null SSE / sigma^2 / (n - p) has
+/// mean 1 and variance 2 / (n - p) plus the relative variance of the noise
+/// estimate (the test of [`whiteness`]); the misfit is significant when it
+/// exceeds 1 + z_alpha times that SD.
+fn short_record_caveat(
+    n: usize,
+    p: usize,
+    noise: &super::NoiseEstimate,
+    alpha: f64,
+    folds: usize,
+) -> String {
+    let dof = n.saturating_sub(p).max(1) as f64;
+    let z = super::structure::chi2_isf(2.0 * alpha, 1.0).sqrt();
+    let detectable = (1.0 + z * (2.0 / dof + noise.rel_var_sd2).sqrt()).sqrt();
+    format!(
+        "Short record: {n} samples ({SHORT_RECORD} give the diagnosis its usual power). The noise SD rests on {} \
+         second differences (its square uncertain by +-{:.0} %) and the cross-validation on {folds} folds of about {} \
+         samples, so only a misfit above {detectable:.2} x noise can be told from the noise at level {alpha:.0e}; a \
+         smaller gap goes unseen. More samples along the same loading path (or replicates) would show smaller gaps.",
+        noise.used,
+        100.0 * noise.rel_var_sd2.sqrt(),
+        n / folds.max(1),
+    )
 }
 
 /// Whether a candidate's fitted zero offset lies outside what the record
@@ -517,6 +565,82 @@ mod tests {
         let r = diagnose(&base, &loading, &y, &GapOptions::default()).unwrap();
         assert_eq!(r.verdict, "none", "{}", r.explanation);
         assert!(!r.base.gap_significant && r.where_.is_empty());
+    }
+
+    #[test]
+    fn the_refined_linearised_cross_validation_matches_the_refits() {
+        // A nonlinear fold refit (the offset moves the kink): the chord
+        // iterations from the full optimum reach the Levenberg-Marquardt
+        // refits' held-out predictions, where one linear step need not.
+        use super::super::crossval::cross_validate_by;
+        use super::super::fit::fit_from_starts;
+        let (loading, y) = data(0.3, 6);
+        let model: Arc<dyn ForwardModel> = Arc::new(Spring::new(true));
+        let starts = vec![vec![2.0, 0.1]];
+        let full = fit_from_starts(&model, &loading, &y, None, &starts, &[], false).unwrap();
+        let folds = Folds::new(super::super::FoldLayout::Stratified, &loading.drive, 8, 13);
+        let cv = |linearised: bool| {
+            let starts = vec![full.theta.clone()];
+            cross_validate_by(
+                linearised,
+                &model,
+                &loading,
+                &y,
+                &folds,
+                &full,
+                &starts,
+                &[],
+                None,
+            )
+            .unwrap()
+        };
+        let (refit, chord) = (cv(false), cv(true));
+        let worst = refit
+            .iter()
+            .zip(&chord)
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        // within a hundredth of the noise SD (0.01) at every sample
+        assert!(worst < 1e-4, "largest difference {worst}");
+        assert!(refit
+            .iter()
+            .zip(&full.predicted)
+            .any(|(a, b)| (a - b).abs() > 1e-4));
+    }
+
+    #[test]
+    fn a_short_record_is_diagnosed_with_its_power_stated() {
+        // 12 samples every 0.15 mm with a large offset: diagnosed, the
+        // caveat says how large a misfit the record can show.
+        let base = Spring::new(false);
+        let (loading, y) = data(0.3, 4);
+        let pick: Vec<usize> = (0..12).map(|i| 8 + 15 * i).collect();
+        let short = Loading::quasi_static(
+            Drive::DisplacementMm,
+            pick.iter().map(|&i| loading.drive[i]).collect(),
+        );
+        let ys: Vec<f64> = pick.iter().map(|&i| y[i]).collect();
+        let r = diagnose(&base, &short, &ys, &GapOptions::default()).unwrap();
+        let caveat = r.caveat.as_deref().unwrap();
+        assert!(caveat.contains("Short record: 12 samples"), "{caveat}");
+        assert!(r.explanation.starts_with("Short record"));
+        assert_eq!(r.folds, 6);
+        // the smallest detectable misfit is stated and above the noise
+        let at = caveat.find("misfit above ").unwrap() + "misfit above ".len();
+        let ratio: f64 = caveat[at..].split(' ').next().unwrap().parse().unwrap();
+        assert!(ratio > 1.2 && ratio < 3.0, "{caveat}");
+        // a full-length record has no caveat; under 8 samples is refused
+        let (loading, y) = data(0.0, 5);
+        assert!(diagnose(&base, &loading, &y, &GapOptions::default())
+            .unwrap()
+            .caveat
+            .is_none());
+        let tiny = Loading::quasi_static(Drive::DisplacementMm, short.drive[..7].to_vec());
+        let err = diagnose(&base, &tiny, &ys[..7], &GapOptions::default()).unwrap_err();
+        assert!(
+            matches!(err, GapError::TooFewSamples { got: 7, needed: 8 }),
+            "{err}"
+        );
     }
 
     #[test]

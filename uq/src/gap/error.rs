@@ -9,7 +9,7 @@ use thiserror::Error;
 #[non_exhaustive]
 pub enum GapError {
     /// Too few samples for the noise estimate and the tests.
-    #[error("{got} samples; the diagnosis needs at least {needed}")]
+    #[error("{got} samples; the diagnosis needs at least {needed} (the noise is estimated from second differences of neighbouring samples): record more samples along the loading path")]
     TooFewSamples { got: usize, needed: usize },
     /// Observations and loading disagree in length.
     #[error("{observed} observations for {samples} loading samples")]

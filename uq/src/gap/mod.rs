@@ -52,7 +52,7 @@ mod verdict;
 
 pub use diagnose::diagnose;
 pub use error::GapError;
-pub use noise::{difference_noise_sd, NoiseEstimate};
+pub use noise::{difference_noise_sd, path_noise_sd, NoiseEstimate, NoisePaths};
 pub use options::{CrossValidation, FoldLayout, GapOptions};
 pub use profile::ProfileInterval;
 pub use report::{BaseSummary, FailedCandidate, GapPlot, GapReport, PracticalSize, RankedEffect};

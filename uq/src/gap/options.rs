@@ -1,6 +1,6 @@
 //! Options of the gap diagnosis.
 
-use super::GapError;
+use super::{GapError, NoisePaths};
 use palpate_core::Effect;
 use serde::{Deserialize, Serialize};
 
@@ -46,6 +46,11 @@ pub struct GapOptions {
     /// to be homogeneous in them (`gap::memo`). Default true; false only to
     /// measure what the cache saves.
     pub cache: bool,
+    /// The record's loading paths, when it interleaves several (general
+    /// biaxial data: one stress per direction, paths at a fixed stretch):
+    /// the noise is then estimated within each path only. Default: one
+    /// path, the record in order (by time when timed).
+    pub paths: Option<NoisePaths>,
 }
 
 /// How the record is cut into the folds of the cross-validation.
@@ -67,25 +72,31 @@ pub enum FoldLayout {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum CrossValidation {
-    /// `linearised` for models that declare themselves expensive
-    /// (`ForwardModel::expensive`, e.g. finite elements), `refit` otherwise.
+    /// `linearised` whenever the folds are stratified (for a model that
+    /// declares itself expensive, `ForwardModel::expensive`, one step; for
+    /// a cheap one refined to the refit by chord iterations), `refit` with
+    /// contiguous blocks (leaving a whole phase out can move the parameters
+    /// far from the full-record optimum, where one Jacobian does not reach).
     #[default]
     Auto,
     /// A Levenberg-Marquardt refit per left-out block (exact).
     Refit,
-    /// One Gauss-Newton step per left-out block from the full-record optimum,
-    /// with the sensitivities at that optimum: no model evaluation beyond
-    /// the one Jacobian (approximate cross-validation; Beirami et al. 2017,
-    /// Stephenson & Broderick 2020). Accurate when leaving a block out moves
-    /// the parameters little compared with the curvature of the model.
+    /// From the full-record optimum with the sensitivities there: one
+    /// Gauss-Newton step per left-out block for an expensive model (no
+    /// model evaluation beyond the one Jacobian: approximate
+    /// cross-validation; Beirami et al. 2017, Stephenson & Broderick 2020),
+    /// refined by chord iterations (a few predictions per block) for a
+    /// cheap one. Accurate when leaving a block out moves the parameters
+    /// little compared with the curvature of the model.
     Linearised,
 }
 
 impl CrossValidation {
-    /// Whether the linearised form applies to a model of this cost.
-    pub fn linearised(self, expensive: bool) -> bool {
+    /// Whether the linearised form applies to a model of this cost and
+    /// folds of this layout.
+    pub fn linearised(self, expensive: bool, layout: FoldLayout) -> bool {
         match self {
-            CrossValidation::Auto => expensive,
+            CrossValidation::Auto => expensive || layout == FoldLayout::Stratified,
             CrossValidation::Refit => false,
             CrossValidation::Linearised => true,
         }
@@ -104,6 +115,7 @@ impl Default for GapOptions {
             fold_layout: FoldLayout::Stratified,
             materiality: 0.4,
             cache: true,
+            paths: None,
         }
     }
 }

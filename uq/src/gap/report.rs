@@ -202,6 +202,10 @@ pub struct GapReport {
     /// Samples, and blocks of the cross-validation.
     pub samples: usize,
     pub folds: usize,
+    /// What limits the diagnosis on this record (a short record: the
+    /// smallest misfit it can tell from the noise); absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub caveat: Option<String>,
     pub plot: GapPlot,
 }
 
