@@ -136,3 +136,42 @@ fn replicates_rerun_byte_identically() {
     let curve = nh["mu0_mean_curve"].as_f64().unwrap();
     assert!((mean / curve - 1.0).abs() < 0.01, "{mean} {curve}");
 }
+
+/// `palpate sample --hierarchical` on EF10_0T's ten tests: the between-test
+/// SD of C10 holds the spread of the per-test fits, and the chains converge.
+#[test]
+fn hierarchical_posterior_holds_the_spread_of_the_tests() {
+    let dir = tempfile::tempdir().unwrap();
+    let json = dir.path().join("h.json");
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_palpate"))
+        .args(["sample", "--law", "neo-hookean", "--hierarchical", "--data"])
+        .arg(format!(
+            "uniaxial={}",
+            database().join("EF10_0T/*.csv").display()
+        ))
+        .arg("--json")
+        .arg(&json)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let h: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    let post = &h["hierarchical"];
+    assert_eq!(post["tests"], 10);
+    assert!(post["converged"].as_bool().unwrap() && post["rhat_max"].as_f64().unwrap() < 1.01);
+    let c10 = &post["parameters"][0];
+    let sd = c10["estimates_sd"].as_f64().unwrap();
+    let (lo, hi) = (
+        c10["tau"]["hdi_3"].as_f64().unwrap(),
+        c10["tau"]["hdi_97"].as_f64().unwrap(),
+    );
+    assert!(lo < sd && sd < hi, "tau [{lo}, {hi}], per-test SD {sd}");
+    let mu = c10["mu"]["mean"].as_f64().unwrap();
+    assert!(
+        (mu / c10["estimates_mean"].as_f64().unwrap() - 1.0).abs() < 0.01,
+        "{mu}"
+    );
+}
