@@ -131,6 +131,13 @@ pub struct Args {
     /// Write corner.svg and predictive_<data>.svg into this folder.
     #[arg(long, value_name = "DIR")]
     pub plot: Option<PathBuf>,
+    /// The --data files are replicates of one material (a FILE with wildcards,
+    /// or several --data): sample the hierarchical posterior of each
+    /// parameter, its population mean and between-test SD, from each
+    /// record's own fit (NUTS until R-hat < 1.01; --seed, --max-draws and
+    /// --json apply).
+    #[arg(long)]
+    pub hierarchical: bool,
 }
 
 fn sampler_from(args: &Args) -> anyhow::Result<Sampler> {
@@ -238,7 +245,43 @@ pub struct Sampled {
 
 /// Runs `palpate sample`.
 pub fn run(args: Args) -> anyhow::Result<()> {
+    if args.hierarchical {
+        return hierarchical(&args);
+    }
     draw(&args, &[]).map(|_| ())
+}
+
+/// `palpate sample --hierarchical`: the population of replicates.
+fn hierarchical(args: &Args) -> anyhow::Result<()> {
+    anyhow::ensure!(
+        args.benchmark.is_none() && args.sigma.is_none() && !args.ar1 && args.prior.is_empty() && !args.evidence,
+        "--hierarchical: the records' own fits make the test level; not with --benchmark, --sigma, --ar1, --prior or --evidence"
+    );
+    let law: Law = args
+        .law
+        .parse()
+        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    let records = read_data_opts(&args.data, None, &[], &args.reading.defaults()?)?;
+    anyhow::ensure!(
+        records.len() >= 2,
+        "--hierarchical: {} record; give replicates (a --data FILE with wildcards, or several --data)",
+        records.len()
+    );
+    let cap = args.max_draws.unwrap_or(16_000);
+    let (reps, post) = crate::steps::replicates::hierarchical(law, &records, args.seed, cap)?;
+    print!("{}", reps.table());
+    print!(
+        "{}",
+        crate::steps::replicates::hierarchical_table(law, &post)
+    );
+    if let Some(p) = &args.json {
+        write_json(
+            p,
+            &json!({ "law": law.to_string(), "replicates": reps, "hierarchical": post }),
+        )?;
+        eprintln!("wrote {}", p.display());
+    }
+    Ok(())
 }
 
 /// Runs `palpate sample` (printing its table and writing the outputs it is

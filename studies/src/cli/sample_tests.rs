@@ -33,6 +33,7 @@ fn c1_args() -> Args {
         chains_out: None,
         evidence: false,
         plot: None,
+        hierarchical: false,
     }
 }
 

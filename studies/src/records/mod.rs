@@ -10,6 +10,7 @@
 pub mod arrays;
 pub mod columns;
 pub mod machine;
+pub mod published;
 pub mod replicates;
 pub mod sign;
 

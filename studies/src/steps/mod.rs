@@ -43,10 +43,6 @@ macro_rules! registry {
     };
 }
 
-/// Replicates of one material: pooled and per-record fits, the batch test
-/// (not a step kind: the calibrate command and step use it).
-pub mod replicates;
-
 registry! {
     calibrate => Calibrate(CalibrateStep),
     diagnose => Diagnose(DiagnoseStep),
@@ -55,6 +51,7 @@ registry! {
     two_stage => TwoStage(TwoStageStep),
     localize => Localize(LocalizeStep),
     sample => Sample(SampleStep),
+    replicates => Replicates(ReplicatesStep),
 }
 
 impl StepEntry {

@@ -1,5 +1,8 @@
 //! Replicates of one material: the law fitted to all records pooled and to
-//! each record alone, the per-record parameters' mean and SD beside the
+//! each record alone ([`analyse`], which `palpate calibrate` uses too), and
+//! the study step `replicates` ([`ReplicatesStep`]) that adds the fit to
+//! their mean curve on a common strain grid and its comparison with a
+//! published table of fits to that curve; the per-record parameters' mean and SD beside the
 //! pooled fit's standard errors, and the batch-to-batch difference (batch A
 //! against batch B) by Welch's t-test on the per-record parameters.
 //!
@@ -11,11 +14,18 @@
 //! standard error.
 
 use crate::model::calibration::{calibrate, Calibration, Request};
-use crate::records::replicates::{batches_from_names, stem};
-use crate::records::TestData;
+use crate::records::published::PublishedFit;
+use crate::records::replicates::{batches_from_names, mean_curve, stem, MeanCurve};
+use crate::records::{ReadOptions, TestData, TestKind};
+use crate::run::output::write_atomic;
+use crate::run::step::{duplicate, At, Run, Step, StepResult, Study};
+use palpate_uq::likelihood::{HierarchicalPosterior, RandomEffects};
+use serde::Deserialize;
+use std::path::PathBuf;
 use anyhow::Context;
 use palpate_inverse::{Method, ResidualKind};
-use palpate_material::Law;
+use palpate_analytic::Mode;
+use palpate_material::{homogeneous, Law};
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
 
@@ -27,6 +37,8 @@ pub struct ReplicateFit {
     pub batch: Option<String>,
     /// Fitted parameters, in the law's order.
     pub values: Vec<f64>,
+    /// Their standard errors (from the record's residuals).
+    pub standard_errors: Vec<Option<f64>>,
     pub r2: f64,
     pub rms: f64,
     pub converged: bool,
@@ -165,6 +177,7 @@ pub fn analyse(law: Law, records: &[TestData], pooled: &Calibration) -> anyhow::
             record: stems[k].clone(),
             batch: batch_of[k].clone(),
             values: c.params.iter().map(|(_, v)| v.value).collect(),
+            standard_errors: c.params.iter().map(|(_, v)| v.standard_error).collect(),
             r2: c.r2,
             rms: c.rms,
             converged: c.converged,
@@ -339,6 +352,650 @@ impl Replicates {
         }
         out
     }
+}
+
+/// The replicate files of a step: a pattern with wildcards in the file
+/// name, or a list of files (relative to the manifest).
+#[derive(Debug, Clone, Deserialize)]
+#[serde(untagged)]
+pub enum Files {
+    Pattern(String),
+    List(Vec<String>),
+}
+
+/// A published table to compare the mean-curve fits with.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PublishedTable {
+    /// The table, relative to the manifest.
+    pub file: String,
+    /// Its format ([`crate::records::published::FORMATS`]).
+    pub format: String,
+    /// The material's key in the table.
+    pub material: String,
+    /// `engineering` (default) or `true`.
+    #[serde(default = "engineering")]
+    pub measure: String,
+}
+
+fn engineering() -> String {
+    "engineering".into()
+}
+fn uniaxial() -> String {
+    "uniaxial".into()
+}
+fn thousand() -> usize {
+    1000
+}
+
+/// A study step (`[[steps]] [steps.replicates]`): replicate records of one
+/// material, their mean curve on a common strain grid, each law fitted to
+/// the mean curve (beside a published table's fits to it, when given), to
+/// the records pooled and to each record alone, with the batch test.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReplicatesStep {
+    pub name: String,
+    /// The replicate files: `"folder/EF10_0T_*.csv"` or a list.
+    pub data: Files,
+    /// The test they record (default `uniaxial`).
+    #[serde(default = "uniaxial")]
+    pub test: String,
+    /// The laws (`--law` names).
+    pub laws: Vec<String>,
+    /// Points of the mean curve's strain grid (default 1000).
+    #[serde(default = "thousand")]
+    pub grid_points: usize,
+    /// The laws also fitted to the records pooled and one by one (default:
+    /// every law; `[]`: none).
+    #[serde(default)]
+    pub per_record_laws: Option<Vec<String>>,
+    /// The published table of fits to the same curve.
+    #[serde(default)]
+    pub published: Option<PublishedTable>,
+}
+
+impl ReplicatesStep {
+    fn laws(&self) -> anyhow::Result<Vec<Law>> {
+        self.laws
+            .iter()
+            .map(|l| {
+                l.parse::<Law>()
+                    .map_err(|e| anyhow::anyhow!("laws: \"{l}\": {e}"))
+            })
+            .collect()
+    }
+
+    /// The files, in order (a pattern expanded and sorted by name).
+    fn files(&self, dir: &std::path::Path) -> anyhow::Result<Vec<PathBuf>> {
+        match &self.data {
+            Files::Pattern(p) => {
+                let full = dir.join(p);
+                crate::records::replicates::expand(&full.to_string_lossy())
+                    .map_err(|e| anyhow::anyhow!("data: {e}"))
+            }
+            Files::List(l) => {
+                anyhow::ensure!(!l.is_empty(), "data = []: list two files at least");
+                Ok(l.iter().map(|f| dir.join(f)).collect())
+            }
+        }
+    }
+}
+
+impl Step for ReplicatesStep {
+    fn name(&self) -> &str {
+        &self.name
+    }
+
+    fn validate(&self, _study: &Study, site: &At) -> anyhow::Result<()> {
+        let at = format!("{}: {}", site.file, site.step(&self.name));
+        self.laws().map_err(|e| anyhow::anyhow!("{at}.{e}"))?;
+        anyhow::ensure!(!self.laws.is_empty(), "{at}.laws = []: give at least one");
+        if let Some(d) = duplicate(&self.laws) {
+            anyhow::bail!("{at}.laws: \"{d}\" is listed twice");
+        }
+        for l in self.per_record_laws.iter().flatten() {
+            anyhow::ensure!(
+                self.laws.contains(l),
+                "{at}.per_record_laws: \"{l}\" is not one of laws ({})",
+                self.laws.join(", ")
+            );
+        }
+        let test = TestKind::parse(&self.test).map_err(|e| anyhow::anyhow!("{at}.test: {e}"))?;
+        anyhow::ensure!(
+            matches!(test, TestKind::Homogeneous(_)),
+            "{at}.test = \"{}\": replicates take uniaxial, biaxial or planar records",
+            self.test
+        );
+        anyhow::ensure!(
+            self.grid_points >= 2,
+            "{at}.grid_points = {}: give 2 at least",
+            self.grid_points
+        );
+        let files = self.files(site.dir).map_err(|e| anyhow::anyhow!("{at}.{e}"))?;
+        anyhow::ensure!(
+            files.len() >= 2,
+            "{at}.data: {} file; replicates need two files at least",
+            files.len()
+        );
+        for f in &files {
+            anyhow::ensure!(f.is_file(), "{at}.data: {} does not exist", f.display());
+        }
+        if let Some(p) = &self.published {
+            crate::records::published::read(&site.dir.join(&p.file), &p.format, &p.material, &p.measure)
+                .map_err(|e| anyhow::anyhow!("{at}.published: {e}"))?;
+        }
+        Ok(())
+    }
+
+    fn inputs(&self) -> Vec<PathBuf> {
+        let mut out: Vec<PathBuf> = match &self.data {
+            Files::Pattern(_) => Vec::new(),
+            Files::List(l) => l.iter().map(PathBuf::from).collect(),
+        };
+        out.extend(self.published.iter().map(|p| PathBuf::from(&p.file)));
+        out
+    }
+
+    fn run(
+        &self,
+        run: &Run,
+        _done: &[StepResult],
+        report: &mut String,
+    ) -> anyhow::Result<serde_json::Value> {
+        run_replicates(run, self, report)
+    }
+}
+
+/// One law's fits to the mean curve, pooled and per record.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct LawFits {
+    pub law: String,
+    pub names: Vec<String>,
+    pub units: Vec<String>,
+    /// The fit to the mean curve: values, SSE (MPa^2) and the database's AIC
+    /// (`n ln(SSE / n) + 2 k`, SSE in the published table's unit, kPa^2 by
+    /// default).
+    pub mean_curve: Vec<f64>,
+    pub mean_curve_sse: f64,
+    pub mean_curve_aic: f64,
+    pub mean_curve_converged: bool,
+    /// The initial shear modulus of each fit (MPa).
+    pub mu0_mean_curve: f64,
+    pub mu0_pooled: Option<f64>,
+    /// The per-record fits' mu0: mean and SD.
+    pub mu0_records_mean: Option<f64>,
+    pub mu0_records_sd: Option<f64>,
+    /// The published fit of this law, when the table has it.
+    pub published: Option<PublishedComparison>,
+    /// Pooled and per-record fits ([`Replicates`]), as serialised.
+    pub replicates: Option<serde_json::Value>,
+    /// The replicates' report table.
+    pub replicates_table: Option<String>,
+}
+
+/// A published fit beside palpate's fit to the same curve.
+#[derive(Debug, Clone, Serialize, Deserialize)]
+pub struct PublishedComparison {
+    /// The table's name of the law.
+    pub name: String,
+    /// Its parameters in palpate's convention (MPa).
+    pub values: Vec<f64>,
+    /// Its SSE as published, in the table's unit squared.
+    pub sse: f64,
+    /// Its AIC as published.
+    pub aic: Option<f64>,
+    /// Its parameters' SSE on palpate's mean curve, in the table's unit squared.
+    pub sse_here: f64,
+    /// palpate's SSE in the table's unit squared.
+    pub sse_palpate: f64,
+    /// The largest relative difference of a parameter.
+    pub max_relative_difference: f64,
+    /// `same` (every parameter to 4 significant digits, SSE within 1e-4),
+    /// `lower SSE` (palpate's optimum is better on the same curve) or
+    /// `higher SSE` (palpate missed the published optimum).
+    pub verdict: String,
+}
+
+/// palpate's fit against a published one on the same curve: every
+/// parameter within half a unit of the 4th significant digit and SSE within
+/// 1e-4 relative is `same`; a lower SSE (by more than 1e-4 relative) than
+/// the published parameters' on the same curve is `lower SSE`.
+pub fn verdict(
+    law: Law,
+    palpate: &[f64],
+    published: &[f64],
+    sse_palpate: f64,
+    sse_published_here: f64,
+) -> (f64, String) {
+    let max_rel = palpate
+        .iter()
+        .zip(published)
+        .map(|(a, b)| (a - b).abs() / b.abs().max(f64::MIN_POSITIVE))
+        .fold(0.0_f64, f64::max);
+    let same_sse = (sse_palpate - sse_published_here).abs() <= 1e-4 * sse_published_here;
+    let outside: Vec<String> = law
+        .params()
+        .iter()
+        .zip(published)
+        .filter(|(b, v)| **v < b.lower || **v > b.upper)
+        .map(|(b, v)| format!("{} = {} outside [{}, {}]", b.name, sig4(*v), b.lower, b.upper))
+        .collect();
+    let text = if max_rel <= 5e-4 && same_sse {
+        "same".to_string()
+    } else if sse_palpate < sse_published_here * (1.0 - 1e-4) {
+        "lower SSE".to_string()
+    } else if same_sse {
+        "same SSE, other parameters".to_string()
+    } else if !outside.is_empty() {
+        format!("higher SSE: the published optimum has {}, palpate's bounds", outside.join(", "))
+    } else {
+        "higher SSE".to_string()
+    };
+    (max_rel, text)
+}
+
+fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyhow::Result<serde_json::Value> {
+    let test = TestKind::parse(&step.test)?;
+    let files = step.files(run.manifest_dir)?;
+    let records: Vec<TestData> = files
+        .iter()
+        .map(|f| {
+            let mut r = TestData::read_with(&step.test, test, f, ReadOptions::default())?;
+            // names relative to the manifest, so that reports and cache keys
+            // do not depend on where the study is run from
+            r.file = f
+                .strip_prefix(run.manifest_dir)
+                .unwrap_or(f)
+                .display()
+                .to_string();
+            r.name = stem(&r.file);
+            Ok(r)
+        })
+        .collect::<anyhow::Result<_>>()
+        .with_context(|| format!("step `{}`", step.name))?;
+    let curve = mean_curve(&records, step.grid_points).with_context(|| format!("step `{}`", step.name))?;
+    let published = match &step.published {
+        Some(p) => crate::records::published::read(
+            &run.manifest_dir.join(&p.file),
+            &p.format,
+            &p.material,
+            &p.measure,
+        )?,
+        None => Vec::new(),
+    };
+    // the table's stress unit (kPa by default) for SSE and AIC
+    let unit = published.first().map(|p| p.stress_unit).unwrap_or(1e-3);
+    let mut fits = Vec::new();
+    for (text, law) in step.laws.iter().zip(step.laws()?) {
+        let per_record = step
+            .per_record_laws
+            .as_ref()
+            .is_none_or(|l| l.contains(text));
+        let label = format!("{}: {law}", step.name);
+        let inputs = ("replicates", &step.name, law.to_string(), &records, step.grid_points, per_record, &published);
+        let Some(f): Option<LawFits> = run.unit(&label, &inputs, || {
+            fit_law(law, &records, &curve, &published, unit, per_record)
+                .with_context(|| format!("step `{}`: {law}", step.name))
+        })?
+        else {
+            continue;
+        };
+        fits.push(f);
+    }
+    report.push_str(&replicates_report(step, &records, &curve, &published, unit, &fits));
+    let table = fits_csv(&fits, unit);
+    write_atomic(&run.out.join(format!("{}-fits.csv", step.name)), table.as_bytes())?;
+    Ok(serde_json::json!({
+        "name": step.name.clone(),
+        "records": records.iter().map(|r| r.file.clone()).collect::<Vec<_>>(),
+        "mean_curve": { "points": curve.points, "strain_max": curve.strain_max, "records": curve.records },
+        "laws": fits,
+    }))
+}
+
+/// The fits of one law.
+fn fit_law(
+    law: Law,
+    records: &[TestData],
+    curve: &MeanCurve,
+    published: &[PublishedFit],
+    unit: f64,
+    per_record: bool,
+) -> anyhow::Result<LawFits> {
+    let request = |fitted: &[TestData]| -> anyhow::Result<Calibration> {
+        calibrate(Request {
+            law,
+            model: None,
+            fitted,
+            predict: &[],
+            residual: ResidualKind::Absolute,
+            method: Method::LevenbergMarquardt(Default::default()),
+            fixed: Vec::new(),
+            observer: None,
+            viscous: None,
+        })
+    };
+    let mean = request(std::slice::from_ref(&curve.record)).context("the mean-curve fit")?;
+    let values: Vec<f64> = mean.params.iter().map(|(_, v)| v.value).collect();
+    // the stress of the law itself (its own checks, not the fit's bounds:
+    // a published fit may lie outside palpate's search box)
+    let TestKind::Homogeneous(mode) = curve.record.test else {
+        anyhow::bail!("the mean curve is not a homogeneous record");
+    };
+    let sse_of = |theta: &[f64]| -> anyhow::Result<f64> {
+        law.check(theta)?;
+        let mut sse = 0.0;
+        for (&l, o) in curve.record.loading.drive.iter().zip(&curve.record.observed) {
+            let p = match mode {
+                Mode::Uniaxial => homogeneous::uniaxial(&law, theta, l),
+                Mode::Equibiaxial => homogeneous::equibiaxial(&law, theta, l),
+                Mode::Planar => homogeneous::planar(&law, theta, l),
+            };
+            sse += (p - o) * (p - o);
+        }
+        anyhow::ensure!(sse.is_finite(), "{law} {theta:?}: the stress is not finite on the curve");
+        Ok(sse)
+    };
+    let sse = sse_of(&values)?;
+    let to_table = |s: f64| s / (unit * unit);
+    let k = law.param_count();
+    let comparison = match published.iter().find(|p| p.law == Some(law)) {
+        Some(p) => {
+            let theirs = p.params.clone().unwrap_or_default();
+            let here = to_table(sse_of(&theirs)?);
+            let (max_rel, verdict) = verdict(law, &values, &theirs, to_table(sse), here);
+            Some(PublishedComparison {
+                name: p.name.clone(),
+                values: theirs,
+                sse: p.sse,
+                aic: p.aic,
+                sse_here: here,
+                sse_palpate: to_table(sse),
+                max_relative_difference: max_rel,
+                verdict,
+            })
+        }
+        None => None,
+    };
+    let (mu0_pooled, mu0_mean, mu0_sd, reps, table) = if per_record && records.len() >= 2 {
+        let pooled = request(records).context("the pooled fit")?;
+        let reps = analyse(law, records, &pooled)?;
+        let theta: Vec<f64> = pooled.params.iter().map(|(_, v)| v.value).collect();
+        let mu0s: Vec<f64> = reps.fits.iter().map(|f| law.shear_modulus(&f.values)).collect();
+        let (m, v) = mean_var(&mu0s);
+        (
+            Some(law.shear_modulus(&theta)),
+            Some(m),
+            Some(v.sqrt()),
+            Some(serde_json::to_value(&reps)?),
+            Some(reps.table()),
+        )
+    } else {
+        (None, None, None, None, None)
+    };
+    Ok(LawFits {
+        law: law.to_string(),
+        names: mean.params.iter().map(|(n, _)| n.clone()).collect(),
+        units: mean.params.iter().map(|(_, v)| v.unit.clone()).collect(),
+        mean_curve_aic: crate::records::published::aic(to_table(sse), curve.points, k),
+        mean_curve: values.clone(),
+        mean_curve_sse: sse,
+        mean_curve_converged: mean.converged,
+        mu0_mean_curve: law.shear_modulus(&values),
+        mu0_pooled,
+        mu0_records_mean: mu0_mean,
+        mu0_records_sd: mu0_sd,
+        published: comparison,
+        replicates: reps,
+        replicates_table: table,
+    })
+}
+
+fn unit_name(unit: f64) -> &'static str {
+    if unit == 1.0 {
+        "MPa"
+    } else if unit == 1e-6 {
+        "Pa"
+    } else {
+        "kPa"
+    }
+}
+
+/// The step's section of the report.
+fn replicates_report(
+    step: &ReplicatesStep,
+    records: &[TestData],
+    curve: &MeanCurve,
+    published: &[PublishedFit],
+    unit: f64,
+    fits: &[LawFits],
+) -> String {
+    let u = unit_name(unit);
+    let mut out = format!("\n## replicates `{}`\n\n", step.name);
+    out.push_str(&format!(
+        "{} records: {}\n\nmean curve: {}\n",
+        records.len(),
+        records.iter().map(|r| stem(&r.file)).collect::<Vec<_>>().join(", "),
+        curve.describe()
+    ));
+    if let Some(p) = &step.published {
+        out.push_str(&format!(
+            "\n### fits to the mean curve beside the published table ({}, {} `{}`, {})\n\n",
+            p.file, p.format, p.material, p.measure
+        ));
+    } else {
+        out.push_str("\n### fits to the mean curve\n\n");
+    }
+    out.push_str(&format!(
+        "SSE in {u}^2 over the {} grid points; AIC = n ln(SSE / n) + 2 k; parameters in palpate's convention (MPa)\n\n",
+        curve.points
+    ));
+    out.push_str("| law | parameters (palpate) | SSE | AIC | published (converted) | published SSE | its SSE here | published AIC | max rel. diff. | verdict |\n");
+    out.push_str("|---|---|---|---|---|---|---|---|---|---|\n");
+    for f in fits {
+        let ours = params_text(&f.names, &f.mean_curve);
+        match &f.published {
+            Some(c) => out.push_str(&format!(
+                "| {} | {} | {:.4} | {:.3} | {} | {:.4} | {:.4} | {} | {:.1e} | {} |\n",
+                f.law,
+                ours,
+                f.mean_curve_sse / (unit * unit),
+                f.mean_curve_aic,
+                params_text(&f.names, &c.values),
+                c.sse,
+                c.sse_here,
+                c.aic.map(|a| format!("{a:.3}")).unwrap_or_else(|| "-".into()),
+                c.max_relative_difference,
+                c.verdict
+            )),
+            None => out.push_str(&format!(
+                "| {} | {} | {:.4} | {:.3} | - | - | - | - | - | not in the table |\n",
+                f.law,
+                ours,
+                f.mean_curve_sse / (unit * unit),
+                f.mean_curve_aic
+            )),
+        }
+    }
+    let missing: Vec<&str> = published
+        .iter()
+        .filter(|p| p.law.is_none())
+        .map(|p| p.name.as_str())
+        .collect();
+    if !missing.is_empty() {
+        out.push_str(&format!(
+            "\npublished laws palpate does not have: {}\n",
+            missing.join(", ")
+        ));
+    }
+    if fits.iter().any(|f| f.mu0_pooled.is_some()) {
+        out.push_str("\n### initial shear modulus mu0 (MPa): mean curve, pooled records, per-record fits\n\n");
+        out.push_str("| law | mean curve | pooled | pooled / mean curve - 1 | per-record mean | SD | per-record mean / mean curve - 1 |\n|---|---|---|---|---|---|---|\n");
+        for f in fits {
+            if let (Some(p), Some(m), Some(s)) = (f.mu0_pooled, f.mu0_records_mean, f.mu0_records_sd) {
+                out.push_str(&format!(
+                    "| {} | {} | {} | {:+.2} % | {} | {} | {:+.2} % |\n",
+                    f.law,
+                    sig4(f.mu0_mean_curve),
+                    sig4(p),
+                    100.0 * (p / f.mu0_mean_curve - 1.0),
+                    sig4(m),
+                    sig4(s),
+                    100.0 * (m / f.mu0_mean_curve - 1.0)
+                ));
+            }
+        }
+        for f in fits {
+            if let Some(t) = &f.replicates_table {
+                out.push_str(&format!("\n```{t}```\n"));
+            }
+        }
+    }
+    out
+}
+
+fn params_text(names: &[String], values: &[f64]) -> String {
+    names
+        .iter()
+        .zip(values)
+        .map(|(n, v)| format!("{n} {}", sig4(*v)))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// The table of fits: one row per law and kind of fit (the parameters in
+/// palpate's convention, MPa).
+fn fits_csv(fits: &[LawFits], unit: f64) -> String {
+    let mut out = format!(
+        "law,fit,parameters,values,sse_{u}2,aic,mu0_MPa\n",
+        u = unit_name(unit)
+    );
+    for f in fits {
+        let join = |v: &[f64]| v.iter().map(|x| format!("{x:.9e}")).collect::<Vec<_>>().join(" ");
+        let names = f.names.join(" ");
+        out.push_str(&format!(
+            "{},mean curve,{names},{},{:.6},{:.4},{:.9e}\n",
+            f.law,
+            join(&f.mean_curve),
+            f.mean_curve_sse / (unit * unit),
+            f.mean_curve_aic,
+            f.mu0_mean_curve
+        ));
+        if let Some(c) = &f.published {
+            out.push_str(&format!(
+                "{},published ({}),{names},{},{:.6},{},{:.9e}\n",
+                f.law,
+                c.name,
+                join(&c.values),
+                c.sse,
+                c.aic.map(|a| format!("{a:.4}")).unwrap_or_default(),
+                f.law
+                    .parse::<Law>()
+                    .map(|l| l.shear_modulus(&c.values))
+                    .unwrap_or(f64::NAN)
+            ));
+        }
+        if let Some(p) = f.mu0_pooled {
+            out.push_str(&format!("{},pooled,,,,,{p:.9e}\n", f.law));
+        }
+        if let (Some(m), Some(s)) = (f.mu0_records_mean, f.mu0_records_sd) {
+            out.push_str(&format!("{},per-record mean,,,,,{m:.9e}\n", f.law));
+            out.push_str(&format!("{},per-record SD,,,,,{s:.9e}\n", f.law));
+        }
+    }
+    out
+}
+
+/// The hierarchical posterior of replicates' parameters: each record
+/// fitted alone, then the population mean `mu` and between-test SD `tau`
+/// of each parameter sampled ([`RandomEffects`]; prior scale of `tau`: the
+/// largest |estimate| of the parameter).
+pub fn hierarchical(
+    law: Law,
+    records: &[TestData],
+    seed: u64,
+    max_draws: usize,
+) -> anyhow::Result<(Replicates, HierarchicalPosterior)> {
+    let fitted = |fitted: &[TestData]| {
+        calibrate(Request {
+            law,
+            model: None,
+            fitted,
+            predict: &[],
+            residual: ResidualKind::Absolute,
+            method: Method::LevenbergMarquardt(Default::default()),
+            fixed: Vec::new(),
+            observer: None,
+            viscous: None,
+        })
+    };
+    let pooled = fitted(records).context("the pooled fit")?;
+    let reps = analyse(law, records, &pooled)?;
+    let estimates: Vec<Vec<f64>> = reps.fits.iter().map(|f| f.values.clone()).collect();
+    let standard_errors: Vec<Vec<f64>> = reps
+        .fits
+        .iter()
+        .map(|f| f.standard_errors.iter().map(|s| s.unwrap_or(0.0)).collect())
+        .collect();
+    let tau_scale = (0..reps.names.len())
+        .map(|j| {
+            estimates
+                .iter()
+                .map(|y| y[j].abs())
+                .fold(0.0, f64::max)
+                .max(f64::MIN_POSITIVE)
+        })
+        .collect();
+    let model = RandomEffects {
+        names: reps.names.clone(),
+        estimates,
+        standard_errors,
+        tau_scale,
+    };
+    let post = model
+        .sample(seed, max_draws)
+        .map_err(|e| anyhow::anyhow!("the hierarchical posterior: {e}"))?;
+    Ok((reps, post))
+}
+
+/// The hierarchical posterior as a table: per parameter the population
+/// mean and between-test SD (posterior mean, 94 % HDI, R-hat) beside the
+/// per-record fits' mean and SD.
+pub fn hierarchical_table(law: Law, post: &HierarchicalPosterior) -> String {
+    let mut out = format!(
+        "\nhierarchical posterior of {law} over {} records (theta_i ~ N(mu, tau^2); each record's fit with its standard error):\n",
+        post.tests
+    );
+    out.push_str(&format!(
+        "{:<10} {:>12} {:>25} {:>12} {:>25} {:>12} {:>12} {:>8}\n",
+        "parameter", "mu", "mu 94% HDI", "tau", "tau 94% HDI", "fits mean", "fits SD", "R-hat"
+    ));
+    for p in &post.parameters {
+        out.push_str(&format!(
+            "{:<10} {:>12} {:>25} {:>12} {:>25} {:>12} {:>12} {:>8.4}\n",
+            p.name,
+            sig4(p.mu.mean),
+            format!("[{}, {}]", sig4(p.mu.hdi_3), sig4(p.mu.hdi_97)),
+            sig4(p.tau.mean),
+            format!("[{}, {}]", sig4(p.tau.hdi_3), sig4(p.tau.hdi_97)),
+            sig4(p.estimates_mean),
+            sig4(p.estimates_sd),
+            p.mu.rhat.max(p.tau.rhat)
+        ));
+    }
+    out.push_str(&format!(
+        "{} chains x {} draws, max R-hat {:.4}{}\n",
+        post.chains,
+        post.draws_per_chain,
+        post.rhat_max,
+        if post.converged {
+            ""
+        } else {
+            " (NOT CONVERGED: the cap of draws was reached)"
+        }
+    ));
+    out
 }
 
 #[cfg(test)]

@@ -6,7 +6,7 @@
 //! returns a [`CheckedManifest`], the only form the runner takes. Steps are
 //! an externally tagged enum ([`StepEntry`], the registry of
 //! [`crate::steps`]), so each `[[steps]]` table holds exactly one of
-//! `calibrate`, `diagnose`, `predict`, `anova`, `two_stage`, `localize` or
+//! `calibrate`, `diagnose`, `predict`, `anova`, `two_stage`, `localize`, `replicates` or
 //! `sample`; each kind checks itself ([`crate::run::step::Step::validate`]).
 //!
 //! ```toml

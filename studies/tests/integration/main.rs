@@ -22,6 +22,7 @@ mod localize_units;
 mod manifest_properties;
 mod mesa2011;
 mod models;
+mod phantom_database;
 mod real_data;
 mod real_data_fits;
 mod run_study;

@@ -8,8 +8,11 @@
 //! * [`fit_and_laplace`]: least-squares fit, Laplace approximation, chain start.
 //! * [`thermodynamic_integration`]: evidence by power posteriors.
 //! * [`predictive_band`]: posterior predictive bands.
+//! * [`RandomEffects`]: the hierarchical posterior of replicates (population
+//!   mean and between-test SD of each parameter).
 
 pub mod evidence;
+pub mod hierarchical;
 pub mod map_start;
 pub mod noise;
 pub mod posterior;
@@ -17,6 +20,7 @@ pub mod predictive;
 pub mod prior;
 
 pub use evidence::{thermodynamic_integration, ThermodynamicEvidence};
+pub use hierarchical::{HierarchicalPosterior, Population, RandomEffects};
 pub use map_start::{fit_and_laplace, PosteriorStart, StartError};
 pub use noise::{
     ar1_log_likelihood, gaussian_log_likelihood, gaussian_log_likelihood_with_model_error,
