@@ -54,7 +54,7 @@ use crate::experiment::{
     CylinderKinematics, ElementSpec, Experiment, MaterialSpec, Specimen, SupportSpec, Tool, Value,
 };
 use crate::model::{FeModel, PlaneCell, Setup, Support};
-use crate::n1::{prony_of, BandMaterial, N1Needle, N1Setup, Sizing};
+use crate::n1::{prony_of, BandMaterial, EdgeBand, N1Needle, N1Setup, Sizing};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
 use crate::FeError;
@@ -63,6 +63,10 @@ use crate::FeError;
 pub type CylinderSetup = N1Setup;
 /// The axisymmetric cylinder as a forward model.
 pub type Cylinder = N1Needle;
+
+/// The growth of the elements away from a flat punch's rim per unit
+/// distance ([`EdgeBand::slope`]).
+pub const EDGE_SLOPE: f64 = 0.5;
 
 /// The default mesh level of a description without `mesh.level`.
 pub const DEFAULT_LEVEL: f64 = 2.0;
@@ -419,6 +423,19 @@ impl N1Setup {
         m.fine_zone = sizing.fine_zone;
         m.sizing = Some(sizing);
         m.element = element;
+        // the punch's rim: a band graded to half its rounding (at most a
+        // quarter of the fine size) at level 1
+        if let ToolShape::FlatPunch {
+            radius: a,
+            edge_radius: rho,
+        } = tool
+        {
+            m.edge_band = Some(EdgeBand {
+                r: a,
+                h: (0.5 * rho).min(0.25 * sizing.h),
+                slope: EDGE_SLOPE,
+            });
+        }
         m.prony = prony;
         m.prony_parameters = prony_parameters;
         m.layers = layers;

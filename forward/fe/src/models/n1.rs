@@ -45,6 +45,7 @@ use crate::dofs::Dirichlet;
 use crate::kernel::kernel_for;
 use crate::kinematics::Kinematics;
 use crate::material::LawMaterial;
+use crate::mesh::grading::refine_towards;
 use crate::mesh::{Grading, Mesh};
 use crate::model::{
     doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup, Support,
@@ -178,6 +179,25 @@ pub struct N1Setup {
     /// The name of the law's material (the prefix of its parameters when
     /// there are band materials).
     pub first_material: String,
+    /// A band of the mesh graded towards a tool's edge (a flat punch's);
+    /// `None`: the grading alone.
+    pub edge_band: Option<EdgeBand>,
+}
+
+/// The mesh about a tool's edge, where the contact pressure is singular (a
+/// flat punch's rim at radius `r` on the top face): the radial mesh lines
+/// about `r` and the axial ones under the top are split to elements of `h`
+/// mm there, growing by about `1 + slope` per element until they meet the
+/// grading's ([`crate::mesh::grading::refine_towards`]), as Q1 refines its
+/// punch edge ([`crate::Q1Setup::edge_refinement`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EdgeBand {
+    /// Radius of the edge (mm).
+    pub r: f64,
+    /// Element size at the edge (mm).
+    pub h: f64,
+    /// Growth of the size per unit distance from the edge.
+    pub slope: f64,
 }
 
 /// A material of a band after the law's ([`N1Setup::layers`]).
@@ -290,6 +310,7 @@ impl N1Needle {
             sizing: None,
             space: None,
             first_material: "body".into(),
+            edge_band: None,
         })
     }
 
@@ -314,8 +335,12 @@ impl N1Needle {
     /// elements growing by 1.4.
     pub fn coarser(&self) -> Coarser<N1Needle> {
         let coarse = doubled(self.effective_grading());
+        let edge = self.edge_band.map_or(0.0, |b| self.edge_size(&b));
         self.companion(2.0, graded_mesh_words(coarse, "tool"), |s| {
-            s.grading = Some(coarse)
+            s.grading = Some(coarse);
+            if let Some(b) = &mut s.edge_band {
+                b.h = 2.0 * edge;
+            }
         })
     }
 }
@@ -324,10 +349,27 @@ impl N1Setup {
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
-        let m = Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?;
+        let m = match self.edge_band {
+            None => Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?,
+            Some(b) => {
+                let h = self.edge_size(&b);
+                let rs = refine_towards(&g.positions(self.radius)?, b.r, h, b.slope);
+                let zs = refine_towards(&g.positions(self.height)?, 0.0, h, b.slope);
+                Mesh::lines_in_layers(&rs, &zs, self.height, &self.interfaces())?
+            }
+        };
         match self.element {
             PlaneCell::Quad4 => Ok(m),
             PlaneCell::Quad9 => m.to_quadratic(),
+        }
+    }
+
+    /// The element size at a tool's edge (mm): the band's `h` at the
+    /// sizing rule's level (`h / level`), `h` without a rule.
+    fn edge_size(&self, b: &EdgeBand) -> f64 {
+        match (self.grading, self.sizing) {
+            (None, Some(s)) => b.h / s.level,
+            _ => b.h,
         }
     }
 
@@ -764,6 +806,14 @@ impl Setup for N1Setup {
                 ", {:?} mesh of {}",
                 self.element,
                 graded_mesh_words(self.effective_grading(), "tool")
+            );
+        }
+        if let Some(b) = &self.edge_band {
+            name += &format!(
+                ", refined to {} mm at the tool's edge (r = {} mm, slope {})",
+                self.edge_size(b),
+                b.r,
+                b.slope
             );
         }
         name
