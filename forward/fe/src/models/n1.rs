@@ -31,7 +31,8 @@
 //!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
 
 use palpate_core::{
-    enrichable::not_applicable, Effect, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec,
+    enrichable::not_applicable, Drive, Effect, ForwardError, ForwardModel, Loading, ParamSpace,
+    ParamSpec,
 };
 use palpate_enrich::{prony_params, richer_law, MaterialForm, ZeroOffset};
 use palpate_material::Law;
@@ -48,10 +49,12 @@ use crate::material::LawMaterial;
 use crate::mesh::grading::refine_towards;
 use crate::mesh::{Grading, Mesh};
 use crate::model::{
-    doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup, Support,
+    doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, Path, PlaneCell, Setup,
+    Support,
 };
 use crate::motion::ToolMotion;
 use crate::surface::{Floor2d, Profile2d};
+use crate::stepper::LoadPath;
 use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
@@ -182,6 +185,11 @@ pub struct N1Setup {
     /// A band of the mesh graded towards a tool's edge (a flat punch's);
     /// `None`: the grading alone.
     pub edge_band: Option<EdgeBand>,
+    /// The body is the upper half of a specimen compressed between two
+    /// identical platens (a mirror plane at the base): the drive is the
+    /// platens' travel, twice the half model's, and the force is the
+    /// whole specimen's (the same through every horizontal section).
+    pub mirror: bool,
 }
 
 /// The mesh about a tool's edge, where the contact pressure is singular (a
@@ -311,6 +319,7 @@ impl N1Needle {
             space: None,
             first_material: "body".into(),
             edge_band: None,
+            mirror: false,
         })
     }
 
@@ -370,6 +379,16 @@ impl N1Setup {
         match (self.grading, self.sizing) {
             (None, Some(s)) => b.h / s.level,
             _ => b.h,
+        }
+    }
+
+    /// The drive (the tool's or the platens' travel) over the modelled
+    /// body's: 2 for the upper half of a mirrored specimen, else 1.
+    fn drive_scale_inverse(&self) -> f64 {
+        if self.mirror {
+            2.0
+        } else {
+            1.0
         }
     }
 
@@ -587,17 +606,44 @@ impl Setup for N1Setup {
                 "a viscoelastic material needs the time of each sample".into(),
             ));
         }
+        let reach = self.drive_scale_inverse() * self.height;
         if let Some(&d) = loading
             .drive
             .iter()
-            .find(|&&d| !(d.is_finite() && d < self.height))
+            .find(|&&d| !(d.is_finite() && d < reach))
         {
-            return Err(ForwardError::InvalidLoading(format!(
-                "a depth of {d} mm: the tool must stay above the base ({} mm below the top)",
-                self.height
-            )));
+            return Err(ForwardError::InvalidLoading(if self.mirror {
+                format!("a travel of {d} mm: the platens must stay apart (the specimen is {reach} mm high)")
+            } else {
+                format!(
+                    "a depth of {d} mm: the tool must stay above the base ({} mm below the top)",
+                    self.height
+                )
+            }));
         }
         Ok(())
+    }
+    /// The default path ([`Setup::path`]) of the tool's travel in the
+    /// modelled body: half the platens' travel for a mirrored half.
+    fn path(&self, loading: &Loading, opts: &SolverOptions) -> Result<Path, ForwardError> {
+        if loading.drive_kind != Drive::DisplacementMm {
+            return Err(ForwardError::InvalidLoading(format!(
+                "FE models are driven by {}, got {}",
+                Drive::DisplacementMm.column(),
+                loading.drive_kind.column()
+            )));
+        }
+        let scale = 1.0 / self.drive_scale_inverse();
+        let drive: Vec<f64> = loading.drive.iter().map(|d| scale * d).collect();
+        Ok(Path {
+            path: LoadPath::from_loading(
+                &drive,
+                loading.time.as_deref(),
+                opts.max_step,
+                opts.max_time_step,
+            ),
+            preload: 0,
+        })
     }
     fn build(&self) -> Result<(System, N1Parts), FeError> {
         if !(self.friction >= 0.0) {
@@ -614,8 +660,19 @@ impl Setup for N1Setup {
                 });
             }
         }
-        let mesh = self.build_mesh()?;
+        let mut mesh = self.build_mesh()?;
         let kin = Kinematics::Axisymmetric;
+        // A platen also meets the free side where it bulges and folds over
+        // onto the platen (bonded or rough platens at large compression).
+        let surface = if self.tool == ToolShape::Platen {
+            let (top, side) = (mesh.facet_set("top")?, mesh.facet_set("side")?);
+            let mut both = top.clone();
+            both.nodes.extend_from_slice(&side.nodes);
+            mesh.facet_sets.insert("top_and_side".into(), both);
+            "top_and_side"
+        } else {
+            "top"
+        };
         let regions = self.regions();
         let region_refs: Vec<&str> = regions.iter().map(String::as_str).collect();
         let body = SolidBody::new(
@@ -649,7 +706,7 @@ impl Setup for N1Setup {
             Box::new(Profile2d(self.tool)),
             motion,
             &mesh,
-            "top",
+            surface,
             kin,
             options,
             1,
@@ -806,6 +863,12 @@ impl Setup for N1Setup {
                 ", {:?} mesh of {}",
                 self.element,
                 graded_mesh_words(self.effective_grading(), "tool")
+            );
+        }
+        if self.mirror {
+            name += &format!(
+                ", the upper half ({} mm) of a specimen between two identical platens",
+                self.height
             );
         }
         if let Some(b) = &self.edge_band {
