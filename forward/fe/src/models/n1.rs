@@ -53,8 +53,8 @@ use crate::model::{
     Support,
 };
 use crate::motion::ToolMotion;
-use crate::surface::{Floor2d, Profile2d};
 use crate::stepper::LoadPath;
+use crate::surface::{Floor2d, Profile2d};
 use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
