@@ -354,15 +354,18 @@ fn two_identical_platens_model_the_upper_half() {
             "d = {d}: {f} vs {expected}"
         );
     }
-    // a travel as deep as the specimen is refused with the specimen's height
-    let e = m
-        .predict(
-            &[C10],
-            &Loading::quasi_static(Drive::DisplacementMm, vec![9.0]),
-        )
-        .unwrap_err()
-        .to_string();
-    assert!(e.contains("9 mm high"), "{e}");
+    // a travel as deep as the whole specimen is refused by the description
+    let e = N1Needle::from_experiment(&experiment(&cylinder(
+        r,
+        h,
+        "\"symmetry\"",
+        "shape = \"platens\"",
+        9.0,
+        "level = 1",
+    )))
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("reaches the base of a 9 mm specimen"), "{e}");
 }
 
 /// Tool friction "bonded" is the limit of a growing coefficient, and a
