@@ -7,9 +7,10 @@ usage: post.py DECK.dat --out CURVE.csv [--note TEXT]
 
 Indentation decks (a tool node set NTOOL only): displacement = the second
 step's time (mm) less the tool's initial gap (`** GAP g` in NAME.inp).
-Cylinder decks (sets TOP and NTOOL): the force is TOP's reaction plus the
-platen strip's; displacement = 12 mm x step time (the
-platens' travel). NAME.sta and NAME.time (from run.sh) beside the .dat give
+Cylinder decks (`** TRAVEL t` in NAME.inp, else sets TOP and NTOOL with
+t = 12 mm): the force is TOP's reaction (bonded or frictionless platens)
+plus the platen strip's; displacement = t x step time (the platens'
+travel). NAME.sta and NAME.time (from run.sh) beside the .dat give
 increments, iterations and CPU seconds.
 """
 import argparse
@@ -25,20 +26,28 @@ def main():
     ap.add_argument("--note", action="append", default=[])
     a = ap.parse_args()
     text = open(a.dat).read()
+    inp = a.dat[:-4] + ".inp"
+    travel, gap = None, 0.0
+    if os.path.exists(inp):
+        for ln in open(inp):
+            if ln.startswith("** TRAVEL"):
+                travel = float(ln.split()[2])
+            elif ln.startswith("** GAP"):
+                gap = float(ln.split()[2])
     if "for set TOP and time" in text:
-        top = curve(a.dat, "TOP", t0=1.0, scale=12.0)
-        fold = dict(curve(a.dat, "NTOOL", t0=1.0, scale=12.0))
+        travel = travel or 12.0
+        top = curve(a.dat, "TOP", t0=1.0, scale=travel)
+        fold = dict(curve(a.dat, "NTOOL", t0=1.0, scale=travel))
         rows = [(d, f + fold.get(d, 0.0)) for d, f in top]
         extra = [f"of which the fold on the platen beyond r = 25 mm: {fold.get(rows[-1][0], 0):.6g} N "
                  f"at {rows[-1][0]:g} mm"]
+    elif travel is not None:            # the platen in contact over the top face
+        # the half model's platen moves travel / 2 + gap: whole-body travel
+        # (travel + 2 gap) (t - 1) - 2 gap
+        rows = curve(a.dat, "NTOOL", t0=1.0 + 2 * gap / (travel + 2 * gap),
+                     scale=travel + 2 * gap)
+        extra = [f"platen gap {gap:g} mm (half model) subtracted"] if gap else []
     else:
-        gap = 0.0
-        inp = a.dat[:-4] + ".inp"
-        if os.path.exists(inp):
-            for ln in open(inp):
-                if ln.startswith("** GAP"):
-                    gap = float(ln.split()[2])
-                    break
         rows = curve(a.dat, "NTOOL", t0=1.0 + gap)
         extra = [f"tool gap {gap:g} mm subtracted"] if gap else []
     rows = [(round(d, 4), f) for d, f in rows]

@@ -102,7 +102,7 @@ pub use error::FeError;
 pub use line_search::LineSearch;
 pub use material::LawMaterial;
 pub use model::{Bulk, FeModel, PlaneCell, Setup, Simulation, Support};
-pub use n1::{BandMaterial, MeshDensity, N1Needle, N1Setup, Sizing};
+pub use n1::{BandMaterial, EdgeBand, MeshDensity, N1Needle, N1Setup, Sizing};
 pub use n3::{
     n3_core_cells, n3_grading, n3_quadratic_grading, N3Element, N3Mesh, N3Needle, N3Setup,
 };

@@ -89,21 +89,8 @@ fn assert_recovered(fit: &serde_json::Value, truth: &[(&str, f64)]) {
     }
 }
 
-const GEL: &str = r#"
-[specimen]
-shape = "cylinder"
-radius = 20.0
-height = 10.0
-support = "bonded"
-
-[materials.gel]
-law = "neo-hookean"
-C10 = { start = 2e-3 }
-
-[tool]
-shape = "sphere"
-radius = 2.5
-"#;
+/// The gel disc as shipped (`studies/experiments/gel-disc.toml`).
+const GEL: &str = include_str!("../../experiments/gel-disc.toml");
 
 /// The `[mesh]` table of the fit (4-node elements at level 1, the
 /// coarsest) and of the record (level 2: elements half as large).

@@ -118,21 +118,8 @@ fn simulate_refuses_benchmark_options_with_an_experiment() {
     assert_clean_failure(&o, &["--experiment", "--law"]);
 }
 
-const GEL: &str = r#"
-[specimen]
-shape = "cylinder"
-radius = 20.0
-height = 10.0
-support = "bonded"
-
-[materials.gel]
-law = "neo-hookean"
-C10 = { start = 2e-3 }
-
-[tool]
-shape = "sphere"
-radius = 2.5
-"#;
+/// The gel disc as shipped (`studies/experiments/gel-disc.toml`).
+const GEL: &str = include_str!("../../experiments/gel-disc.toml");
 
 fn manifest(dir: &Path, experiment: &str, model: &str) -> std::path::PathBuf {
     std::fs::write(

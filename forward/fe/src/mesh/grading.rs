@@ -90,9 +90,66 @@ impl Grading {
     }
 }
 
+/// The node positions `xs` (increasing) with each interval split into
+/// equal parts no longer than the local size `h_min + slope * dist`,
+/// `dist` the interval's distance from `centre` (0 for the interval that
+/// holds it): a band graded towards `centre` (a punch edge), from `h_min`
+/// there growing by about `1 + slope` per element until it meets the
+/// spacing of `xs`, which it never coarsens.
+pub fn refine_towards(xs: &[f64], centre: f64, h_min: f64, slope: f64) -> Vec<f64> {
+    let mut out = Vec::with_capacity(xs.len());
+    if let Some(&first) = xs.first() {
+        out.push(first);
+    }
+    for w in xs.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let dist = if centre < a {
+            a - centre
+        } else if centre > b {
+            centre - b
+        } else {
+            0.0
+        };
+        let h = h_min + slope * dist;
+        let n = if h > 0.0 && h.is_finite() {
+            (((b - a) / h) - 1e-9).ceil().max(1.0) as usize
+        } else {
+            1
+        };
+        for k in 1..n {
+            out.push(a + (b - a) * k as f64 / n as f64);
+        }
+        out.push(b);
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn refinement_towards_a_point_is_fine_there_and_keeps_the_nodes() {
+        let xs: Vec<f64> = (0..=20).map(|k| 0.1 * k as f64).collect();
+        let r = refine_towards(&xs, 1.0, 0.01, 0.5);
+        for x in &xs {
+            assert!(r.iter().any(|y| (y - x).abs() < 1e-12), "{x} kept");
+        }
+        assert!(r.windows(2).all(|w| w[1] > w[0]));
+        // elements of 0.01 on both sides of 1.0, coarser away from it
+        let at = |x: f64| {
+            r.windows(2)
+                .find(|w| w[0] <= x && x < w[1])
+                .map(|w| w[1] - w[0])
+                .unwrap()
+        };
+        assert!((at(0.995) - 0.01).abs() < 1e-9, "{}", at(0.995));
+        assert!((at(1.005) - 0.01).abs() < 1e-9, "{}", at(1.005));
+        assert!(at(1.15) > 0.04 && at(1.15) <= 0.1, "{}", at(1.15));
+        assert!((at(1.85) - 0.1).abs() < 1e-9);
+        // a centre outside leaves the far intervals alone
+        assert_eq!(refine_towards(&xs, 10.0, 0.01, 0.5), xs);
+    }
 
     #[test]
     fn grading_covers_the_length_and_grows() {

@@ -48,6 +48,29 @@ impl Mesh {
         if interfaces.is_empty() {
             return Self::graded_rectangle(width, height, radial, axial);
         }
+        Self::lines_in_layers(
+            &radial.positions(width)?,
+            &axial.positions(height)?,
+            height,
+            interfaces,
+        )
+    }
+
+    /// [`Mesh::graded_layers`] on given mesh lines: radial positions `rs`
+    /// from the axis and axial ones `from_top` (depths below the top, from
+    /// 0 to `height`), e.g. a grading refined about a punch edge
+    /// ([`super::grading::refine_towards`]). Without interfaces, one region
+    /// `body`.
+    pub fn lines_in_layers(
+        rs: &[f64],
+        from_top: &[f64],
+        height: f64,
+        interfaces: &[f64],
+    ) -> Result<Mesh, FeError> {
+        if interfaces.is_empty() {
+            let zs: Vec<f64> = from_top.iter().rev().map(|t| height - t).collect();
+            return Ok(Self::tensor(rs, &zs));
+        }
         let bad = |reason: String| FeError::InvalidMesh {
             field: "interfaces".into(),
             reason,
@@ -61,9 +84,9 @@ impl Mesh {
             }
             last = t;
         }
-        let from_top = with_lines(&axial.positions(height)?, interfaces);
+        let from_top = with_lines(from_top, interfaces);
         let zs: Vec<f64> = from_top.iter().rev().map(|t| height - t).collect();
-        let mut m = Self::tensor(&radial.positions(width)?, &zs);
+        let mut m = Self::tensor(rs, &zs);
         let mut bands: Vec<Vec<usize>> = vec![Vec::new(); interfaces.len() + 1];
         for e in 0..m.cell_count() {
             let yc = m.cell(e).iter().map(|&n| m.nodes[n][1]).sum::<f64>() / 4.0;

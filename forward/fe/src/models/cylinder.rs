@@ -9,17 +9,17 @@
 //! * **Tools** (on the axis): a sphere, a cone (a needle profile: a
 //!   spherical tip tangent to the cone; `tip_radius` defaults to 1e-3 of
 //!   the design depth, a sharp cone), N1's needle, a flat punch (edge radius
-//!   default a tenth of the radius), or a platen over the whole top. The
+//!   default a tenth of the radius), or a platen over the whole top (in contact with the top and the free side, onto which the side folds at large compression). The
 //!   tool's Coulomb friction is a number, a parameter (`friction`), or
 //!   `"bonded"`: an infinite coefficient, so that a surface point sticks to
 //!   the tool where it first touches it and never slips (the return map
 //!   never leaves its stick branch).
 //! * **Supports** of the base: `bonded` (fixed), `sliding` (`u_z = 0`),
-//!   `symmetry` (a mirror plane: also `u_z = 0` with `u_r` free; for a
-//!   cylinder compressed between two identical platens the description is
-//!   the half above the mid-plane, its `height` half the specimen's and the
-//!   depth the upper platen's travel towards the mid-plane, half the
-//!   total), or `{ friction = .. }`: the base rests on a fixed rigid plane
+//!   `symmetry` (a mirror plane: also `u_z = 0` with `u_r` free; with
+//!   platens, a cylinder compressed between two identical platens: the
+//!   description gives the whole specimen's `height` and the platens'
+//!   travel, and the model is the upper half above the mid-plane, moved by
+//!   half the travel), or `{ friction = .. }`: the base rests on a fixed rigid plane
 //!   (unilateral contact) with Coulomb friction, a number or a parameter
 //!   (`base_friction`; `"bonded"` is the bonded support).
 //! * **Materials**: the first material (in [`Experiment::material_order`])
@@ -42,7 +42,7 @@
 //!   | sphere `R` | `sqrt(R d)` (at most `R`) | `2 a` | `a / 5` | `R / 10` |
 //!   | cone `alpha`, tip `rho` | `2 d tan(alpha) / pi + rho` | `2 a` | `a / 5` | `height / 10` |
 //!   | flat punch `a`, edge `rho` | `a` | `1.5 a` | `a / 10` | `a / 10` |
-//!   | platens | | the whole body | `min(radius, height) / 8`, uniform | `0.3 height` |
+//!   | platens | | the whole body | `min(radius, height) / 8`, uniform (`height` the modelled half's when mirrored) | `0.3 height` |
 //!
 //!   A zone larger than the body is the whole body.
 
@@ -54,7 +54,7 @@ use crate::experiment::{
     CylinderKinematics, ElementSpec, Experiment, MaterialSpec, Specimen, SupportSpec, Tool, Value,
 };
 use crate::model::{FeModel, PlaneCell, Setup, Support};
-use crate::n1::{prony_of, BandMaterial, N1Needle, N1Setup, Sizing};
+use crate::n1::{prony_of, BandMaterial, EdgeBand, N1Needle, N1Setup, Sizing};
 use crate::tool::ToolShape;
 use crate::viscoelastic::Prony;
 use crate::FeError;
@@ -63,6 +63,10 @@ use crate::FeError;
 pub type CylinderSetup = N1Setup;
 /// The axisymmetric cylinder as a forward model.
 pub type Cylinder = N1Needle;
+
+/// The growth of the elements away from a flat punch's rim per unit
+/// distance ([`EdgeBand::slope`]).
+pub const EDGE_SLOPE: f64 = 0.5;
 
 /// The default mesh level of a description without `mesh.level`.
 pub const DEFAULT_LEVEL: f64 = 2.0;
@@ -260,6 +264,15 @@ impl N1Setup {
                 _ => Ok(()),
             }
         };
+        // two identical platens: the upper half above a mirror plane
+        let mirror =
+            matches!(c.support, SupportSpec::Symmetry) && matches!(e.tool, Tool::Platens(_));
+        if mirror && !layers.is_empty() {
+            return Err(bad(
+                "specimen.support",
+                "symmetry between platens mirrors the upper half of a uniform cylinder; a layered one needs its lower platen as its support (bonded, sliding or { friction = .. })",
+            ));
+        }
         let level = match e.mesh.level {
             None => DEFAULT_LEVEL,
             Some(0) => return Err(bad("mesh.level", "0: levels are 1, 2, 3, ...")),
@@ -366,13 +379,15 @@ impl N1Setup {
                 )
             }
             Tool::Platens(t) => {
-                let d = depth.unwrap_or(0.3 * height);
+                // a mirrored specimen: the upper half, half the travel
+                let k = if mirror { 0.5 } else { 1.0 };
+                let (h, d) = (k * height, k * depth.unwrap_or(0.3 * height));
                 (
                     ToolShape::Platen,
                     &t.friction,
                     Sizing {
-                        h: radius.min(height) / 8.0,
-                        fine_zone: radius.max(height),
+                        h: radius.min(h) / 8.0,
+                        fine_zone: radius.max(h),
                         growth: 0.0,
                         level,
                     },
@@ -415,10 +430,24 @@ impl N1Setup {
         m.base_friction = base_friction;
         m.base_friction_is_parameter = base_friction_is_parameter;
         m.radius = radius;
-        m.height = height;
+        m.height = if mirror { 0.5 * height } else { height };
+        m.mirror = mirror;
         m.fine_zone = sizing.fine_zone;
         m.sizing = Some(sizing);
         m.element = element;
+        // the punch's rim: a band graded to half its rounding (at most a
+        // quarter of the fine size) at level 1
+        if let ToolShape::FlatPunch {
+            radius: a,
+            edge_radius: rho,
+        } = tool
+        {
+            m.edge_band = Some(EdgeBand {
+                r: a,
+                h: (0.5 * rho).min(0.25 * sizing.h),
+                slope: EDGE_SLOPE,
+            });
+        }
         m.prony = prony;
         m.prony_parameters = prony_parameters;
         m.layers = layers;

@@ -31,7 +31,8 @@
 //!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
 
 use palpate_core::{
-    enrichable::not_applicable, Effect, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec,
+    enrichable::not_applicable, Drive, Effect, ForwardError, ForwardModel, Loading, ParamSpace,
+    ParamSpec,
 };
 use palpate_enrich::{prony_params, richer_law, MaterialForm, ZeroOffset};
 use palpate_material::Law;
@@ -45,11 +46,14 @@ use crate::dofs::Dirichlet;
 use crate::kernel::kernel_for;
 use crate::kinematics::Kinematics;
 use crate::material::LawMaterial;
+use crate::mesh::grading::refine_towards;
 use crate::mesh::{Grading, Mesh};
 use crate::model::{
-    doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, PlaneCell, Setup, Support,
+    doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, Path, PlaneCell, Setup,
+    Support,
 };
 use crate::motion::ToolMotion;
+use crate::stepper::LoadPath;
 use crate::surface::{Floor2d, Profile2d};
 use crate::system::{Part, Parts, SolverOptions, System};
 use crate::tool::ToolShape;
@@ -178,6 +182,30 @@ pub struct N1Setup {
     /// The name of the law's material (the prefix of its parameters when
     /// there are band materials).
     pub first_material: String,
+    /// A band of the mesh graded towards a tool's edge (a flat punch's);
+    /// `None`: the grading alone.
+    pub edge_band: Option<EdgeBand>,
+    /// The body is the upper half of a specimen compressed between two
+    /// identical platens (a mirror plane at the base): the drive is the
+    /// platens' travel, twice the half model's, and the force is the
+    /// whole specimen's (the same through every horizontal section).
+    pub mirror: bool,
+}
+
+/// The mesh about a tool's edge, where the contact pressure is singular (a
+/// flat punch's rim at radius `r` on the top face): the radial mesh lines
+/// about `r` and the axial ones under the top are split to elements of `h`
+/// mm there, growing by about `1 + slope` per element until they meet the
+/// grading's ([`crate::mesh::grading::refine_towards`]), as Q1 refines its
+/// punch edge ([`crate::Q1Setup::edge_refinement`]).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct EdgeBand {
+    /// Radius of the edge (mm).
+    pub r: f64,
+    /// Element size at the edge (mm).
+    pub h: f64,
+    /// Growth of the size per unit distance from the edge.
+    pub slope: f64,
 }
 
 /// A material of a band after the law's ([`N1Setup::layers`]).
@@ -290,6 +318,8 @@ impl N1Needle {
             sizing: None,
             space: None,
             first_material: "body".into(),
+            edge_band: None,
+            mirror: false,
         })
     }
 
@@ -314,8 +344,12 @@ impl N1Needle {
     /// elements growing by 1.4.
     pub fn coarser(&self) -> Coarser<N1Needle> {
         let coarse = doubled(self.effective_grading());
+        let edge = self.edge_band.map_or(0.0, |b| self.edge_size(&b));
         self.companion(2.0, graded_mesh_words(coarse, "tool"), |s| {
-            s.grading = Some(coarse)
+            s.grading = Some(coarse);
+            if let Some(b) = &mut s.edge_band {
+                b.h = 2.0 * edge;
+            }
         })
     }
 }
@@ -324,10 +358,37 @@ impl N1Setup {
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
-        let m = Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?;
+        let m = match self.edge_band {
+            None => Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?,
+            Some(b) => {
+                let h = self.edge_size(&b);
+                let rs = refine_towards(&g.positions(self.radius)?, b.r, h, b.slope);
+                let zs = refine_towards(&g.positions(self.height)?, 0.0, h, b.slope);
+                Mesh::lines_in_layers(&rs, &zs, self.height, &self.interfaces())?
+            }
+        };
         match self.element {
             PlaneCell::Quad4 => Ok(m),
             PlaneCell::Quad9 => m.to_quadratic(),
+        }
+    }
+
+    /// The element size at a tool's edge (mm): the band's `h` at the
+    /// sizing rule's level (`h / level`), `h` without a rule.
+    fn edge_size(&self, b: &EdgeBand) -> f64 {
+        match (self.grading, self.sizing) {
+            (None, Some(s)) => b.h / s.level,
+            _ => b.h,
+        }
+    }
+
+    /// The drive (the tool's or the platens' travel) over the modelled
+    /// body's: 2 for the upper half of a mirrored specimen, else 1.
+    fn drive_scale_inverse(&self) -> f64 {
+        if self.mirror {
+            2.0
+        } else {
+            1.0
         }
     }
 
@@ -545,17 +606,44 @@ impl Setup for N1Setup {
                 "a viscoelastic material needs the time of each sample".into(),
             ));
         }
+        let reach = self.drive_scale_inverse() * self.height;
         if let Some(&d) = loading
             .drive
             .iter()
-            .find(|&&d| !(d.is_finite() && d < self.height))
+            .find(|&&d| !(d.is_finite() && d < reach))
         {
-            return Err(ForwardError::InvalidLoading(format!(
-                "a depth of {d} mm: the tool must stay above the base ({} mm below the top)",
-                self.height
-            )));
+            return Err(ForwardError::InvalidLoading(if self.mirror {
+                format!("a travel of {d} mm: the platens must stay apart (the specimen is {reach} mm high)")
+            } else {
+                format!(
+                    "a depth of {d} mm: the tool must stay above the base ({} mm below the top)",
+                    self.height
+                )
+            }));
         }
         Ok(())
+    }
+    /// The default path ([`Setup::path`]) of the tool's travel in the
+    /// modelled body: half the platens' travel for a mirrored half.
+    fn path(&self, loading: &Loading, opts: &SolverOptions) -> Result<Path, ForwardError> {
+        if loading.drive_kind != Drive::DisplacementMm {
+            return Err(ForwardError::InvalidLoading(format!(
+                "FE models are driven by {}, got {}",
+                Drive::DisplacementMm.column(),
+                loading.drive_kind.column()
+            )));
+        }
+        let scale = 1.0 / self.drive_scale_inverse();
+        let drive: Vec<f64> = loading.drive.iter().map(|d| scale * d).collect();
+        Ok(Path {
+            path: LoadPath::from_loading(
+                &drive,
+                loading.time.as_deref(),
+                opts.max_step,
+                opts.max_time_step,
+            ),
+            preload: 0,
+        })
     }
     fn build(&self) -> Result<(System, N1Parts), FeError> {
         if !(self.friction >= 0.0) {
@@ -572,8 +660,19 @@ impl Setup for N1Setup {
                 });
             }
         }
-        let mesh = self.build_mesh()?;
+        let mut mesh = self.build_mesh()?;
         let kin = Kinematics::Axisymmetric;
+        // A platen also meets the free side where it bulges and folds over
+        // onto the platen (bonded or rough platens at large compression).
+        let surface = if self.tool == ToolShape::Platen {
+            let (top, side) = (mesh.facet_set("top")?, mesh.facet_set("side")?);
+            let mut both = top.clone();
+            both.nodes.extend_from_slice(&side.nodes);
+            mesh.facet_sets.insert("top_and_side".into(), both);
+            "top_and_side"
+        } else {
+            "top"
+        };
         let regions = self.regions();
         let region_refs: Vec<&str> = regions.iter().map(String::as_str).collect();
         let body = SolidBody::new(
@@ -607,7 +706,7 @@ impl Setup for N1Setup {
             Box::new(Profile2d(self.tool)),
             motion,
             &mesh,
-            "top",
+            surface,
             kin,
             options,
             1,
@@ -764,6 +863,20 @@ impl Setup for N1Setup {
                 ", {:?} mesh of {}",
                 self.element,
                 graded_mesh_words(self.effective_grading(), "tool")
+            );
+        }
+        if self.mirror {
+            name += &format!(
+                ", the upper half ({} mm) of a specimen between two identical platens",
+                self.height
+            );
+        }
+        if let Some(b) = &self.edge_band {
+            name += &format!(
+                ", refined to {} mm at the tool's edge (r = {} mm, slope {})",
+                self.edge_size(b),
+                b.r,
+                b.slope
             );
         }
         name

@@ -153,30 +153,65 @@ fn hertz_sphere_on_a_large_block() {
     }
 }
 
-/// Sneddon's flat punch (radius 1 mm, edge radius 0.01 mm) on a 200 x 200
-/// mm block, within 1 %.
-#[test]
-#[ignore = "the rounded edge's mesh rule is not yet verified within 1 % (0.05 mm edge at 0.005 mm: -4.7 %); cargo test -p palpate-fe --test integration closed_form_experiments::sneddon_flat_punch -- --ignored"]
-fn sneddon_flat_punch() {
-    let a = 1.0;
+/// The flat punch's force on a bonded block of height `h` (radius as
+/// large), the description's mesh rule at `level`, at the given depths.
+fn punch_forces(h: f64, edge_radius: f64, level: usize, depths: &[f64]) -> Vec<f64> {
     let m = model(&cylinder(
-        200.0,
-        200.0,
+        h,
+        h,
         "\"bonded\"",
-        "shape = \"flat_punch\"\nradius = 1.0\nedge_radius = 0.01",
-        0.04,
-        "level = 2",
+        &format!("shape = \"flat_punch\"\nradius = 1.0\nedge_radius = {edge_radius}"),
+        depths[depths.len() - 1],
+        &format!("level = {level}"),
     ));
-    let depths = [0.02, 0.04];
-    let f = forces(&m, &[C10], &depths);
+    eprintln!("{}", palpate_core::ForwardModel::name(&m));
+    forces(&m, &[C10], depths)
+}
+
+/// Sneddon's force of a punch of radius `a` at depth `d` on a bonded layer
+/// of thickness `h`: 2 E* a d times the layer's factor to second order in
+/// a / h (Hayes et al. 1972; its first two terms are Dimitriadis's, eq. 12).
+fn sneddon_on_layer(a: f64, d: f64, h: f64) -> f64 {
+    let chi = a / h;
+    2.0 * E_STAR * a * d * (1.0 + 1.133 * chi + 1.283 * chi * chi)
+}
+
+/// Sneddon's flat punch (radius 1 mm, edge radius 0.01 mm) on a bonded 20 x
+/// 20 mm block (the layer's factor, +5.9 %, in the closed form), within 1 %.
+/// On a 200 x 200 mm block at level 2 the band meets the half-space force
+/// to -0.59 % (d = 0.02 mm) and -0.60 % (d = 0.04 mm) in 5.5 min of CPU,
+/// but that block's own thickness adds about +0.6 % (the factor at a / h =
+/// 0.005), so the mesh is about 1.2 % below the block's force there.
+#[test]
+#[ignore = "the band graded to the rim is about 1.2 % below the closed form with the block's thickness on a 200 mm block at level 2 (-0.6 % from the half-space force) and takes minutes of CPU; cargo test -p palpate-fe --test integration closed_form_experiments::sneddon_flat_punch -- --ignored --nocapture"]
+fn sneddon_flat_punch() {
+    let (a, h) = (1.0, 20.0);
+    let depths = [0.01, 0.02];
+    let f = punch_forces(h, 0.01, 1, &depths);
     for (d, f) in depths.iter().zip(&f) {
-        let expected = 2.0 * E_STAR * a * d;
+        let expected = sneddon_on_layer(a, *d, h);
         let dev = f / expected - 1.0;
         eprintln!(
             "Sneddon punch d = {d}: FE {f:.6e} N, closed form {expected:.6e} N, {:+.3} %",
             100.0 * dev
         );
         assert!(dev.abs() < 0.01, "d = {d}: {:+.3} %", 100.0 * dev);
+    }
+}
+
+/// The edge rule's convergence: the punch's force at the description's
+/// mesh levels 1, 2 and 3 (the band at the rim 0.005, 0.0025 and 0.00167
+/// mm), against the closed form.
+#[test]
+#[ignore = "a convergence table, several minutes of CPU; cargo test -p palpate-fe --test integration closed_form_experiments::sneddon_flat_punch_levels -- --ignored --nocapture"]
+fn sneddon_flat_punch_levels() {
+    let (a, h, d) = (1.0, 20.0, 0.02);
+    for level in [1, 2, 3] {
+        let f = punch_forces(h, 0.01, level, &[d])[0];
+        eprintln!(
+            "level {level}: FE {f:.6e} N, {:+.3} % from the closed form",
+            100.0 * (f / sneddon_on_layer(a, d, h) - 1.0)
+        );
     }
 }
 
@@ -290,6 +325,47 @@ fn platens_homogeneous_and_bonded() {
         // conditions; this checks the contact route's limit)
         assert!((a / b - 1.0).abs() < 6e-3, "bonded platens {a} vs C1 {b}");
     }
+}
+
+/// Two identical platens (`support = "symmetry"`): the description gives
+/// the whole specimen and the platens' travel, the model is the upper half
+/// moved by half of it: frictionless, the compression is homogeneous.
+#[test]
+fn two_identical_platens_model_the_upper_half() {
+    let (r, h) = (19.0, 9.0);
+    let area = std::f64::consts::PI * r * r;
+    let depths = [1.0, 2.0];
+    let m = model(&cylinder(
+        r,
+        h,
+        "\"symmetry\"",
+        "shape = \"platens\"",
+        2.0,
+        "element = \"quad4\"\nlevel = 1",
+    ));
+    assert_eq!(m.height, 0.5 * h);
+    assert!(m.name().contains("upper half"), "{}", m.name());
+    let f = forces(&m, &[C10], &depths);
+    for (d, f) in depths.iter().zip(&f) {
+        let l = 1.0 - d / h;
+        let expected = 2.0 * C10 * (l - l.powi(-2)).abs() * area;
+        assert!(
+            (f / expected - 1.0).abs() < 1e-3,
+            "d = {d}: {f} vs {expected}"
+        );
+    }
+    // a travel as deep as the whole specimen is refused by the description
+    let e = N1Needle::from_experiment(&experiment(&cylinder(
+        r,
+        h,
+        "\"symmetry\"",
+        "shape = \"platens\"",
+        9.0,
+        "level = 1",
+    )))
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("reaches the base of a 9 mm specimen"), "{e}");
 }
 
 /// Tool friction "bonded" is the limit of a growing coefficient, and a

@@ -1,0 +1,380 @@
+//! The silicone phantom between platens: a real compression record of the
+//! phantom database (`studies/tests/data/phantom_dawood2026/EF10_0T_A1.csv`,
+//! Ecoflex 00-10, a cylinder 50 mm across and 30 mm high, testing-machine
+//! format) fitted by the homogeneous model and by the finite-element
+//! cylinder between platens with friction 0, 0.3, bonded and fitted, all
+//! through `palpate calibrate` as a user runs it; then the same cylinder
+//! simulated at friction 0.3 and bonded against the CalculiX references of
+//! `docs/validation/experiments/cylinder_platens_60/`. Writes the page
+//! `docs/validation/phantom-compression.md` (`--out FILE` for another).
+//!
+//! The record is cut at 60 % strain (18 mm) and thinned to one row every
+//! 0.5 mm of compression (36 rows): the copy keeps the file's metadata
+//! lines, header and columns as they are (the testing machine's format),
+//! so both fits read it exactly as they read the original:
+//!
+//! * homogeneous: `palpate calibrate --law neo-hookean --data uniaxial=FILE`
+//!   (engineering stress against stretch, from the file's own columns);
+//! * FE: `palpate calibrate --experiment PLATENS.toml --data force=FILE`
+//!   (load against compression), with the shipped description
+//!   `studies/experiments/phantom-platens.toml` (its friction set per case):
+//!   the whole specimen with `support = "symmetry"`, two identical
+//!   platens, of which the model is the upper half.
+//!
+//! ```text
+//! nice cargo run -p palpate-studies --example bench_phantom_compression -- [--level 2] [--skip-fits] [--skip-ccx] [--out PAGE.md]
+//! ```
+
+use clap::Parser;
+use palpate_studies::cli::{dispatch, Cli};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+#[path = "../../forward/fe/examples/common/cpu.rs"]
+mod cpu;
+use cpu::cpu_seconds;
+
+const RECORD: &str = "studies/tests/data/phantom_dawood2026/EF10_0T_A1.csv";
+const DESCRIPTION: &str = "studies/experiments/phantom-platens.toml";
+const CCX: &str = "docs/validation/experiments/cylinder_platens_60";
+const STRAIN: f64 = 0.6;
+const HEIGHT: f64 = 30.0;
+const STEP: f64 = 0.5;
+
+/// The shipped description of the cylinder between two identical platens
+/// (`studies/experiments/phantom-platens.toml`) with the given platen
+/// friction and C10 (TOML values) and mesh level.
+fn description(friction: &str, c10: &str, level: Option<usize>) -> String {
+    let mut t: toml::Table =
+        toml::from_str(&std::fs::read_to_string(DESCRIPTION).expect(DESCRIPTION))
+            .expect("the shipped description");
+    let value = |v: &str| -> toml::Value {
+        toml::from_str::<toml::Table>(&format!("v = {v}")).expect("a TOML value")["v"].clone()
+    };
+    t["tool"]["friction"] = value(friction);
+    t["materials"]["silicone"]["C10"] = value(c10);
+    let mut s = toml::to_string(&t).expect("TOML");
+    if let Some(l) = level {
+        s += &format!("\n[mesh]\nlevel = {l}\n");
+    }
+    s
+}
+
+/// The record cut at `STRAIN` and thinned to a row every `STEP` mm of
+/// compression, in the file's own format (metadata lines and header kept).
+fn thinned(text: &str) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let header = lines
+        .iter()
+        .position(|l| l.starts_with("Time (s)"))
+        .expect("the record's header");
+    let mut out: String = lines[..=header].iter().map(|l| format!("{l}\n")).collect();
+    let mut next = STEP;
+    for l in &lines[header + 1..] {
+        let c: f64 = l
+            .split(',')
+            .nth(1)
+            .and_then(|v| v.trim().parse().ok())
+            .expect("a compression value");
+        if c > STRAIN * HEIGHT + 1e-6 {
+            break;
+        }
+        if c >= next - 1e-9 {
+            out += l;
+            out.push('\n');
+            next += STEP;
+        }
+    }
+    out
+}
+
+fn run(line: &[String]) -> anyhow::Result<(f64, f64)> {
+    println!("$ {}", line.join(" "));
+    let cli = Cli::try_parse_from(line)?;
+    let (t0, w0) = (cpu_seconds(false), std::time::Instant::now());
+    dispatch(cli)?;
+    Ok((cpu_seconds(false) - t0, w0.elapsed().as_secs_f64()))
+}
+
+fn json(path: &Path) -> serde_json::Value {
+    serde_json::from_str(&std::fs::read_to_string(path).expect("the fit's JSON")).expect("JSON")
+}
+
+/// `(displacement_mm, force_N)` rows of a CSV with `#` comments and a
+/// header.
+fn curve(path: &Path) -> Vec<(f64, f64)> {
+    std::fs::read_to_string(path)
+        .unwrap_or_default()
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| {
+            let mut c = l.split(',').map(|v| v.trim().parse::<f64>());
+            Some((c.next()?.ok()?, c.next()?.ok()?))
+        })
+        .collect()
+}
+
+fn interpolate(c: &[(f64, f64)], d: f64) -> Option<f64> {
+    c.windows(2)
+        .find(|w| w[0].0 <= d + 1e-9 && d <= w[1].0 + 1e-9)
+        .map(|w| w[0].1 + (w[1].1 - w[0].1) * (d - w[0].0) / (w[1].0 - w[0].0))
+}
+
+struct Fit {
+    label: String,
+    c10: f64,
+    se: f64,
+    friction: Option<(f64, f64)>,
+    rms: f64,
+    evaluations: String,
+    iterations: String,
+    cpu: f64,
+}
+
+/// The fits as a Markdown table.
+fn fits_table(fits: &[Fit], c10_h: f64) -> String {
+    let mut t = String::from(
+        "## Fits\n\nNeo-Hookean C10 by each model; the ratio is the FE fit's C10 over the \
+         homogeneous fit's. The homogeneous fit's RMS is in MPa (engineering stress), the \
+         FE fits' in N (load). CPU: seconds of the bench's process for the fit.\n\n\
+         | model | C10 (MPa) | SE | ratio to homogeneous | platen friction | RMS | evaluations | iterations | CPU s |\n\
+         |---|---|---|---|---|---|---|---|---|\n",
+    );
+    for f in fits {
+        t += &format!(
+            "| {} | {:.5e} | {:.2e} | {:.4} | {} | {:.4} | {} | {} | {:.0} |\n",
+            f.label,
+            f.c10,
+            f.se,
+            f.c10 / c10_h,
+            f.friction
+                .map_or("-".into(), |(v, s)| format!("{v:.3} +- {s:.3}")),
+            f.rms,
+            f.evaluations,
+            f.iterations,
+            f.cpu
+        );
+    }
+    t + "\n"
+}
+
+fn main() -> anyhow::Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let opt = |name: &str| {
+        args.iter()
+            .position(|a| a == name)
+            .and_then(|k| args.get(k + 1))
+            .cloned()
+    };
+    let level: Option<usize> = opt("--level").map(|v| v.parse().expect("--level: 1, 2, ..."));
+    let out =
+        PathBuf::from(opt("--out").unwrap_or("docs/validation/phantom-compression.md".into()));
+    let skip_fits = args.iter().any(|a| a == "--skip-fits");
+    let skip_ccx = args.iter().any(|a| a == "--skip-ccx");
+    let dir = tempfile::tempdir()?;
+    let record = dir.path().join("EF10_0T_A1_to60.csv");
+    std::fs::write(&record, thinned(&std::fs::read_to_string(RECORD)?))?;
+    let rows = curve(&record).len();
+    let mut page = String::new();
+    writeln!(
+        page,
+        "# The phantom cylinder between platens: FE against the homogeneous fit\n\n\
+         Generated by `nice cargo run -p palpate-studies --example bench_phantom_compression{}` \
+         (do not edit: rerun it). Dev profile, a 2-core machine shared with other builds: CPU \
+         seconds of the bench's process.\n",
+        level.map_or(String::new(), |l| format!(" -- --level {l}"))
+    )?;
+    writeln!(
+        page,
+        "Record: `{RECORD}` (Ecoflex 00-10, no thinner, cast A, test 1; Dawood et al. 2026, CC BY \
+         4.0), a cylinder 50 mm across and 30 mm high compressed at 10 mm/min; cut at {:.0} % \
+         strain ({} mm) and thinned to one row every {STEP} mm of compression ({rows} rows), \
+         in the file's own format (its metadata lines, header and seven columns kept). The \
+         platens' lubrication is not stated by the database.\n",
+        100.0 * STRAIN,
+        STRAIN * HEIGHT
+    )?;
+    if !skip_fits {
+        let mut fits: Vec<Fit> = Vec::new();
+        // the homogeneous fit
+        let h_json = dir.path().join("homogeneous.json");
+        let line: Vec<String> = [
+            "palpate",
+            "calibrate",
+            "--law",
+            "neo-hookean",
+            "--data",
+            &format!("uniaxial={}", record.display()),
+            "--json",
+            &h_json.display().to_string(),
+        ]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+        let (cpu, _) = run(&line)?;
+        let h = json(&h_json);
+        let c10_h = h["params"]["C10"]["value"].as_f64().unwrap_or(f64::NAN);
+        fits.push(Fit {
+            label: "homogeneous (uniaxial stress, `--data uniaxial=FILE`)".into(),
+            c10: c10_h,
+            se: h["params"]["C10"]["standard_error"]
+                .as_f64()
+                .unwrap_or(f64::NAN),
+            friction: None,
+            rms: h["rms"].as_f64().unwrap_or(f64::NAN),
+            evaluations: h["evaluations"].to_string(),
+            iterations: h["iterations"].to_string(),
+            cpu,
+        });
+        for (label, friction) in [
+            ("FE, platen friction 0.3", "0.3"),
+            ("FE, bonded platens", "\"bonded\""),
+            (
+                "FE, platen friction fitted",
+                "{ start = 0.3, lower = 0.0, upper = 2.0 }",
+            ),
+            ("FE, frictionless platens", "0.0"),
+        ] {
+            let file = dir.path().join("platens.toml");
+            let fe_json = dir.path().join("fe.json");
+            std::fs::write(
+                &file,
+                description(friction, &format!("{{ start = {c10_h:.4e} }}"), level),
+            )?;
+            let line: Vec<String> = [
+                "palpate",
+                "calibrate",
+                "--experiment",
+                &file.display().to_string(),
+                "--data",
+                &format!("force={}", record.display()),
+                "--json",
+                &fe_json.display().to_string(),
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+            let (cpu, wall) = match run(&line) {
+                Ok(t) => t,
+                Err(e) => {
+                    println!("{label}: calibrate failed: {e:#}");
+                    writeln!(page, "{label}: calibrate failed: {e:#}\n")?;
+                    continue;
+                }
+            };
+            let f = json(&fe_json);
+            let p = |n: &str, k: &str| f["params"][n][k].as_f64().unwrap_or(f64::NAN);
+            let fit = Fit {
+                label: label.into(),
+                c10: p("C10", "value"),
+                se: p("C10", "standard_error"),
+                friction: f["params"]
+                    .get("friction")
+                    .map(|_| (p("friction", "value"), p("friction", "standard_error"))),
+                rms: f["rms"].as_f64().unwrap_or(f64::NAN),
+                evaluations: f["evaluations"].to_string(),
+                iterations: f["iterations"].to_string(),
+                cpu,
+            };
+            println!(
+                "{label}: C10 {:.5e} +- {:.2e}, ratio {:.4}, RMS {:.3} N; {} FE runs, {} iterations, {cpu:.0} s CPU ({wall:.0} s wall)",
+                fit.c10, fit.se, fit.c10 / c10_h, fit.rms, fit.evaluations, fit.iterations
+            );
+            fits.push(fit);
+            // the page so far, should a later fit be stopped
+            std::fs::write(&out, format!("{page}{}", fits_table(&fits, c10_h)))?;
+        }
+        page += &fits_table(&fits, c10_h);
+    }
+    std::fs::write(&out, &page)?;
+    if !skip_ccx {
+        writeln!(
+            page,
+            "## The same cylinder against CalculiX at 60 %\n\n\
+             `palpate simulate --experiment {CCX}/experiment_<case>.toml` (the description above \
+             with C10 = 2e-2 MPa, `bulk = 1000.0` as the decks' K = 1000 mu, to 18 mm) against \
+             the CalculiX curves beside it (its README states how far each deck went and its \
+             error); relative difference (palpate - CalculiX) / CalculiX. CalculiX's decks stop \
+             before 60 %: friction 0.3 at 5 mm, bonded at 13 mm; with bonded platens the side \
+             folds over onto the platen from 6.5 mm (21.7 % strain, `fold.py`), where both \
+             solvers hold it in contact with the platen (CalculiX frictionless beyond the bonded \
+             face, palpate with the platen's friction).\n"
+        )?;
+        let mut table = String::from("| travel (mm) | strain |");
+        let cases = [
+            (
+                "experiment_mu03.toml",
+                "friction 0.3",
+                "ccx_mu03_level1.csv",
+            ),
+            ("experiment_bonded.toml", "bonded", "ccx_bonded_level1.csv"),
+        ];
+        let mut cols = Vec::new();
+        for (experiment, label, ccx) in cases {
+            let mut file = Path::new(CCX).join(experiment);
+            if let Some(l) = level {
+                let text = std::fs::read_to_string(&file)? + &format!("\n[mesh]\nlevel = {l}\n");
+                file = dir.path().join(experiment);
+                std::fs::write(&file, text)?;
+            }
+            let csv = dir
+                .path()
+                .join(format!("sim_{label}.csv").replace(' ', "_"));
+            let line: Vec<String> = [
+                "palpate",
+                "simulate",
+                "--experiment",
+                &file.display().to_string(),
+                "--csv",
+                &csv.display().to_string(),
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+            let cpu = match run(&line) {
+                Ok((cpu, _)) => cpu,
+                Err(e) => {
+                    writeln!(page, "{label}: simulate failed: {e:#}\n")?;
+                    continue;
+                }
+            };
+            let estimate: Vec<String> = std::fs::read_to_string(&csv)?
+                .lines()
+                .filter(|l| l.starts_with("# discretisation error") || l.starts_with("# mesh"))
+                .map(|l| l.trim_start_matches("# ").to_string())
+                .collect();
+            writeln!(
+                page,
+                "palpate, {label} ({cpu:.0} s CPU): {}\n",
+                estimate.join("; ")
+            )?;
+            table += &format!(" palpate {label} (N) | CalculiX (N) | difference |");
+            cols.push((curve(&csv), curve(&Path::new(CCX).join(ccx))));
+            std::fs::write(&out, &page)?;
+        }
+        table += "\n|---|---|";
+        for _ in &cols {
+            table += "---|---|---|";
+        }
+        table.push('\n');
+        for k in 1..=12 {
+            let d = 1.5 * k as f64;
+            table += &format!("| {d:.1} | {:.0} % |", 100.0 * d / HEIGHT);
+            for (p, c) in &cols {
+                match (interpolate(p, d), c.iter().find(|r| (r.0 - d).abs() < 1e-6)) {
+                    (Some(fp), Some(&(_, fc))) => {
+                        table +=
+                            &format!(" {fp:.3} | {fc:.3} | {:+.2} % |", 100.0 * (fp / fc - 1.0))
+                    }
+                    (Some(fp), None) => table += &format!(" {fp:.3} | - | - |"),
+                    _ => table += " - | - | - |",
+                }
+            }
+            table.push('\n');
+        }
+        writeln!(page, "{table}")?;
+    }
+    std::fs::write(&out, &page)?;
+    println!("wrote {}", out.display());
+    Ok(())
+}
