@@ -85,7 +85,7 @@ impl RandomEffects {
                 ));
             }
             for j in 0..p {
-                if !y[j].is_finite() || !(s[j].is_finite() && s[j] >= 0.0) {
+                if !(y[j].is_finite() && s[j].is_finite() && s[j] >= 0.0) {
                     return Err(format!(
                         "test {i}, {}: estimate {} with standard error {}: both must be finite, the error >= 0",
                         self.names[j], y[j], s[j]
