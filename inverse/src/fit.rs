@@ -6,8 +6,9 @@ use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
 use crate::wall_slide::{limit_ahead, wall_slide};
 use crate::{
-    covariance, jacobian_unbounded, residuals_and_exact_jacobian, sum_of_squares, BoundSide, FdOptions, FitReport, InverseError,
-    Method, Objective, ParameterEstimate, SetReport, SharedObserver,
+    covariance, jacobian_unbounded, residuals_and_exact_jacobian, sum_of_squares, BoundSide,
+    FdOptions, FitReport, InverseError, Method, Objective, ParameterEstimate, SetReport,
+    SharedObserver,
 };
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};

@@ -37,6 +37,7 @@
 pub mod boundary_polish;
 pub mod covariance;
 pub mod dataset;
+pub mod design;
 pub mod error;
 pub mod fidelity_correction;
 pub mod fit;
@@ -54,7 +55,8 @@ pub mod wall_slide;
 
 pub use boundary_polish::{near_bound, POLISH_RELATIVE_DISTANCE};
 pub use covariance::{
-    covariance, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION, MAX_CORRELATION,
+    covariance, covariance_with_noise, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION,
+    MAX_CORRELATION,
 };
 pub use dataset::DataSet;
 pub use error::InverseError;

@@ -77,7 +77,17 @@ fn main() {
     println!("one plain run: {run_cpu:.1} s CPU");
     println!(
         "{:<20} {:>5} {:>6} {:>5} {:>7} {:>8} {:>8} {:>14} {:>10} {:>10} {:>10}",
-        "route", "iter", "evals", "jacs", "runs/it", "CPU s", "FE runs", "C10 MPa", "SE", "friction", "SE"
+        "route",
+        "iter",
+        "evals",
+        "jacs",
+        "runs/it",
+        "CPU s",
+        "FE runs",
+        "C10 MPa",
+        "SE",
+        "friction",
+        "SE"
     );
     for exact in [false, true] {
         let mut set = DataSet::new(

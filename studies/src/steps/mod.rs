@@ -55,6 +55,7 @@ registry! {
     two_stage => TwoStage(TwoStageStep),
     localize => Localize(LocalizeStep),
     sample => Sample(SampleStep),
+    plan => Plan(PlanStep),
 }
 
 impl StepEntry {

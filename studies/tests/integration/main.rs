@@ -21,6 +21,7 @@ mod localize_units;
 mod manifest_properties;
 mod mesa2011;
 mod models;
+mod plan_cli;
 mod real_data;
 mod real_data_fits;
 mod run_study;
