@@ -337,11 +337,8 @@ pub fn information(
 fn log_det(a: &DMatrix<f64>) -> f64 {
     let eig = a.clone().symmetric_eigen();
     let max = eig.eigenvalues.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    if eig
-        .eigenvalues
-        .iter()
-        .any(|&v| !(v > crate::covariance::RANK_TOLERANCE * max))
-    {
+    let tol = crate::covariance::RANK_TOLERANCE * max;
+    if max == 0.0 || eig.eigenvalues.iter().any(|&v| v.is_nan() || v <= tol) {
         return f64::NEG_INFINITY;
     }
     eig.eigenvalues.iter().map(|v| v.ln()).sum()

@@ -507,8 +507,8 @@ pub fn table(p: &Plan) -> String {
             "{:>4}  {:<label_w$}  {:>7}  {:>9.3e}",
             c.rank, c.label, i.samples, i.noise_sd
         );
-        for j in 0..i.names.len() {
-            let cell = match (i.standard_errors[j], i.relative_standard_errors[j]) {
+        for (se, rel) in i.standard_errors.iter().zip(&i.relative_standard_errors) {
+            let cell = match (*se, *rel) {
                 (Some(se), Some(r)) => format!("{se:.3e} ({:.2}%)", 100.0 * r),
                 (Some(se), None) => format!("{se:.3e}"),
                 _ => "-".into(),
@@ -517,9 +517,8 @@ pub fn table(p: &Plan) -> String {
         }
         if i.names.len() > 1 {
             let mut worst: Option<f64> = None;
-            for a in 0..i.names.len() {
-                for b in a + 1..i.names.len() {
-                    let v = i.correlation[a][b];
+            for (a, row) in i.correlation.iter().enumerate() {
+                for &v in &row[a + 1..] {
                     if v.is_finite() {
                         worst = Some(worst.map_or(v.abs(), |w: f64| w.max(v.abs())));
                     }
