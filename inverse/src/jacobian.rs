@@ -128,6 +128,10 @@ fn exact_jacobian(objective: &Objective, z: &[f64]) -> Result<JacobianEval, Inve
     Ok(residuals_and_exact_jacobian(objective, z, "exact sensitivities")?.2)
 }
 
+/// Predictions (one vector per set), residuals and the exact Jacobian at
+/// one point ([`residuals_and_exact_jacobian`]).
+pub type ExactEvaluation = (Vec<Vec<f64>>, Vec<f64>, JacobianEval);
+
 /// The predictions (per set) and residuals at `z` and d r / d z from the
 /// sets' exact sensitivities,
 /// both from one run per set ([`palpate_core::Sensitivities::predict_with_jacobian`]
@@ -139,7 +143,7 @@ pub fn residuals_and_exact_jacobian(
     objective: &Objective,
     z: &[f64],
     stage: &'static str,
-) -> Result<(Vec<Vec<f64>>, Vec<f64>, JacobianEval), InverseError> {
+) -> Result<ExactEvaluation, InverseError> {
     let theta = objective.theta_from_unbounded(z);
     let dxdz = objective.dx_dz(z);
     let mut matrix = DMatrix::zeros(objective.n_residuals(), z.len());
