@@ -66,9 +66,24 @@ pub struct Covariance {
 /// names and which parameters sit on a bound.
 pub fn covariance(jx: &DMatrix<f64>, sse: f64, names: &[String], at_bound: &[bool]) -> Covariance {
     let (m, q) = jx.shape();
+    let sigma2 = (m > q).then(|| sse / (m - q) as f64);
+    covariance_with_noise(jx, sigma2, names, at_bound)
+}
+
+/// Covariance from the physical Jacobian `jx` for a known noise variance
+/// `sigma2` per residual (`None`: standard errors undefined): the inverse
+/// Fisher information `sigma2 (J^T J)^{-1}` (experiment design,
+/// [`crate::design`]), with the same rank and identifiability verdict as
+/// [`covariance`].
+pub fn covariance_with_noise(
+    jx: &DMatrix<f64>,
+    sigma2: Option<f64>,
+    names: &[String],
+    at_bound: &[bool],
+) -> Covariance {
+    let (m, q) = jx.shape();
     let active: Vec<usize> = (0..q).filter(|&j| !at_bound[j]).collect();
     let qa = active.len();
-    let sigma2 = (m > q).then(|| sse / (m - q) as f64);
     let mut matrix = vec![vec![f64::NAN; q]; q];
     let mut involved = vec![false; q];
     let mut exact_deficient = vec![false; q];

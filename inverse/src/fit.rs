@@ -6,8 +6,9 @@ use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
 use crate::wall_slide::{limit_ahead, wall_slide};
 use crate::{
-    covariance, jacobian_unbounded, sum_of_squares, BoundSide, FdOptions, FitReport, InverseError,
-    Method, Objective, ParameterEstimate, SetReport, SharedObserver,
+    covariance, jacobian_unbounded, residuals_and_exact_jacobian, sum_of_squares, BoundSide,
+    FdOptions, FitReport, InverseError, Method, Objective, ParameterEstimate, SetReport,
+    SharedObserver,
 };
 use nalgebra::DMatrix;
 use serde::{Deserialize, Serialize};
@@ -224,12 +225,19 @@ pub fn statistics(
     fd: &FdOptions,
 ) -> Result<FitReport, InverseError> {
     let theta = objective.theta_from_unbounded(z);
-    let mut evs = objective.evaluators();
-    let predictions = objective.predict(&mut evs, &theta, "final point")?;
-    let mut r = vec![0.0; objective.n_residuals()];
-    objective.residuals_from_predictions(&predictions, &mut r);
+    // With exact sensitivities one run gives the predictions and the
+    // Jacobian; otherwise the predictions, then finite differences.
+    let (predictions, r, jz) = if objective.has_exact_sensitivities() {
+        residuals_and_exact_jacobian(objective, z, "final point")?
+    } else {
+        let mut evs = objective.evaluators();
+        let predictions = objective.predict(&mut evs, &theta, "final point")?;
+        let mut r = vec![0.0; objective.n_residuals()];
+        objective.residuals_from_predictions(&predictions, &mut r);
+        let jz = jacobian_unbounded(objective, z, Some(&r), fd)?;
+        (predictions, r, jz)
+    };
     let sse = sum_of_squares(&r);
-    let jz = jacobian_unbounded(objective, z, Some(&r), fd)?;
     let dxdz = objective.dx_dz(z);
     let free = objective.free_indices();
     let names = objective.free_names();
@@ -330,7 +338,11 @@ pub fn statistics(
         r_squared: 1.0 - ss_res_all / ss_tot_all,
         n_residuals: m,
         iterations: 0,
-        evaluations: 1 + jz.evaluations,
+        evaluations: if objective.has_exact_sensitivities() {
+            1
+        } else {
+            1 + jz.evaluations
+        },
         jacobians: 1,
         termination: crate::Termination::MaxIterations,
         converged: false,

@@ -125,19 +125,42 @@ pub fn jacobian_unbounded(
 /// d r / d z from the sets' exact sensitivities:
 /// `d r_i / d z_j = (w s_i) * d f_i / d theta_k * dx_k / dz_j` for free `k`.
 fn exact_jacobian(objective: &Objective, z: &[f64]) -> Result<JacobianEval, InverseError> {
+    Ok(residuals_and_exact_jacobian(objective, z, "exact sensitivities")?.2)
+}
+
+/// Predictions (one vector per set), residuals and the exact Jacobian at
+/// one point ([`residuals_and_exact_jacobian`]).
+pub type ExactEvaluation = (Vec<Vec<f64>>, Vec<f64>, JacobianEval);
+
+/// The predictions (per set) and residuals at `z` and d r / d z from the
+/// sets' exact sensitivities,
+/// both from one run per set ([`palpate_core::Sensitivities::predict_with_jacobian`]
+/// gives the predictions with their derivatives), so that an estimator that
+/// needs both at one point (Levenberg-Marquardt at an accepted trial, the
+/// statistics at the optimum) pays one forward run, not two. The Jacobian
+/// counts one evaluation. Errors when a set has no exact sensitivities.
+pub fn residuals_and_exact_jacobian(
+    objective: &Objective,
+    z: &[f64],
+    stage: &'static str,
+) -> Result<ExactEvaluation, InverseError> {
     let theta = objective.theta_from_unbounded(z);
     let dxdz = objective.dx_dz(z);
     let mut matrix = DMatrix::zeros(objective.n_residuals(), z.len());
+    let mut predictions = Vec::with_capacity(objective.sets().len());
     for (s, set) in objective.sets().iter().enumerate() {
         let Some(sens) = &set.sensitivities else {
-            continue;
+            return Err(InverseError::InvalidOption {
+                option: "sensitivities",
+                reason: format!("data set `{}` has no exact sensitivities", set.name),
+            });
         };
-        let (_, cols) = sens
+        let (pred, cols) = sens
             .predict_with_jacobian(&theta, &set.loading)
             .map_err(|source| InverseError::Forward {
                 set: set.name.clone(),
                 theta: theta.clone(),
-                stage: "exact sensitivities",
+                stage,
                 source: Box::new(source),
             })?;
         let range = objective.residual_range(s);
@@ -146,9 +169,16 @@ fn exact_jacobian(objective: &Objective, z: &[f64]) -> Result<JacobianEval, Inve
                 matrix[(row, j)] = f * cols[k][i] * dxdz[j];
             }
         }
+        predictions.push(pred);
     }
-    Ok(JacobianEval {
-        matrix,
-        evaluations: 1,
-    })
+    let mut r = vec![0.0; objective.n_residuals()];
+    objective.residuals_from_predictions(&predictions, &mut r);
+    Ok((
+        predictions,
+        r,
+        JacobianEval {
+            matrix,
+            evaluations: 1,
+        },
+    ))
 }

@@ -37,6 +37,7 @@
 pub mod boundary_polish;
 pub mod covariance;
 pub mod dataset;
+pub mod design;
 pub mod error;
 pub mod fidelity_correction;
 pub mod fit;
@@ -55,13 +56,14 @@ pub mod wall_slide;
 
 pub use boundary_polish::{near_bound, POLISH_RELATIVE_DISTANCE};
 pub use covariance::{
-    covariance, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION, MAX_CORRELATION,
+    covariance, covariance_with_noise, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION,
+    MAX_CORRELATION,
 };
 pub use dataset::DataSet;
 pub use error::InverseError;
 pub use fidelity_correction::{CorrectedModel, FidelityCorrection};
 pub use fit::{fit, start_points, statistics, FitOptions, MultiStart};
-pub use jacobian::{jacobian_unbounded, FdOptions, JacobianEval};
+pub use jacobian::{jacobian_unbounded, residuals_and_exact_jacobian, FdOptions, JacobianEval};
 pub use lm::{LevenbergMarquardt, LmOptions, LmState};
 pub use objective::{sum_of_squares, Evaluators, Objective, ParamMap};
 pub use observer::{shared_observer, FitObserver, Progress, SharedObserver};

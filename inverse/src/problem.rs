@@ -3,7 +3,18 @@
 //! argmin asks for the cost and then the gradient (or residuals and then the
 //! Jacobian) in separate calls with the same parameter vector; the adapter
 //! remembers the last vector and its residuals so they are computed once.
+//!
+//! With exact sensitivities (every data set has them) each evaluation is
+//! one run that gives the residuals and the Jacobian together
+//! ([`crate::jacobian::residuals_and_exact_jacobian`]), and the Jacobian at
+//! the last point is kept: Levenberg-Marquardt evaluates a trial point, and
+//! when it accepts it asks for the Jacobian there, which then costs no
+//! forward run. A rejected trial pays the sensitivities for nothing (the
+//! back-substitutions and assemblies of one run, less than a second run),
+//! so one forward run per trial point is the whole cost
+//! ([`LeastSquaresProblem::evaluations`] counts them).
 
+use crate::jacobian::residuals_and_exact_jacobian;
 use crate::{jacobian_unbounded, sum_of_squares, Evaluators, FdOptions, InverseError, Objective};
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
 use nalgebra::DMatrix;
@@ -25,6 +36,8 @@ pub struct LeastSquaresProblem<'a> {
     evaluations: Cell<usize>,
     jacobians: Cell<usize>,
     last: RefCell<Option<(Vec<f64>, Vec<f64>)>>,
+    /// The exact Jacobian at `last`'s point (exact sensitivities only).
+    last_jacobian: RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
 }
 
 impl<'a> LeastSquaresProblem<'a> {
@@ -37,6 +50,7 @@ impl<'a> LeastSquaresProblem<'a> {
             evaluations: Cell::new(0),
             jacobians: Cell::new(0),
             last: RefCell::new(None),
+            last_jacobian: RefCell::new(None),
         }
     }
 
@@ -58,6 +72,13 @@ impl<'a> LeastSquaresProblem<'a> {
             }
         }
         self.evaluations.set(self.evaluations.get() + 1);
+        if self.objective.has_exact_sensitivities() {
+            let (_, r, j) =
+                residuals_and_exact_jacobian(self.objective, z, "objective evaluation")?;
+            *self.last.borrow_mut() = Some((z.to_vec(), r.clone()));
+            *self.last_jacobian.borrow_mut() = Some((z.to_vec(), j.matrix));
+            return Ok(r);
+        }
         let r = self.objective.residuals(
             &mut self.evaluators.borrow_mut(),
             z,
@@ -67,8 +88,17 @@ impl<'a> LeastSquaresProblem<'a> {
         Ok(r)
     }
 
-    /// d r / d z at `z`.
+    /// d r / d z at `z`. With exact sensitivities, the one kept from the
+    /// evaluation at `z` (computed by one run when `z` was not evaluated).
     pub fn jacobian_at(&self, z: &[f64]) -> Result<DMatrix<f64>, InverseError> {
+        if self.objective.has_exact_sensitivities() {
+            self.residuals_at(z)?;
+            let kept = self.last_jacobian.borrow();
+            if let Some((_, j)) = kept.as_ref().filter(|(zl, _)| zl.as_slice() == z) {
+                self.jacobians.set(self.jacobians.get() + 1);
+                return Ok(j.clone());
+            }
+        }
         let r0 = if self.fd.central || self.objective.has_exact_sensitivities() {
             None
         } else {

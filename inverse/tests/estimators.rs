@@ -694,3 +694,47 @@ fn model_sensitivities_are_used_when_the_model_offers_them() {
         assert!((a - b).abs() < 1e-7 * (1.0 + b.abs()), "{a} vs {b}");
     }
 }
+
+/// `ExpSensitivities` counting its runs.
+struct CountingSensitivities(std::sync::atomic::AtomicUsize);
+impl Sensitivities for CountingSensitivities {
+    fn predict_with_jacobian(
+        &self,
+        t: &[f64],
+        loading: &Loading,
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
+        self.0.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        ExpSensitivities.predict_with_jacobian(t, loading)
+    }
+}
+
+/// With exact sensitivities Levenberg-Marquardt runs the model once per
+/// point it evaluates: the Jacobian at an accepted trial point comes with
+/// the trial's run, and the statistics at the optimum reuse one run. The
+/// runs are the report's evaluations, and there are fewer than one
+/// evaluation plus one Jacobian per iteration (what recomputing the run
+/// inside each Jacobian cost).
+#[test]
+fn exact_jacobians_reuse_the_run_of_their_point() {
+    let truth = [2.5, 0.7, -0.3];
+    let s = noisy(set(exp_decay(), times(30, 6.0), &truth), 0.02, 9);
+    let counter = Arc::new(CountingSensitivities(Default::default()));
+    let obj = Objective::new(
+        vec![s.with_sensitivities(counter.clone())],
+        ResidualKind::Absolute,
+        &[],
+    )
+    .unwrap();
+    let report = fit(&obj, &lm()).unwrap();
+    assert!(report.converged, "{:?}", report.termination);
+    let runs = counter.0.load(std::sync::atomic::Ordering::SeqCst);
+    assert_eq!(runs, report.evaluations, "{report:?}");
+    // every accepted iteration asked for a Jacobian, none cost a run
+    assert!(report.jacobians as u64 > report.iterations, "{report:?}");
+    assert!(
+        runs < report.jacobians + report.iterations as usize,
+        "runs {runs}, jacobians {}, iterations {}",
+        report.jacobians,
+        report.iterations
+    );
+}

@@ -5,8 +5,10 @@
 //! exact route (direct differentiation through the converged increments,
 //! `palpate_fe::sensitivity`, plugged in by `DataSet::with_model_sensitivities`).
 //!
-//! Prints per route the iterations, objective evaluations and Jacobians,
-//! the CPU seconds (user + system of this process), the FE-run equivalents
+//! Prints per route the iterations, objective evaluations (forward runs:
+//! with exact sensitivities each run gives its Jacobian too, so the
+//! Jacobian of an accepted point costs none) and Jacobians, the runs per
+//! iteration, the CPU seconds (user + system of this process), the FE-run equivalents
 //! (CPU over the CPU of one plain run at the truth), and the estimates with
 //! their standard errors.
 //!
@@ -74,8 +76,18 @@ fn main() {
     );
     println!("one plain run: {run_cpu:.1} s CPU");
     println!(
-        "{:<20} {:>5} {:>6} {:>5} {:>8} {:>8} {:>14} {:>10} {:>10} {:>10}",
-        "route", "iter", "evals", "jacs", "CPU s", "FE runs", "C10 MPa", "SE", "friction", "SE"
+        "{:<20} {:>5} {:>6} {:>5} {:>7} {:>8} {:>8} {:>14} {:>10} {:>10} {:>10}",
+        "route",
+        "iter",
+        "evals",
+        "jacs",
+        "runs/it",
+        "CPU s",
+        "FE runs",
+        "C10 MPa",
+        "SE",
+        "friction",
+        "SE"
     );
     for exact in [false, true] {
         let mut set = DataSet::new(
@@ -99,7 +111,7 @@ fn main() {
         let cpu = cpu_seconds(false) - c0;
         let p = &report.parameters;
         println!(
-            "{:<20} {:>5} {:>6} {:>5} {:>8.1} {:>8.1} {:>14.6e} {:>10.2e} {:>10.5} {:>10.2e}",
+            "{:<20} {:>5} {:>6} {:>5} {:>7.2} {:>8.1} {:>8.1} {:>14.6e} {:>10.2e} {:>10.5} {:>10.2e}",
             if exact {
                 "exact sensitivities"
             } else {
@@ -108,6 +120,7 @@ fn main() {
             report.iterations,
             report.evaluations,
             report.jacobians,
+            report.evaluations as f64 / report.iterations.max(1) as f64,
             cpu,
             cpu / run_cpu,
             p[0].value,

@@ -10,6 +10,7 @@ pub mod doe;
 pub mod experiment;
 pub mod localize;
 pub mod merge;
+pub mod plan;
 pub mod reading;
 pub mod realtime;
 pub mod run;
@@ -65,6 +66,8 @@ pub enum Command {
     Localize(localize::Args),
     // Experiment descriptions: presets, show, check (experiment::Args).
     Experiment(experiment::Args),
+    // Experiment design from the Fisher information (plan::Args).
+    Plan(plan::Args),
 }
 
 /// The command line with a negative number after an option joined to it
@@ -111,5 +114,6 @@ pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
         Command::Realtime(a) => realtime::run(a),
         Command::Localize(a) => localize::run(a),
         Command::Experiment(a) => experiment::run(a),
+        Command::Plan(a) => plan::run(a),
     }
 }

@@ -52,6 +52,7 @@ registry! {
     localize => Localize(LocalizeStep),
     sample => Sample(SampleStep),
     replicates => Replicates(ReplicatesStep),
+    plan => Plan(PlanStep),
 }
 
 impl StepEntry {

@@ -23,6 +23,7 @@ mod manifest_properties;
 mod mesa2011;
 mod models;
 mod phantom_database;
+mod plan_cli;
 mod real_data;
 mod real_data_fits;
 mod run_study;
