@@ -6,6 +6,11 @@ docs/validation/gap-real.md.
     cargo build --release -p palpate-studies --bin palpate
     python3 docs/validation/gap_real.py [--law neo-hookean] > /tmp/table.md
 
+It prints two tables: the single-effect verdict of each record, then the
+explanation as a set (each member with its share of the excess misfit, in the
+order of selection and dropped one out), the remainder over the noise and,
+where the remainder is above 3 x the noise, where it lies.
+
 The JSON of each diagnosis goes to target/gap_real/<set>__<file>.json (or $GAP_REAL_OUT).
 The test kind of each file follows from its folder and name (the files' own
 headers say which test they record); the only per-file option is the kPa
@@ -52,7 +57,31 @@ def g(x):
     return f"{x:.3g}"
 
 
+def pct(x):
+    return "-" if x is None else f"{x * 100:.0f} %"
+
+
+def set_row(folder, name, r):
+    """The explanation of one record as a set, for the second table."""
+    noise = r["noise_sd"]
+    members = r.get("explanation") or []
+    text = "; ".join(
+        f"{m['effect']} ({pct(m.get('share_marginal'))} / {pct(m.get('share_dropped'))})"
+        for m in members) or "none"
+    rem = r.get("remainder") or {}
+    over = rem.get("misfit_over_noise")
+    if over is None and rem.get("misfit") is not None:
+        over = rem["misfit"] / noise
+    where = ""
+    if over is not None and over > 3.0:
+        spans = [f"{w['axis']} {w['from']:.3g}..{w['to']:.3g}" for w in (rem.get("where") or [])]
+        where = ", ".join(spans) if spans else "the whole record"
+    return (f"| {folder} | {name} | {text} | {pct(rem.get('share_unexplained'))} | "
+            f"{'-' if over is None else g(over)} | {where} |")
+
+
 os.makedirs(OUT, exist_ok=True)
+sets = []
 print("| set | file | test | verdict | noise SD (MPa) | misfit/noise before | best effect | misfit/noise after | share of excess explained | other findings | CPU s |")
 print("|---|---|---|---|---|---|---|---|---|---|---|")
 for folder, name, path in records():
@@ -68,6 +97,7 @@ for folder, name, path in records():
         print(f"| {folder} | {name} | {test} | *not run*: {msg} | | | | | | | {cpu:.1f} |")
         continue
     r = json.load(open(js))
+    sets.append(set_row(folder, name, r))
     noise = r["noise_sd"]
     best = r["ranking"][0] if r["ranking"] else None
     before = r["base"]["misfit"] / noise
@@ -86,3 +116,11 @@ for folder, name, path in records():
         other.append("failed: " + ", ".join(str(f.get("effect", f)) if isinstance(f, dict) else str(f) for f in r["failed"]))
     print(f"| {folder} | {name} | {test} | **{r['verdict']}** | {noise:.2e} | {g(before)} | "
           f"{best['effect'] if best else '-'} | {g(after)} | {excess*100:.0f} % | {'; '.join(other)} | {cpu:.1f} |")
+    if r.get("caveat"):
+        sets[-1] = sets[-1][:-1] + f" caveat: {r['caveat']} |"
+
+print()
+print("| set | file | explanation (share of the excess: in order / dropped one out) | excess left | remainder / noise | where the remainder lies (above 3 x noise) |")
+print("|---|---|---|---|---|---|")
+for row in sets:
+    print(row)
