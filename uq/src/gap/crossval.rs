@@ -166,36 +166,52 @@ fn cross_validate(
     starts: &[Vec<f64>],
     fixed: &[(String, f64)],
 ) -> Result<Vec<f64>, GapError> {
-    let n = observed.len();
-    let mut out = vec![0.0; n];
+    let mut out = vec![0.0; observed.len()];
     for f in 0..folds.count {
-        let keep = folds.kept(f, n);
-        let mut fitted = fit_from_starts(
+        refit_fold(model, loading, observed, folds, f, starts, fixed, &mut out)?;
+    }
+    Ok(out)
+}
+
+/// The exact refit of one fold (see [`cross_validate`]): its held-out
+/// predictions written into `out`.
+#[allow(clippy::too_many_arguments)]
+fn refit_fold(
+    model: &Arc<dyn ForwardModel>,
+    loading: &Loading,
+    observed: &[f64],
+    folds: &Folds,
+    f: usize,
+    starts: &[Vec<f64>],
+    fixed: &[(String, f64)],
+    out: &mut [f64],
+) -> Result<(), GapError> {
+    let keep = folds.kept(f, observed.len());
+    let mut fitted = fit_from_starts(
+        model,
+        loading,
+        observed,
+        Some(&keep),
+        &starts[..1],
+        fixed,
+        false,
+    );
+    if fitted.is_err() && starts.len() > 1 {
+        fitted = fit_from_starts(
             model,
             loading,
             observed,
             Some(&keep),
-            &starts[..1],
+            &starts[1..],
             fixed,
             false,
         );
-        if fitted.is_err() && starts.len() > 1 {
-            fitted = fit_from_starts(
-                model,
-                loading,
-                observed,
-                Some(&keep),
-                &starts[1..],
-                fixed,
-                false,
-            );
-        }
-        let fitted = fitted?;
-        for i in folds.held_out(f) {
-            out[i] = fitted.predicted[i];
-        }
     }
-    Ok(out)
+    let fitted = fitted?;
+    for i in folds.held_out(f) {
+        out[i] = fitted.predicted[i];
+    }
+    Ok(())
 }
 
 /// Chord iterations of a refined linearised refit: at most this many
@@ -229,7 +245,11 @@ const CHORD_ITERATIONS: usize = 4;
 /// two optima (second order in the step): the exact refit's held-out
 /// predictions to well within the noise at a few predictions per fold,
 /// where a Levenberg-Marquardt refit per fold (with its statistics and the
-/// polish of parameters near a bound) costs hundreds. Written here rather
+/// polish of parameters near a bound) costs hundreds. A fold whose chord
+/// fails (a prediction fails, or the kept samples end up fitted worse than
+/// by the full-record optimum, which an exact refit never is: a strongly
+/// nonlinear parameter such as a relaxation time can send the simplified
+/// iteration away) is returned for an exact refit. Written here rather
 /// than taken from a solver crate because it reuses one factorisation
 /// across the folds' iterations, which a general solver does not offer.
 fn cross_validate_linearised(
@@ -240,11 +260,12 @@ fn cross_validate_linearised(
     free: &[bool],
     jac: &DMatrix<f64>,
     refine: Option<&Loading>,
-) -> Result<Vec<f64>, GapError> {
+) -> Result<(Vec<f64>, Vec<usize>), GapError> {
     let n = observed.len();
     let specs = &model.space().params;
     let r = residuals(observed, &fitted.predicted);
     let mut out = fitted.predicted.clone();
+    let mut unsettled = Vec::new();
     for f in 0..folds.count {
         let keep = folds.kept(f, n);
         let mut active: Vec<usize> = (0..specs.len())
@@ -281,17 +302,18 @@ fn cross_validate_linearised(
         };
         let held = folds.held_out(f);
         let refined = match (refine, &svd) {
-            (Some(loading), Some((svd, tol))) => chord(
+            (Some(loading), Some((svd, tol))) => Some(chord(
                 model, loading, observed, fitted, &keep, &active, &delta, svd, *tol, &norms,
-            ),
+            )),
             _ => None,
         };
         match refined {
-            Some(pred) => {
+            Some(Some(pred)) => {
                 for i in held {
                     out[i] = pred[i];
                 }
             }
+            Some(None) => unsettled.push(f),
             None => {
                 for i in held {
                     out[i] += active
@@ -303,13 +325,14 @@ fn cross_validate_linearised(
             }
         }
     }
-    Ok(out)
+    Ok((out, unsettled))
 }
 
 /// The chord iterations of [`cross_validate_linearised`] for one fold:
-/// the model's predictions at the refined parameters, or `None` when a
-/// prediction fails or a correction would cross a bound (the linear
-/// prediction is used then).
+/// the model's predictions at the refined parameters (a correction that
+/// would cross a bound stops the iteration where it is), or `None` when a
+/// prediction fails or the kept samples are fitted worse than by the
+/// full-record optimum (the fold is then refitted exactly).
 #[allow(clippy::too_many_arguments)]
 fn chord(
     model: &dyn ForwardModel,
@@ -328,6 +351,17 @@ fn chord(
     for (&j, dj) in active.iter().zip(delta) {
         theta[j] += dj;
     }
+    let kept_sse = |f: &[f64]| {
+        keep.iter()
+            .map(|&i| (observed[i] - f[i]).powi(2))
+            .sum::<f64>()
+    };
+    // the exact refit of the kept samples fits them at least this well
+    let at_optimum = kept_sse(&fitted.predicted);
+    let settled = |f: Vec<f64>| {
+        let sse = kept_sse(&f);
+        (sse.is_finite() && sse <= at_optimum * (1.0 + 1e-9) + f64::MIN_POSITIVE).then_some(f)
+    };
     let mut f = model.predict(&theta, loading).ok()?;
     for _ in 1..CHORD_ITERATIONS {
         let rhs =
@@ -342,13 +376,13 @@ fn chord(
         for ((&j, x), s) in active.iter().zip(scaled.iter()).zip(norms) {
             let v = theta[j] + x / s;
             if !(v >= specs[j].lower && v <= specs[j].upper) {
-                return Some(f);
+                return settled(f);
             }
             theta[j] = v;
         }
         f = model.predict(&theta, loading).ok()?;
     }
-    Some(f)
+    settled(f)
 }
 
 /// The sensitivities of the free parameters (those not in `fixed`) at a
@@ -402,7 +436,12 @@ pub(crate) fn cross_validate_by(
             }
         };
         let refine = (!model.expensive()).then_some(loading);
-        cross_validate_linearised(model.as_ref(), observed, folds, fitted, free, jac, refine)
+        let (mut out, unsettled) =
+            cross_validate_linearised(model.as_ref(), observed, folds, fitted, free, jac, refine)?;
+        for f in unsettled {
+            refit_fold(model, loading, observed, folds, f, starts, fixed, &mut out)?;
+        }
+        Ok(out)
     } else {
         cross_validate(model, loading, observed, folds, starts, fixed)
     }
