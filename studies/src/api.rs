@@ -11,7 +11,8 @@
 //! ```no_run
 //! use palpate_studies::api::{calibrate, CalibrateOptions};
 //! use palpate_studies::records::{TestData, TestKind};
-//! let data = TestData::read("uniaxial", TestKind::Uniaxial, "uniaxial.csv".as_ref())?;
+//! let kind = TestKind::parse("uniaxial")?;
+//! let data = TestData::read("uniaxial", kind, "uniaxial.csv".as_ref())?;
 //! let fit = calibrate(&[data], &CalibrateOptions::new("yeoh".parse()?))?;
 //! println!("{:?}", fit.params);
 //! # Ok::<(), anyhow::Error>(())
