@@ -2,6 +2,7 @@
 //! on N1's coarse mesh, and its bad input (a candidate that leaves the
 //! description's validity, no free parameter, no noise, a bad field).
 
+use super::common::refused;
 use std::path::Path;
 use std::process::{Command, Output};
 
@@ -18,15 +19,6 @@ fn stdout(o: &Output) -> String {
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).to_string()
-}
-
-fn assert_clean_failure(o: &Output, needles: &[&str]) {
-    let e = stderr(o);
-    assert!(!o.status.success(), "should fail: {}", stdout(o));
-    assert!(!e.contains("panicked"), "panic: {e}");
-    for n in needles {
-        assert!(e.contains(n), "`{n}` not in: {e}");
-    }
 }
 
 /// N1 on its coarse mesh, a 1 mm ramp of 4 samples; `C10` as given.
@@ -117,7 +109,7 @@ fn plan_bad_input_is_named() {
     let dir = tempfile::tempdir().unwrap();
     let file = n1_file(dir.path(), "{ start = 1.1e-3 }");
     // a candidate tool as large as the specimen (radius 35 mm)
-    assert_clean_failure(
+    refused(
         &palpate(&[
             "plan",
             "--experiment",
@@ -133,11 +125,11 @@ fn plan_bad_input_is_named() {
             "as large as the specimen",
         ],
     );
-    assert_clean_failure(
+    refused(
         &palpate(&["plan", "--experiment", &file, "--vary", "tool.tip_radius=1"]),
         &["--noise", "missing"],
     );
-    assert_clean_failure(
+    refused(
         &palpate(&[
             "plan",
             "--experiment",
@@ -149,7 +141,7 @@ fn plan_bad_input_is_named() {
         ]),
         &["tool.tip"],
     );
-    assert_clean_failure(
+    refused(
         &palpate(&[
             "plan",
             "--experiment",
@@ -163,7 +155,7 @@ fn plan_bad_input_is_named() {
     );
     let fixed = tempfile::tempdir().unwrap();
     let file = n1_file(fixed.path(), "1.1e-3");
-    assert_clean_failure(
+    refused(
         &palpate(&["plan", "--experiment", &file, "--noise", "0.01"]),
         &["no free parameter", "C10"],
     );
