@@ -128,7 +128,24 @@ pub fn parse_method(s: &str) -> anyhow::Result<Method> {
     }
 }
 
-impl Request<'_> {
+impl<'a> Request<'a> {
+    /// The plain least-squares fit of `law` to `fitted`: each record's own
+    /// model, absolute residuals, Levenberg-Marquardt, nothing fixed,
+    /// elastic, no further data sets and no observer.
+    pub fn least_squares(law: Law, fitted: &'a [TestData]) -> Self {
+        Request {
+            law,
+            model: None,
+            fitted,
+            predict: &[],
+            residual: ResidualKind::Absolute,
+            method: Method::LevenbergMarquardt(Default::default()),
+            fixed: Vec::new(),
+            observer: None,
+            viscous: None,
+        }
+    }
+
     /// The forward model of a data set.
     fn model_of(&self, d: &TestData) -> anyhow::Result<Arc<dyn ForwardModel>> {
         match self.model {

@@ -23,7 +23,6 @@ use palpate_uq::likelihood::{HierarchicalPosterior, RandomEffects};
 use serde::Deserialize;
 use std::path::PathBuf;
 use anyhow::Context;
-use palpate_inverse::{Method, ResidualKind};
 use palpate_analytic::Mode;
 use palpate_material::{homogeneous, Law};
 use serde::Serialize;
@@ -161,17 +160,7 @@ pub fn analyse(law: Law, records: &[TestData], pooled: &Calibration) -> anyhow::
     };
     let mut fits = Vec::with_capacity(records.len());
     for (k, r) in records.iter().enumerate() {
-        let c = calibrate(Request {
-            law,
-            model: None,
-            fitted: std::slice::from_ref(r),
-            predict: &[],
-            residual: ResidualKind::Absolute,
-            method: Method::LevenbergMarquardt(Default::default()),
-            fixed: Vec::new(),
-            observer: None,
-            viscous: None,
-        })
+        let c = calibrate(Request::least_squares(law, std::slice::from_ref(r)))
         .with_context(|| format!("replicate {}", r.file))?;
         fits.push(ReplicateFit {
             record: stems[k].clone(),
@@ -664,17 +653,7 @@ fn fit_law(
     per_record: bool,
 ) -> anyhow::Result<LawFits> {
     let request = |fitted: &[TestData]| -> anyhow::Result<Calibration> {
-        calibrate(Request {
-            law,
-            model: None,
-            fitted,
-            predict: &[],
-            residual: ResidualKind::Absolute,
-            method: Method::LevenbergMarquardt(Default::default()),
-            fixed: Vec::new(),
-            observer: None,
-            viscous: None,
-        })
+        calibrate(Request::least_squares(law, fitted))
     };
     let mean = request(std::slice::from_ref(&curve.record)).context("the mean-curve fit")?;
     let values: Vec<f64> = mean.params.iter().map(|(_, v)| v.value).collect();
@@ -918,17 +897,7 @@ pub fn hierarchical(
     max_draws: usize,
 ) -> anyhow::Result<(Replicates, HierarchicalPosterior)> {
     let fitted = |fitted: &[TestData]| {
-        calibrate(Request {
-            law,
-            model: None,
-            fitted,
-            predict: &[],
-            residual: ResidualKind::Absolute,
-            method: Method::LevenbergMarquardt(Default::default()),
-            fixed: Vec::new(),
-            observer: None,
-            viscous: None,
-        })
+        calibrate(Request::least_squares(law, fitted))
     };
     let pooled = fitted(records).context("the pooled fit")?;
     let reps = analyse(law, records, &pooled)?;
