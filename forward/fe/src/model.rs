@@ -239,6 +239,20 @@ pub trait Setup: Clone + std::fmt::Debug + PartialEq + Send + Sync + 'static {
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         Err(not_applicable(effect, &self.name()))
     }
+    /// Whether some parameters move the geometry (a specimen's thickness):
+    /// the mesh is then built per run from [`Setup::geometry`], and the
+    /// model has no exact sensitivities (its derivatives are finite
+    /// differences of whole runs, the same cells moved, so smooth in the
+    /// parameter). Default: none do.
+    fn has_geometric_parameters(&self) -> bool {
+        false
+    }
+    /// The setup whose [`Setup::build`] makes the mesh for the parameters
+    /// after the law's (`extra`), when [`Setup::has_geometric_parameters`].
+    /// Default: this one.
+    fn geometry(&self, _extra: &[f64]) -> Result<Self, FeError> {
+        Ok(self.clone())
+    }
 }
 
 /// The forward model of a [`Setup`]: one FE run per prediction, each
@@ -291,9 +305,11 @@ impl<S: Setup> FeModel<S> {
         progress: Option<&mut dyn FnMut(&Progress)>,
     ) -> Result<(Simulation, System), ForwardError> {
         self.setup.check_loading(loading)?;
-        let (mut sys, parts) = self.setup.build().map_err(to_forward)?;
+        let setup = self.setup_for(theta)?;
+        let setup: &S = &setup;
+        let (mut sys, parts) = setup.build().map_err(to_forward)?;
         let sim = simulate_with(
-            &self.setup,
+            setup,
             self.space(),
             &mut sys,
             &parts,
@@ -348,6 +364,15 @@ impl<S: Setup> FeModel<S> {
         loading: &Loading,
         drop_history: bool,
     ) -> Result<Simulation, ForwardError> {
+        if self.setup.has_geometric_parameters() {
+            return Err(ForwardError::InvalidConfig {
+                field: "parameters".into(),
+                reason: format!(
+                    "{} has parameters that move the mesh: its derivatives are finite differences, not sensitivities",
+                    self.setup.name()
+                ),
+            });
+        }
         self.setup.check_loading(loading)?;
         let (mut sys, parts) = self.setup.build().map_err(to_forward)?;
         simulate_with(
@@ -361,6 +386,19 @@ impl<S: Setup> FeModel<S> {
             true,
             Some(drop_history),
         )
+    }
+
+    /// The setup that builds the mesh for `theta` ([`Setup::geometry`]).
+    fn setup_for(&self, theta: &[f64]) -> Result<std::borrow::Cow<'_, S>, ForwardError> {
+        if !self.setup.has_geometric_parameters() {
+            return Ok(std::borrow::Cow::Borrowed(&self.setup));
+        }
+        self.space().check(theta)?;
+        let n_law = self.setup.law().params().len();
+        self.setup
+            .geometry(&theta[n_law..])
+            .map(std::borrow::Cow::Owned)
+            .map_err(to_forward)
     }
 
     /// The model with its setup changed by `change`, as the coarser
@@ -429,6 +467,7 @@ impl<S: Setup> ForwardModel for FeModel<S> {
             space: self.space(),
             outputs: self.outputs().len(),
             system: None,
+            geometry: None,
         })
     }
     /// A nonlinear FE solve per prediction (seconds or more).
@@ -439,9 +478,10 @@ impl<S: Setup> ForwardModel for FeModel<S> {
         self.setup.effects().map(|_| self as &dyn Enrichable)
     }
     /// Every FE model differentiates its runs
-    /// ([`FeModel::simulate_sensitivities`]).
+    /// ([`FeModel::simulate_sensitivities`]), but one whose parameters
+    /// move the mesh ([`Setup::has_geometric_parameters`]).
     fn as_sensitivities(&self) -> Option<&dyn Sensitivities> {
-        Some(self)
+        (!self.setup.has_geometric_parameters()).then_some(self as &dyn Sensitivities)
     }
 }
 
@@ -655,6 +695,9 @@ struct FeEvaluator<'a, S: Setup> {
     /// `observe` returns.
     outputs: usize,
     system: Option<(System, S::Parts)>,
+    /// The setup the system was built from when the parameters move the
+    /// mesh ([`Setup::geometry`]); rebuilt when they change.
+    geometry: Option<S>,
 }
 
 impl<S: Setup> FeEvaluator<'_, S> {
@@ -665,9 +708,22 @@ impl<S: Setup> FeEvaluator<'_, S> {
         loading: &Loading,
         all_outputs: bool,
     ) -> Result<Simulation, ForwardError> {
+        if self.setup.has_geometric_parameters() {
+            self.space.check(theta)?;
+            let n_law = self.setup.law().params().len();
+            let g = self.setup.geometry(&theta[n_law..]).map_err(to_forward)?;
+            if self.geometry.as_ref() != Some(&g) {
+                self.system = Some(g.build().map_err(to_forward)?);
+                self.geometry = Some(g);
+            }
+        }
         if self.system.is_none() {
             self.system = Some(self.setup.build().map_err(to_forward)?);
         }
+        let setup: &S = match &self.geometry {
+            Some(g) => g,
+            None => self.setup,
+        };
         let (sys, parts) = self
             .system
             .as_mut()
@@ -676,7 +732,7 @@ impl<S: Setup> FeEvaluator<'_, S> {
                 reason: "system unavailable".into(),
             })?;
         simulate_with(
-            self.setup,
+            setup,
             self.space,
             sys,
             parts,

@@ -190,6 +190,14 @@ pub struct N1Setup {
     /// platens' travel, twice the half model's, and the force is the
     /// whole specimen's (the same through every horizontal section).
     pub mirror: bool,
+    /// The specimen's thickness is the last parameter (`thickness_mm`, the
+    /// `boundary_condition` effect of a described cylinder): each run
+    /// meshes the specimen at that thickness ([`Setup::geometry`]).
+    pub(crate) thickness_is_parameter: bool,
+    /// The height (mm) whose axial mesh lines are stretched to `height`
+    /// below the fine zone (the same cells at every thickness, so the force
+    /// is smooth in it); `None`: the lines of `height`.
+    pub(crate) mesh_height: Option<f64>,
 }
 
 /// The mesh about a tool's edge, where the contact pressure is singular (a
@@ -320,6 +328,8 @@ impl N1Needle {
             first_material: "body".into(),
             edge_band: None,
             mirror: false,
+            thickness_is_parameter: false,
+            mesh_height: None,
         })
     }
 
@@ -358,12 +368,25 @@ impl N1Setup {
     /// The mesh this model uses.
     pub fn build_mesh(&self) -> Result<Mesh, FeError> {
         let g = self.effective_grading();
-        let m = match self.edge_band {
-            None => Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?,
-            Some(b) => {
+        let m = match (self.edge_band, self.stretch()) {
+            (None, None) => {
+                Mesh::graded_layers(self.radius, self.height, g, g, &self.interfaces())?
+            }
+            (None, Some(map)) => Mesh::lines_in_layers(
+                &g.positions(self.radius)?,
+                &map.apply(&g.positions(map.from)?),
+                self.height,
+                &self.interfaces(),
+            )?,
+            (Some(b), map) => {
                 let h = self.edge_size(&b);
                 let rs = refine_towards(&g.positions(self.radius)?, b.r, h, b.slope);
-                let zs = refine_towards(&g.positions(self.height)?, 0.0, h, b.slope);
+                let zs = match map {
+                    None => refine_towards(&g.positions(self.height)?, 0.0, h, b.slope),
+                    Some(map) => {
+                        map.apply(&refine_towards(&g.positions(map.from)?, 0.0, h, b.slope))
+                    }
+                };
                 Mesh::lines_in_layers(&rs, &zs, self.height, &self.interfaces())?
             }
         };
@@ -438,6 +461,19 @@ impl N1Setup {
         self.base_friction_is_parameter
     }
 
+    /// The number of parameters after the law's.
+    fn extra_len(&self) -> usize {
+        2 * self.prony_parameters
+            + self
+                .materials
+                .iter()
+                .map(BandMaterial::param_count)
+                .sum::<usize>()
+            + usize::from(self.friction_is_parameter)
+            + usize::from(self.base_friction_is_parameter)
+            + usize::from(self.thickness_is_parameter)
+    }
+
     /// The parameters after the law's: its Prony terms, then each band
     /// material's, then the tool's and the base's friction; `(prony of the
     /// law, per material its slice, friction, base friction)`.
@@ -446,14 +482,7 @@ impl N1Setup {
         &self,
         extra: &'a [f64],
     ) -> Result<(&'a [f64], Vec<&'a [f64]>, Option<f64>, Option<f64>), FeError> {
-        let need = 2 * self.prony_parameters
-            + self
-                .materials
-                .iter()
-                .map(BandMaterial::param_count)
-                .sum::<usize>()
-            + usize::from(self.friction_is_parameter)
-            + usize::from(self.base_friction_is_parameter);
+        let need = self.extra_len();
         if extra.len() < need {
             return Err(FeError::InvalidConfig {
                 field: "parameters".into(),
@@ -565,6 +594,9 @@ impl Setup for N1Setup {
                 name: "base_friction".into(),
                 ..friction_param(self.base_friction.unwrap_or(0.0))
             });
+        }
+        if self.thickness_is_parameter {
+            specs.push(self.thickness_param());
         }
         ParamSpace::new(specs)
     }
@@ -879,14 +911,47 @@ impl Setup for N1Setup {
                 b.slope
             );
         }
+        if self.thickness_is_parameter {
+            name += ", its thickness a parameter (the mesh lines below the fine zone moved with the base)";
+        }
+        if let Some(map) = self.stretch() {
+            name += &format!(", meshed as {} mm stretched to {} mm", map.from, map.to);
+        }
         name
+    }
+    fn has_geometric_parameters(&self) -> bool {
+        self.thickness_is_parameter
+    }
+    /// With the thickness a parameter: the specimen at that thickness,
+    /// meshed by the lines of its own height moved with the base.
+    fn geometry(&self, extra: &[f64]) -> Result<N1Setup, FeError> {
+        let mut g = self.clone();
+        if self.thickness_is_parameter {
+            let n = self.extra_len();
+            let h = *extra.get(n - 1).ok_or_else(|| FeError::InvalidConfig {
+                field: "parameters".into(),
+                reason: format!("{} parameters after the law's, {n} expected", extra.len()),
+            })?;
+            if !(h > 0.0 && h.is_finite()) {
+                return Err(FeError::InvalidConfig {
+                    field: "thickness_mm".into(),
+                    reason: format!("{h} mm: expected a finite thickness > 0"),
+                });
+            }
+            g.mesh_height = Some(self.mesh_height.unwrap_or(self.height));
+            g.height = h;
+        }
+        Ok(g)
     }
     fn effects(&self) -> Option<Vec<Effect>> {
         let mut v = Vec::new();
         if self.friction_offered() {
             v.push(Effect::Friction);
         }
-        if self.base == Support::Bonded && self.base_friction.is_none() {
+        if self.base == Support::Bonded
+            && self.base_friction.is_none()
+            && !self.thickness_is_parameter
+        {
             v.push(Effect::BoundaryCondition);
         }
         // (one enrichment at a time: the richer law of a model whose friction
@@ -912,8 +977,19 @@ impl Setup for N1Setup {
                 }
                 Ok(Box::new(FeModel::from_setup(m)))
             }
+            Effect::BoundaryCondition if self.thickness_offered() => {
+                let mut m = self.clone();
+                m.thickness_is_parameter = true;
+                let p = self.thickness_param();
+                if let Some(space) = &mut m.space {
+                    space.params.push(p);
+                }
+                Ok(Box::new(FeModel::from_setup(m)))
+            }
             Effect::BoundaryCondition
-                if self.base == Support::Bonded && self.base_friction.is_none() =>
+                if self.base == Support::Bonded
+                    && self.base_friction.is_none()
+                    && !self.thickness_is_parameter =>
             {
                 let mut m = self.clone();
                 m.base = Support::Sliding;
@@ -950,12 +1026,66 @@ impl N1Setup {
             && self.materials.is_empty()
             && !self.friction_is_parameter
             && !self.base_friction_is_parameter
+            && !self.thickness_is_parameter
     }
 
     /// Whether `friction` is offered: the tool's coefficient is a finite
-    /// number.
+    /// number (and the thickness, which must stay the last parameter, is
+    /// not one).
     fn friction_offered(&self) -> bool {
-        !self.friction_is_parameter && self.friction.is_finite()
+        !self.friction_is_parameter && self.friction.is_finite() && !self.thickness_is_parameter
+    }
+
+    /// Whether `boundary_condition` is the specimen's finite thickness: a
+    /// described cylinder (an experiment description's, whose height a lab
+    /// may have given wrong or as "a large block") of one material on a
+    /// bonded base, pressed by a tool (not platens, whose travel is the
+    /// height's), with room below the fine zone to move its base. The N1
+    /// benchmark model keeps the sliding switch that its withheld-effect
+    /// records were made with.
+    fn thickness_offered(&self) -> bool {
+        self.space.is_some()
+            && self.base == Support::Bonded
+            && self.base_friction.is_none()
+            && self.layers.is_empty()
+            && !self.mirror
+            && self.tool != ToolShape::Platen
+            && !self.thickness_is_parameter
+            && self.thickness_range().is_some()
+    }
+
+    /// The fine zone's depth (mm): the mesh lines above it stay where they
+    /// are when the thickness changes.
+    fn kept_depth(&self) -> f64 {
+        self.effective_grading().fine_length
+    }
+
+    /// The range of the thickness parameter (mm): from one and a half
+    /// fine zones (and a tenth of the height) to twice the height; `None`
+    /// when the fine zone leaves no room.
+    fn thickness_range(&self) -> Option<(f64, f64)> {
+        let h = self.mesh_height.unwrap_or(self.height);
+        let lower = (1.5 * self.kept_depth()).max(0.1 * h);
+        (lower < 0.9 * h).then_some((lower, 2.0 * h))
+    }
+
+    /// The `thickness_mm` parameter, starting at the height (the effect
+    /// off: the base model, bit for bit).
+    fn thickness_param(&self) -> ParamSpec {
+        let h = self.mesh_height.unwrap_or(self.height);
+        let (lower, upper) = self.thickness_range().unwrap_or((h, h));
+        ParamSpec::new("thickness_mm", "mm", lower, upper, h)
+    }
+
+    /// How the axial mesh lines are stretched: from `mesh_height` to
+    /// `height`, when the two differ.
+    fn stretch(&self) -> Option<Stretch> {
+        let from = self.mesh_height?;
+        (from != self.height).then(|| Stretch {
+            from,
+            to: self.height,
+            keep: self.kept_depth().min(0.5 * from.min(self.height)),
+        })
     }
 
     /// Whether `material_form` is offered: one material, its law's
@@ -966,11 +1096,16 @@ impl N1Setup {
 }
 
 impl N1Setup {
-    /// Whether `modelling_space` is offered: the axisymmetric model with a
-    /// bonded base, its friction fixed, elastic (N3 has neither a sliding
-    /// base nor viscoelasticity).
+    /// Whether `modelling_space` is offered: the axisymmetric model of N1's
+    /// 70 x 80 mm cylinder with a bonded base, its friction fixed, elastic
+    /// (N3 is that specimen's block, with neither a sliding base nor
+    /// viscoelasticity).
     fn modelling_space_applies(&self) -> bool {
-        self.base == Support::Bonded
+        // the 3D model is N3's block, the 3D counterpart of N1's specimen only
+        self.radius == 35.0
+            && self.height == 80.0
+            && !self.mirror
+            && self.base == Support::Bonded
             && self.base_friction.is_none()
             && self.law_only()
             && self.layers.is_empty()
@@ -995,6 +1130,32 @@ impl N1Setup {
         m.penalty = self.penalty;
         m.penetration_tol = self.penetration_tol;
         m
+    }
+}
+
+/// The axial mesh lines of a specimen `from` mm high moved to one `to` mm
+/// high: depths down to `keep` stay, those below are scaled so that the
+/// base goes to `to` (the same cells at every thickness).
+#[derive(Debug, Clone, Copy)]
+struct Stretch {
+    from: f64,
+    to: f64,
+    keep: f64,
+}
+
+impl Stretch {
+    /// The depths below the top (from 0 to `from`) moved.
+    fn apply(&self, depths: &[f64]) -> Vec<f64> {
+        let k = self.keep;
+        let scale = (self.to - k) / (self.from - k);
+        let mut out: Vec<f64> = depths
+            .iter()
+            .map(|&t| if t <= k { t } else { k + (t - k) * scale })
+            .collect();
+        if let Some(last) = out.last_mut() {
+            *last = self.to;
+        }
+        out
     }
 }
 
