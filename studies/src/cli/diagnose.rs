@@ -3,7 +3,8 @@
 //! shrinks once that effect is added (GAP.md).
 
 use crate::cli::calibrate::read_data;
-use crate::model::{build, default_effects, gap_base_for, parse_effects};
+use crate::model::{build, default_effects, gap_base_for, parse_effects, ExperimentSpec};
+use crate::steps::diagnose::{experiment_base, experiment_effects};
 use crate::records::{TestData, TestKind};
 use crate::report::{gap_summary, gap_svg};
 use crate::run::output::{write_atomic, write_json};
@@ -42,9 +43,19 @@ use std::path::{Path, PathBuf};
 /// friction, boundary_condition (material_form, zero_offset on request). A
 /// bare `--data FILE` without --benchmark is read as a C1 record.
 ///
+/// A lab's own experiment (--experiment FILE|PRESET, docs/guide/experiment.md;
+/// --data FILE or force=FILE with displacement_mm, force_N[, time_s]): the
+/// base is the description's FE model (its law replaced by --base when
+/// given), meshed for the record's deepest displacement, and the candidates
+/// are the effects that model offers: on an axisymmetric cylinder friction
+/// (a finite tool friction), boundary_condition (the specimen's thickness
+/// fitted on a bonded base, by finite differences of whole runs; a sliding
+/// base otherwise), material_form, zero_offset; on other setups their own.
+///
 /// Examples:
 ///   palpate diagnose --data uniaxial=brain.csv --law neo-hookean --json gap.json
 ///   palpate diagnose --benchmark C1 --data record.csv --base neo-hookean
+///   palpate diagnose --experiment gel-disc.toml --data force=indent.csv
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
@@ -52,18 +63,24 @@ pub struct Args {
     /// seconds) or N1 (FE needle indentation on the coarse mesh, frictionless
     /// needle, bonded base; some 100 FE runs, a few minutes on 2 cores for a
     /// 10 mm record). Leave out for homogeneous records (TEST=FILE).
-    #[arg(long)]
+    #[arg(long, conflicts_with = "experiment")]
     pub benchmark: Option<String>,
+    /// A lab's own experiment: an experiment file (TOML), a preset's name
+    /// (palpate experiment list) or the description as JSON text; its FE
+    /// model is the base.
+    #[arg(long, value_name = "FILE|PRESET")]
+    pub experiment: Option<String>,
     /// The record: TEST=FILE or TEST[key=value,...]=FILE for a homogeneous
     /// test (as `palpate calibrate --data`), or FILE with --benchmark (CSV
     /// with displacement_mm, force_N and, for rate effects, time_s).
     #[arg(long, value_name = "TEST=FILE")]
     pub data: String,
     /// Base material law (neo-hookean, mooney-rivlin, reduced-polynomial:N,
-    /// yeoh, arruda-boyce, ogden:N, gent, veronda-westmann, humphrey). `--law` is
+    /// yeoh, arruda-boyce, ogden:N, gent, veronda-westmann, humphrey); default
+    /// neo-hookean, or with --experiment the description's law. `--law` is
     /// the same option.
-    #[arg(long, visible_alias = "law", default_value = "neo-hookean")]
-    pub base: String,
+    #[arg(long, visible_alias = "law")]
+    pub base: Option<String>,
     /// Candidate effects, comma separated. Default: those listed above for
     /// the record's kind (C1: every effect the model offers; N1: `friction`
     /// and `boundary_condition`; add `material_form` and `zero_offset` here:
@@ -109,6 +126,54 @@ pub fn read_record(benchmark: Option<&str>, data: &str) -> anyhow::Result<TestDa
             Ok(records.remove(0))
         }
     }
+}
+
+/// The base law without --base (and without --experiment).
+pub const DEFAULT_BASE: &str = "neo-hookean";
+
+/// The force record of an experiment's diagnosis: `FILE` or `force=FILE`
+/// (columns displacement_mm, force_N, optionally time_s).
+pub fn read_force_record(data: &str) -> anyhow::Result<TestData> {
+    let path = match data.split_once('=') {
+        Some((k, p)) if !Path::new(data).is_file() => {
+            anyhow::ensure!(
+                k.eq_ignore_ascii_case("force") || k.eq_ignore_ascii_case("n1"),
+                "--data {data}: an experiment is diagnosed on a force record: FILE or force=FILE (columns displacement_mm, force_N), not {k}=FILE"
+            );
+            p
+        }
+        _ => data,
+    };
+    TestData::read("record", TestKind::N1, Path::new(path)).with_context(|| format!("--data {path}"))
+}
+
+/// Diagnoses a force record of an experiment (`--experiment`): the base is
+/// its FE model ([`experiment_base`]), the candidates unless given are the
+/// effects it offers that the record can show ([`experiment_effects`]).
+pub fn diagnose_experiment(
+    record: &TestData,
+    spec: ExperimentSpec,
+    base: Option<&str>,
+    options: &GapOptions,
+) -> anyhow::Result<GapReport> {
+    let spec = experiment_base(spec, base, record)?;
+    let model = build(&spec).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let mut options = options.clone();
+    if options.effects.is_none() {
+        options.effects = Some(experiment_effects(model.as_ref(), &record.loading));
+    }
+    if let Some(effects) = &options.effects {
+        crate::model::check_effects(model.as_ref(), effects)
+            .map_err(|e| anyhow::anyhow!("--effects {e}"))?;
+        anyhow::ensure!(
+            !effects.is_empty(),
+            "{}: {} offers no candidate effect this record can show; give --effects",
+            record.file,
+            model.name()
+        );
+    }
+    diagnose(model.as_ref(), &record.loading, &record.observed, &options)
+        .with_context(|| format!("diagnosing {}", record.file))
 }
 
 /// Diagnoses one record (shared with the manifest step).
@@ -202,7 +267,15 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         }
         e => anyhow::anyhow!("{e}"),
     })?;
-    let record = read_record(args.benchmark.as_deref(), &args.data)?;
+    let experiment = args
+        .experiment
+        .as_deref()
+        .map(ExperimentSpec::from_option)
+        .transpose()?;
+    let record = match &experiment {
+        Some(_) => read_force_record(&args.data)?,
+        None => read_record(args.benchmark.as_deref(), &args.data)?,
+    };
     crate::run::output::check_outputs(
         &[Path::new(&record.file)],
         &crate::run::output::given(&[
@@ -211,7 +284,14 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             ("--plot", &args.plot),
         ]),
     )?;
-    let report = diagnose_record(&record, &args.base, &options)?;
+    let report = match experiment {
+        Some(spec) => diagnose_experiment(&record, spec, args.base.as_deref(), &options)?,
+        None => diagnose_record(
+            &record,
+            args.base.as_deref().unwrap_or(DEFAULT_BASE),
+            &options,
+        )?,
+    };
     println!("{}", gap_summary(&report));
     println!("{}", explanation_summary(&report));
     if let Some(p) = &args.json {

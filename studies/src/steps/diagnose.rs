@@ -2,7 +2,8 @@
 //! each record, a unit of the run folder cached under its inputs, and its
 //! table and plots in the report.
 
-use crate::model::{ModelForm, ModelSpec};
+use crate::model::{ExperimentSpec, ModelForm, ModelSpec};
+use palpate_core::{Effect, ForwardModel, Loading};
 use crate::model::{build, default_effects, gap_base_for, parse_effects};
 use crate::run::output::write_atomic;
 use crate::records::{TestData, TestKind};
@@ -30,7 +31,9 @@ pub struct DiagnoseStep {
     #[serde(default)]
     pub model: Option<String>,
     /// Candidate effects (GAP.md names); default: C1 every effect its model
-    /// offers, N1 `friction` and `boundary_condition`.
+    /// offers, N1 `friction` and `boundary_condition`, an experiment's model
+    /// (`model` naming a `[models.NAME] experiment = ..`) every effect it
+    /// offers that the record can show.
     #[serde(default)]
     pub effects: Option<Vec<String>>,
 }
@@ -144,7 +147,61 @@ fn diagnose_model(study: &Study, d: &DiagnoseStep, data: &str) -> Option<ModelSp
     }
 }
 
+/// The base of an experiment's diagnosis on `record`: its description with
+/// the law of its one material replaced by `law` when given (the law's
+/// parameters then start at their defaults), meshed for the record's
+/// deepest displacement when the protocol is the record's
+/// ([`palpate_fe::experiment::Experiment::size_for_depth`]). Parameters the
+/// description holds at their start (`fit = false`) are refused: the
+/// diagnosis (and `palpate sample`) vary every parameter of the model.
+pub fn experiment_base(
+    mut spec: ExperimentSpec,
+    law: Option<&str>,
+    record: &TestData,
+) -> anyhow::Result<ModelSpec> {
+    if let Some(law) = law {
+        law.parse::<Law>()
+            .map_err(|e| anyhow::anyhow!("--base {law}: {e}"))?;
+        let materials = &mut spec.experiment.materials;
+        anyhow::ensure!(
+            materials.len() == 1,
+            "--base {law}: {} has {} materials; give their laws in the description",
+            spec.source,
+            materials.len()
+        );
+        for m in materials.values_mut() {
+            if m.law != law {
+                m.law = law.to_string();
+                m.params.clear();
+            }
+        }
+    }
+    let fixed = spec.fixed()?;
+    if let Some((name, _)) = fixed.first() {
+        anyhow::bail!(
+            "{}: parameter `{name}` is held at its start (fit = false); diagnose and sample vary every parameter of the description: give it as a number to hold it, or let it be fitted",
+            spec.source
+        );
+    }
+    let deepest = record
+        .loading
+        .drive
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    spec.experiment.size_for_depth(deepest);
+    spec.check()?;
+    Ok(ModelSpec::Experiment(spec))
+}
 
+/// The candidates of an experiment's diagnosis: every effect its model
+/// offers (the description's type decides, `Setup::effects`), but
+/// `viscoelasticity` on a record without times.
+pub fn experiment_effects(model: &dyn ForwardModel, loading: &Loading) -> Vec<Effect> {
+    palpate_core::enrichable::effects_of(model)
+        .into_iter()
+        .filter(|e| *e != Effect::Viscoelasticity || loading.time.is_some())
+        .collect()
+}
 
 /// The loading paths of a record whose noise must be estimated path by
 /// path: a general biaxial record holds two stresses per row (one per
@@ -231,6 +288,8 @@ pub(crate) fn run_diagnose(
     for name in &step.data {
         let d = &data[name];
         let spec = match named {
+            Some(ModelSpec::Experiment(e)) => experiment_base(e.clone(), None, d)
+                .with_context(|| format!("step `{}`: `{name}`", step.name))?,
             Some(s) => s.clone(),
             None => {
                 let law: Law = base_name
@@ -257,6 +316,9 @@ pub(crate) fn run_diagnose(
                         parse_effects(list)
                             .with_context(|| format!("step `{}`: effects", step.name))?,
                     ),
+                    None if matches!(spec, ModelSpec::Experiment(_)) => {
+                        Some(experiment_effects(model.as_ref(), &d.loading))
+                    }
                     None => default_effects(&spec, model.as_ref(), &d.loading),
                 },
                 paths: noise_paths(d),
