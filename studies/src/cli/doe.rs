@@ -30,6 +30,13 @@
 //! normalised), `data` (a data-set name of `response.calibration.data`, or
 //! several joined by `+`), `estimator` (lm, bfgs, lbfgs). Factors of the FE
 //! benchmarks (`friction`, `space`, `mesh`) are not supported yet.
+//!
+//! With `--experiment FILE`, a `[response.simulation]` runs that lab's own
+//! experiment (docs/guide/experiment.md) instead of N1: its factors are
+//! parameters of the description (numeric levels, e.g. `name = "C10"`,
+//! `levels = ["2e-3", "5e-3"]`), the other parameters at the description's
+//! starts; `benchmark`, `law`, `friction`, `mesh` and `params` are refused
+//! (the description holds the model).
 
 use super::anova::{format_analysis, write_outputs};
 use crate::model::calibration::{calibrate, parse_method, Request};
@@ -45,6 +52,7 @@ use serde::Deserialize;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 /// Generate and run a designed experiment (factorial design) from a TOML manifest
 ///
@@ -60,6 +68,11 @@ pub struct Args {
     /// Output directory (default: print only).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// A lab's own experiment (an experiment file, a preset's name or the
+    /// description as JSON) that each run of `[response.simulation]`
+    /// simulates; the factors are its parameters.
+    #[arg(long, value_name = "FILE|PRESET")]
+    pub experiment: Option<String>,
 }
 
 /// A design manifest.
@@ -120,8 +133,8 @@ enum ResponseSpec {
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct SimulationResponse {
-    /// `N1` (the needle-indentation benchmark).
-    benchmark: String,
+    /// `N1` (the needle-indentation benchmark); not with `--experiment`.
+    benchmark: Option<String>,
     /// `r2` or `rms` (N) of the simulated force against the reference.
     metric: String,
     /// The reference curve (relative to the manifest).
@@ -225,6 +238,16 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         .unwrap_or(Path::new("."))
         .to_path_buf();
     let m = args.manifest.display();
+    let experiment = args
+        .experiment
+        .as_deref()
+        .map(crate::model::ExperimentSpec::from_option)
+        .transpose()?;
+    if experiment.is_some() && !matches!(manifest.response, Some(ResponseSpec::Simulation(_))) {
+        anyhow::bail!(
+            "--experiment: {m} has no [response.simulation] to run it (each run simulates the experiment)"
+        );
+    }
     if let Some(out) = &args.out {
         check_out(out, &args.manifest, &manifest, &base_dir)?;
     }
@@ -235,7 +258,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
             Some(prepare_calibrations(&design, c, &base_dir).map(Plan::Calibration))
         }
         Some(ResponseSpec::Simulation(s)) => {
-            Some(prepare_simulations(&design, s, &base_dir).map(Plan::Simulation))
+            Some(
+                match experiment {
+                    Some(e) => prepare_experiment(&design, s, &base_dir, e),
+                    None => prepare_simulations(&design, s, &base_dir),
+                }
+                .map(Plan::Simulation),
+            )
         }
         None => None,
     }
@@ -510,7 +539,7 @@ fn run_calibrations(
 /// Every run's N1 model with its parameters, the reference loading and the
 /// reference forces it is scored against.
 struct SimulationPlan {
-    models: Vec<(Box<dyn palpate_core::ForwardModel>, Vec<f64>)>,
+    models: Vec<(Arc<dyn palpate_core::ForwardModel>, Vec<f64>)>,
     loading: palpate_core::Loading,
     y: Vec<f64>,
 }
@@ -523,49 +552,22 @@ fn prepare_simulations(
     base: &Path,
 ) -> anyhow::Result<SimulationPlan> {
     use crate::model::{ModelSpec, N1NeedleSpec};
-    use palpate_core::{data::Table, Drive, ForwardModel, Loading};
-    if !spec.benchmark.eq_ignore_ascii_case("n1") {
-        anyhow::bail!(
-            "response.simulation.benchmark = `{}`: only N1 is supported",
-            spec.benchmark
-        );
+    use palpate_core::ForwardModel;
+    match spec.benchmark.as_deref() {
+        Some(b) if b.eq_ignore_ascii_case("n1") => {}
+        Some(b) => anyhow::bail!(
+            "response.simulation.benchmark = `{b}`: only N1 is supported (or run a lab's own experiment with --experiment FILE)"
+        ),
+        None => anyhow::bail!(
+            "response.simulation.benchmark: give N1, or run a lab's own experiment with --experiment FILE"
+        ),
     }
     for f in &d.factors {
         if !["law", "friction", "mesh"].contains(&f.name.as_str()) {
             anyhow::bail!("factor `{}` has no meaning for an N1 simulation; known factors: law, friction, mesh", f.name);
         }
     }
-    if !["r2", "rms"].contains(&spec.metric.as_str()) {
-        anyhow::bail!(
-            "response.simulation.metric = `{}`; expected r2 or rms",
-            spec.metric
-        );
-    }
-    let reference = Table::read(base.join(&spec.reference))?;
-    let depth = spec.max_depth_mm.unwrap_or(f64::INFINITY);
-    if depth.is_nan() || depth <= 0.0 {
-        anyhow::bail!("response.simulation.max_depth_mm = {depth}: must be positive");
-    }
-    let keep: Vec<usize> = (0..reference.len())
-        .filter(|&i| {
-            reference
-                .column("displacement_mm")
-                .map(|x| x[i] <= depth)
-                .unwrap_or(false)
-        })
-        .collect();
-    let x: Vec<f64> = keep
-        .iter()
-        .map(|&i| reference.column("displacement_mm").map(|c| c[i]))
-        .collect::<Result<_, _>>()?;
-    let y: Vec<f64> = keep
-        .iter()
-        .map(|&i| reference.column("force_N").map(|c| c[i]))
-        .collect::<Result<_, _>>()?;
-    if x.len() < 3 {
-        anyhow::bail!("response.simulation: fewer than 3 reference samples up to {depth} mm");
-    }
-    let loading = Loading::quasi_static(Drive::DisplacementMm, x);
+    let (loading, y) = reference_curve(spec, base)?;
     let setting = |run: &palpate_uq::doe::Run, factor: &str| -> Option<String> {
         d.factors
             .iter()
@@ -573,7 +575,7 @@ fn prepare_simulations(
             .map(|k| d.level_name(run, k).to_string())
     };
     // Every run's model is built and checked before anything runs.
-    let models: Vec<(Box<dyn ForwardModel>, Vec<f64>)> = d
+    let models: Vec<(Arc<dyn ForwardModel>, Vec<f64>)> = d
         .runs
         .iter()
         .map(|run| {
@@ -604,7 +606,7 @@ fn prepare_simulations(
             let law = model_spec
                 .law()
                 .map_err(|e| anyhow::anyhow!("{}: {e}", at()))?;
-            let model = checked.into_forward();
+            let model: Arc<dyn ForwardModel> = Arc::from(checked.into_forward());
             let theta: Vec<f64> = match spec.params.get(&law_text) {
                 Some(p) => model
                     .space()
@@ -628,6 +630,118 @@ fn prepare_simulations(
                 }
             };
             Ok((model, theta))
+        })
+        .collect::<anyhow::Result<_>>()?;
+    Ok(SimulationPlan { models, loading, y })
+}
+
+/// The metric checked and the reference curve of a simulation response
+/// (up to `max_depth_mm`): the loading of its displacements and its forces.
+fn reference_curve(
+    spec: &SimulationResponse,
+    base: &Path,
+) -> anyhow::Result<(palpate_core::Loading, Vec<f64>)> {
+    use palpate_core::{data::Table, Drive, Loading};
+    if !["r2", "rms"].contains(&spec.metric.as_str()) {
+        anyhow::bail!(
+            "response.simulation.metric = `{}`; expected r2 or rms",
+            spec.metric
+        );
+    }
+    let reference = Table::read(base.join(&spec.reference))?;
+    let depth = spec.max_depth_mm.unwrap_or(f64::INFINITY);
+    if depth.is_nan() || depth <= 0.0 {
+        anyhow::bail!("response.simulation.max_depth_mm = {depth}: must be positive");
+    }
+    let keep: Vec<usize> = (0..reference.len())
+        .filter(|&i| {
+            reference
+                .column("displacement_mm")
+                .map(|x| x[i] <= depth)
+                .unwrap_or(false)
+        })
+        .collect();
+    let x: Vec<f64> = keep
+        .iter()
+        .map(|&i| reference.column("displacement_mm").map(|c| c[i]))
+        .collect::<Result<_, _>>()?;
+    let y: Vec<f64> = keep
+        .iter()
+        .map(|&i| reference.column("force_N").map(|c| c[i]))
+        .collect::<Result<_, _>>()?;
+    if x.len() < 3 {
+        anyhow::bail!("response.simulation: fewer than 3 reference samples up to {depth} mm");
+    }
+    Ok((Loading::quasi_static(Drive::DisplacementMm, x), y))
+}
+
+/// Checks a simulation response of `--experiment`, reads its reference and
+/// builds the experiment's model (meshed for the reference's deepest
+/// displacement when its protocol is the record's) and every run's
+/// parameters: the factors' levels, the others at the description's starts.
+fn prepare_experiment(
+    d: &Design,
+    spec: &SimulationResponse,
+    base: &Path,
+    mut experiment: crate::model::ExperimentSpec,
+) -> anyhow::Result<SimulationPlan> {
+    use crate::model::ModelSpec;
+    let given: [(bool, &str); 5] = [
+        (spec.benchmark.is_some(), "benchmark"),
+        (spec.law.is_some(), "law"),
+        (spec.friction.is_some(), "friction"),
+        (spec.mesh.is_some(), "mesh"),
+        (!spec.params.is_empty(), "params"),
+    ];
+    if let Some((_, field)) = given.iter().find(|g| g.0) {
+        anyhow::bail!(
+            "response.simulation.{field}: not with --experiment: the description holds the model (its laws, tool friction, [mesh] and parameter starts)"
+        );
+    }
+    let (loading, y) = reference_curve(spec, base)?;
+    let space = experiment
+        .experiment
+        .param_space()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", experiment.source))?;
+    for f in &d.factors {
+        if space.index_of(&f.name).is_none() {
+            anyhow::bail!(
+                "factor `{}` is not a parameter of the experiment {} (its parameters: {})",
+                f.name,
+                experiment.source,
+                space.names().join(", ")
+            );
+        }
+    }
+    let deepest = loading.drive.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    experiment.experiment.size_for_depth(deepest);
+    experiment.check()?;
+    let model: Arc<dyn palpate_core::ForwardModel> = Arc::from(
+        ModelSpec::Experiment(experiment)
+            .validate()
+            .map_err(|e| anyhow::anyhow!("{}", e.expected))?
+            .into_forward(),
+    );
+    let start: Vec<f64> = space.params.iter().map(|p| p.initial).collect();
+    let models = d
+        .runs
+        .iter()
+        .map(|run| {
+            let at = format!("run {} (standard order {})", run.run_order, run.standard_order);
+            let mut theta = start.clone();
+            for (k, f) in d.factors.iter().enumerate() {
+                let text = d.level_name(run, k);
+                let v: f64 = text.trim().parse().map_err(|_| {
+                    anyhow::anyhow!("{at}: factor `{}` level `{text}` is not a number", f.name)
+                })?;
+                if let Some(j) = space.index_of(&f.name) {
+                    theta[j] = v;
+                }
+            }
+            space
+                .check(&theta)
+                .map_err(|e| anyhow::anyhow!("{at}: {e}"))?;
+            Ok((model.clone(), theta))
         })
         .collect::<anyhow::Result<_>>()?;
     Ok(SimulationPlan { models, loading, y })

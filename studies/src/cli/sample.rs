@@ -34,6 +34,9 @@ use std::path::{Path, PathBuf};
 /// design, so a second run reuses it. Its error on held-out FE runs is
 /// printed and added to the likelihood as a variance per sample. The FE model
 /// is the docs/benchmarks.md set-up on the coarse mesh unless --mesh.
+/// A lab's own experiment (--experiment FILE, docs/guide/experiment.md) is
+/// sampled the same way, its model the description's (meshed for the
+/// record's deepest displacement when its protocol is the record's).
 ///
 /// Convergence: the draws per chain are doubled (the run repeated from the
 /// same seed and continued) until every R-hat < 1.01 and every bulk ESS >=
@@ -48,21 +51,25 @@ use std::path::{Path, PathBuf};
 ///
 /// Example: palpate sample --benchmark C1 --law reduced-polynomial:2 --data c1.csv --sampler nuts --json post.json --plot figs
 /// Example: palpate sample --benchmark N1 --law neo-hookean --data n1.csv --box C10=0.0005,0.002 --json post.json
+/// Example: palpate sample --experiment gel-disc.toml --data force=indent.csv --box C10=0.001,0.01 --json post.json
 #[derive(Debug, clap::Args)]
 #[command(verbatim_doc_comment, allow_negative_numbers = true)]
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N,
-    /// gent, veronda-westmann, humphrey.
-    #[arg(long)]
-    pub law: String,
+    /// gent, veronda-westmann, humphrey. Not with --experiment, whose description names its laws.
+    #[arg(long, required_unless_present = "experiment", conflicts_with = "experiment")]
+    pub law: Option<String>,
     /// Data: TEST=FILE for homogeneous tests, or FILE with --benchmark C1. Repeatable.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]
     pub data: Vec<String>,
     #[command(flatten)]
     pub reading: crate::cli::reading::ReadingArgs,
     /// Benchmark whose force record the data are: C1 (analytic), or N1, N3, Q1 (finite elements, through a surrogate).
-    #[arg(long, value_name = "ID")]
+    #[arg(long, value_name = "ID", conflicts_with = "experiment")]
     pub benchmark: Option<String>,
+    /// A lab's own experiment (an experiment file, a preset's name or the description as JSON): its FE model, sampled through a surrogate as the FE benchmarks are (--box for each of its parameters; --design, --holdout, --cache apply; the model's settings are the description's).
+    #[arg(long, value_name = "FILE|PRESET")]
+    pub experiment: Option<String>,
     /// N1, N3, Q1: the box the surrogate is trained in and the posterior lives in, NAME=LO,HI for every law parameter (physical units). Repeatable.
     #[arg(long = "box", value_name = "NAME=LO,HI")]
     pub boxes: Vec<String>,
@@ -225,6 +232,16 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
     Ok(())
 }
 
+/// The parsed `--law`.
+fn law_of(args: &Args) -> anyhow::Result<Law> {
+    let text = args
+        .law
+        .as_deref()
+        .ok_or_else(|| anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)"))?;
+    text.parse()
+        .map_err(|e| anyhow::anyhow!("--law {text}: {e}"))
+}
+
 /// The cap of the draws per chain: --max-draws, else 16 x the first run's.
 fn max_draws(args: &Args, draws: usize) -> usize {
     args.max_draws.unwrap_or(draws.saturating_mul(16))
@@ -257,10 +274,11 @@ fn hierarchical(args: &Args) -> anyhow::Result<()> {
         args.benchmark.is_none() && args.sigma.is_none() && !args.ar1 && args.prior.is_empty() && !args.evidence,
         "--hierarchical: the records' own fits make the test level; not with --benchmark, --sigma, --ar1, --prior or --evidence"
     );
-    let law: Law = args
-        .law
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    anyhow::ensure!(
+        args.experiment.is_none(),
+        "--hierarchical: not with --experiment (the records' own fits are those of a law)"
+    );
+    let law = law_of(args)?;
     let records = read_data_opts(&args.data, None, &[], &args.reading.defaults()?)?;
     anyhow::ensure!(
         records.len() >= 2,
@@ -293,12 +311,26 @@ pub fn draw(
     args: &Args,
     arrays: &[crate::records::arrays::ArrayRecord],
 ) -> anyhow::Result<Sampled> {
-    let law: Law = args
-        .law
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--law {}: {e}", args.law))?;
+    let experiment = args
+        .experiment
+        .as_deref()
+        .map(crate::model::ExperimentSpec::from_option)
+        .transpose()?;
+    let law = match &experiment {
+        Some(_) => None,
+        None => Some(law_of(args)?),
+    };
     let sampler = sampler_from(args)?;
-    check_sizes(args, &sampler, law.params().len() + 2 * args.data.len())?;
+    let dim = match (&experiment, law) {
+        (Some(e), _) => e
+            .experiment
+            .param_space()
+            .map_err(|err| anyhow::anyhow!("{}: {err}", e.source))?
+            .len(),
+        (None, Some(l)) => l.params().len(),
+        (None, None) => 0,
+    };
+    check_sizes(args, &sampler, dim + 2 * args.data.len())?;
     super::sample_fe::check_options(args)?;
     let fe_kind = super::sample_fe::fe_benchmark(args.benchmark.as_deref());
     if let Some(s) = args.sigma {
@@ -330,7 +362,29 @@ pub fn draw(
     let outputs =
         crate::run::output::given(&[("--json", &args.json), ("--chains", &args.chains_out)]);
     let output_dirs = crate::run::output::given(&[("--plot", &args.plot)]);
-    let (sets, fe) = if let Some(kind) = fe_kind {
+    let (sets, fe) = if let Some(spec) = experiment {
+        anyhow::ensure!(
+            arrays.is_empty(),
+            "--experiment: the record is read from a file (--data FILE), not from arrays"
+        );
+        anyhow::ensure!(
+            !args.ar1,
+            "--ar1: the surrogate's error variance is added to independent noise only; leave out --ar1 with --experiment"
+        );
+        for d in &args.data {
+            let p = d.split_once('=').map_or(d.as_str(), |x| x.1);
+            crate::run::output::check_outputs_and_dirs(&[Path::new(p)], &outputs, &output_dirs)?;
+        }
+        let fe = super::sample_fe::setup_experiment(spec, args)?;
+        let set = DataSet {
+            name: "force".to_string(),
+            model: fe.surrogate.clone(),
+            loading: fe.data.loading.clone(),
+            observed: fe.data.observed.clone(),
+            noise: noise_of(&fe.data.observed),
+        };
+        (vec![set], Some(fe))
+    } else if let Some(kind) = fe_kind {
         anyhow::ensure!(
             arrays.is_empty(),
             "--benchmark {kind}: the record is read from a file (--data FILE), not from arrays"
@@ -366,7 +420,7 @@ pub fn draw(
             .map(|t| -> anyhow::Result<DataSet> {
                 Ok(DataSet {
                     name: t.name.clone(),
-                    model: crate::model::test_model(t.test, law)?,
+                    model: crate::model::test_model(t.test, law_of(args)?)?,
                     loading: t.loading.clone(),
                     observed: t.observed.clone(),
                     noise: noise_of(&t.observed),
@@ -713,6 +767,7 @@ fn report(
     }
     json!({
         "law": args.law,
+        "experiment": args.experiment,
         "model": post.datasets()[0].model.name(),
         "data": args.data,
         "sampler": run.sampler,

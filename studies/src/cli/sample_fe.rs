@@ -9,7 +9,7 @@
 //! surrogate does not extrapolate.
 
 use super::sample::Args;
-use crate::model::{ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
+use crate::model::{ExperimentSpec, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
 use crate::records::{TestData, TestKind};
 use crate::run::surrogate::{default_cache_dir, load_or_build, parse_box, CacheStatus};
 
@@ -32,6 +32,22 @@ pub fn fe_benchmark(benchmark: Option<&str>) -> Option<&'static str> {
 /// Refuses an FE option without an FE benchmark, or one of another FE
 /// benchmark, naming it.
 pub fn check_options(args: &Args) -> anyhow::Result<()> {
+    if args.experiment.is_some() {
+        // the model's settings have their place in the description
+        let model_options: [(bool, &str, &str); 5] = [
+            (args.mesh.is_some(), "--mesh", "[mesh] level and element"),
+            (args.bulk.is_some(), "--bulk", "materials.NAME.bulk"),
+            (args.friction.is_some(), "--friction", "tool.friction"),
+            (args.prony.is_some(), "--prony", "materials.NAME.prony"),
+            (args.edge_radius.is_some(), "--edge-radius", "tool.edge_radius of a flat punch"),
+        ];
+        if let Some((_, name, place)) = model_options.iter().find(|o| o.0) {
+            anyhow::bail!(
+                "{name}: not an option with --experiment: the description holds the model (give its {place} there)"
+            );
+        }
+        return Ok(());
+    }
     let kind = fe_benchmark(args.benchmark.as_deref());
     let given: [(bool, &str, &[&str]); 9] = [
         (!args.boxes.is_empty(), "--box", &FE_BENCHMARKS),
@@ -65,21 +81,21 @@ pub fn model_spec(kind: &str, args: &Args) -> ModelSpec {
     let mesh = Some(args.mesh.clone().unwrap_or_else(|| "coarse".into()));
     match kind {
         "N1" => ModelSpec::N1Needle(N1NeedleSpec {
-            law: args.law.clone(),
+            law: args.law.clone().unwrap_or_default(),
             friction: args.friction,
             mesh,
             bulk: args.bulk.clone(),
             ..Default::default()
         }),
         "N3" => ModelSpec::N3Needle(N3NeedleSpec {
-            law: args.law.clone(),
+            law: args.law.clone().unwrap_or_default(),
             friction: args.friction,
             mesh,
             bulk: args.bulk.clone(),
             ..Default::default()
         }),
         _ => ModelSpec::Q1(Q1Spec {
-            law: args.law.clone(),
+            law: args.law.clone().unwrap_or_default(),
             mesh,
             bulk: args.bulk.clone(),
             prony: args.prony.clone(),
@@ -117,9 +133,31 @@ pub fn setup(kind: &str, args: &Args) -> anyhow::Result<FeRecord> {
         );
     }
     let spec = model_spec(kind, args);
+    surrogate(data, spec, args)
+}
+
+/// Reads the force record of `--experiment` and builds or loads the
+/// surrogate of the description's model (meshed for the record's deepest
+/// displacement when its protocol is the record's).
+pub fn setup_experiment(spec: ExperimentSpec, args: &Args) -> anyhow::Result<FeRecord> {
+    anyhow::ensure!(
+        args.data.len() == 1,
+        "--experiment: give one record (--data FILE), got {}",
+        args.data.len()
+    );
+    let data = crate::cli::diagnose::read_force_record(&args.data[0])?;
+    let spec = crate::steps::diagnose::experiment_base(spec, None, &data)?;
+    surrogate(data, spec, args)
+}
+
+/// The surrogate of `spec`'s model on the record's loading.
+fn surrogate(data: TestData, spec: ModelSpec, args: &Args) -> anyhow::Result<FeRecord> {
     let model = spec
         .validate()
-        .map_err(|e| anyhow::anyhow!("{}", e.as_option()))?
+        .map_err(|e| match &spec {
+            ModelSpec::Experiment(_) => anyhow::anyhow!("{}", e.expected),
+            _ => anyhow::anyhow!("{}", e.as_option()),
+        })?
         .into_forward();
     let bounds = parse_box(&args.boxes, model.as_ref())?;
     let mut options = SurrogateOptions::for_dimension(bounds.len());

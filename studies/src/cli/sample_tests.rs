@@ -7,10 +7,11 @@ use super::*;
 /// they try.
 fn c1_args() -> Args {
     Args {
-        law: "neo-hookean".into(),
+        law: Some("neo-hookean".into()),
         data: vec!["x.csv".into()],
         reading: Default::default(),
         benchmark: Some("C1".into()),
+        experiment: None,
         boxes: vec![],
         mesh: None,
         bulk: None,
@@ -44,7 +45,7 @@ fn samples_c1_and_writes_json_csv_and_plots() {
     let dir = tempfile::tempdir().unwrap();
     let json_path = dir.path().join("post.json");
     let args = Args {
-        law: "reduced-polynomial:2".into(),
+        law: Some("reduced-polynomial:2".into()),
         data: vec![data.display().to_string()],
         max_draws: Some(300),
         sampler: "demc".into(),
