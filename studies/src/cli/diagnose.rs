@@ -4,10 +4,10 @@
 
 use crate::cli::calibrate::read_data;
 use crate::model::{build, default_effects, gap_base_for, parse_effects, ExperimentSpec};
-use crate::steps::diagnose::{experiment_base, experiment_effects};
 use crate::records::{TestData, TestKind};
 use crate::report::{gap_summary, gap_svg};
 use crate::run::output::{write_atomic, write_json};
+use crate::steps::diagnose::{experiment_base, experiment_effects};
 use anyhow::Context;
 use palpate_material::Law;
 use palpate_uq::gap::{diagnose, GapOptions, GapReport};
@@ -144,7 +144,8 @@ pub fn read_force_record(data: &str) -> anyhow::Result<TestData> {
         }
         _ => data,
     };
-    TestData::read("record", TestKind::N1, Path::new(path)).with_context(|| format!("--data {path}"))
+    TestData::read("record", TestKind::N1, Path::new(path))
+        .with_context(|| format!("--data {path}"))
 }
 
 /// Diagnoses a force record of an experiment (`--experiment`): the base is

@@ -257,15 +257,13 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         Some(ResponseSpec::Calibration(c)) => {
             Some(prepare_calibrations(&design, c, &base_dir).map(Plan::Calibration))
         }
-        Some(ResponseSpec::Simulation(s)) => {
-            Some(
-                match experiment {
-                    Some(e) => prepare_experiment(&design, s, &base_dir, e),
-                    None => prepare_simulations(&design, s, &base_dir),
-                }
-                .map(Plan::Simulation),
-            )
-        }
+        Some(ResponseSpec::Simulation(s)) => Some(
+            match experiment {
+                Some(e) => prepare_experiment(&design, s, &base_dir, e),
+                None => prepare_simulations(&design, s, &base_dir),
+            }
+            .map(Plan::Simulation),
+        ),
         None => None,
     }
     .transpose()
@@ -727,7 +725,10 @@ fn prepare_experiment(
         .runs
         .iter()
         .map(|run| {
-            let at = format!("run {} (standard order {})", run.run_order, run.standard_order);
+            let at = format!(
+                "run {} (standard order {})",
+                run.run_order, run.standard_order
+            );
             let mut theta = start.clone();
             for (k, f) in d.factors.iter().enumerate() {
                 let text = d.level_name(run, k);

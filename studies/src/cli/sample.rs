@@ -57,7 +57,11 @@ use std::path::{Path, PathBuf};
 pub struct Args {
     /// Material law: neo-hookean, mooney-rivlin, reduced-polynomial:N, yeoh, arruda-boyce, ogden:N,
     /// gent, veronda-westmann, humphrey. Not with --experiment, whose description names its laws.
-    #[arg(long, required_unless_present = "experiment", conflicts_with = "experiment")]
+    #[arg(
+        long,
+        required_unless_present = "experiment",
+        conflicts_with = "experiment"
+    )]
     pub law: Option<String>,
     /// Data: TEST=FILE for homogeneous tests, or FILE with --benchmark C1. Repeatable.
     #[arg(long = "data", required = true, value_name = "TEST=FILE")]

@@ -39,7 +39,11 @@ pub fn check_options(args: &Args) -> anyhow::Result<()> {
             (args.bulk.is_some(), "--bulk", "materials.NAME.bulk"),
             (args.friction.is_some(), "--friction", "tool.friction"),
             (args.prony.is_some(), "--prony", "materials.NAME.prony"),
-            (args.edge_radius.is_some(), "--edge-radius", "tool.edge_radius of a flat punch"),
+            (
+                args.edge_radius.is_some(),
+                "--edge-radius",
+                "tool.edge_radius of a flat punch",
+            ),
         ];
         if let Some((_, name, place)) = model_options.iter().find(|o| o.0) {
             anyhow::bail!(

@@ -2,17 +2,17 @@
 //! each record, a unit of the run folder cached under its inputs, and its
 //! table and plots in the report.
 
-use crate::model::{ExperimentSpec, ModelForm, ModelSpec};
-use palpate_core::{Effect, ForwardModel, Loading};
 use crate::model::{build, default_effects, gap_base_for, parse_effects};
-use crate::run::output::write_atomic;
+use crate::model::{ExperimentSpec, ModelForm, ModelSpec};
 use crate::records::{TestData, TestKind};
-use crate::steps::replicates::sig4;
-use palpate_uq::gap::NoisePaths;
 use crate::report::{data_unit, gap_svg, gap_table_header};
+use crate::run::output::write_atomic;
 use crate::run::step::{duplicate, keys, At, Run, Step, StepResult, Study};
+use crate::steps::replicates::sig4;
 use anyhow::Context;
+use palpate_core::{Effect, ForwardModel, Loading};
 use palpate_material::Law;
+use palpate_uq::gap::NoisePaths;
 use serde::{Deserialize, Serialize};
 use std::fmt::Write;
 
@@ -228,7 +228,11 @@ pub fn noise_paths(record: &TestData) -> Option<NoisePaths> {
     let runs = |first: bool| {
         rows.windows(2)
             .filter(|w| {
-                let (a, b) = if first { (w[0].0, w[1].0) } else { (w[0].1, w[1].1) };
+                let (a, b) = if first {
+                    (w[0].0, w[1].0)
+                } else {
+                    (w[0].1, w[1].1)
+                };
                 !same(a, b)
             })
             .count()
@@ -240,7 +244,11 @@ pub fn noise_paths(record: &TestData) -> Option<NoisePaths> {
     for (i, &(l1, l2)) in rows.iter().enumerate() {
         let (held, varied) = if held_first { (l1, l2) } else { (l2, l1) };
         if i > 0 {
-            let prev = if held_first { rows[i - 1].0 } else { rows[i - 1].1 };
+            let prev = if held_first {
+                rows[i - 1].0
+            } else {
+                rows[i - 1].1
+            };
             if !same(prev, held) {
                 id += 1;
             }
@@ -339,8 +347,7 @@ pub(crate) fn run_diagnose(
                 sig4(gap.noise_sd),
                 sig4(gap.base.misfit),
                 best.map(|b| b.effect.to_string()).unwrap_or_default(),
-                best.map(|b| sig4(b.misfit_after))
-                    .unwrap_or_default(),
+                best.map(|b| sig4(b.misfit_after)).unwrap_or_default(),
                 best.map(|b| format!("{} / {}", sig4(b.heldout_before), sig4(b.heldout_after)))
                     .unwrap_or_default(),
             );
@@ -388,7 +395,11 @@ mod tests {
         let paths = noise_paths(&d).unwrap();
         let labels: std::collections::BTreeSet<usize> = paths.path.iter().copied().collect();
         let rows = d.loading.len() / 2;
-        assert!(labels.len() >= 20 && labels.len() < rows, "{} paths", labels.len());
+        assert!(
+            labels.len() >= 20 && labels.len() < rows,
+            "{} paths",
+            labels.len()
+        );
         // within a path the position (lambda2) increases
         for w in paths.path.windows(3).zip(paths.along.windows(3)) {
             if w.0[0] == w.0[2] {

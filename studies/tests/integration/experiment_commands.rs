@@ -25,7 +25,10 @@ fn record(noise: f64) -> String {
         .model()
         .unwrap()
         .as_forward()
-        .predict(&[TRUTH], &Loading::quasi_static(Drive::DisplacementMm, depths.clone()))
+        .predict(
+            &[TRUTH],
+            &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
+        )
         .unwrap();
     let top = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut csv = String::from("displacement_mm,force_N\n");
@@ -46,10 +49,27 @@ fn sample_takes_an_experiment() {
     let json = s.path("post.json").display().to_string();
     let cache = s.path("cache").display().to_string();
     let o = s.run(&[
-        "sample", "--experiment", &gel, "--data", &format!("force={data}"),
-        "--box", "C10=0.002,0.01", "--design", "8", "--holdout", "3",
-        "--cache", &cache, "--draws", "300", "--max-draws", "300", "--tune", "300",
-        "--json", &json,
+        "sample",
+        "--experiment",
+        &gel,
+        "--data",
+        &format!("force={data}"),
+        "--box",
+        "C10=0.002,0.01",
+        "--design",
+        "8",
+        "--holdout",
+        "3",
+        "--cache",
+        &cache,
+        "--draws",
+        "300",
+        "--max-draws",
+        "300",
+        "--tune",
+        "300",
+        "--json",
+        &json,
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let v: serde_json::Value =
@@ -58,15 +78,31 @@ fn sample_takes_an_experiment() {
     let (lo, hi) = (p["hdi_3"].as_f64().unwrap(), p["hdi_97"].as_f64().unwrap());
     assert!(lo < TRUTH && TRUTH < hi, "C10 94 % HDI [{lo}, {hi}]");
     assert!(hi - lo < 0.2 * TRUTH, "C10 94 % HDI [{lo}, {hi}]");
-    assert!(v["surrogate"]["model"].as_str().unwrap().contains("Experiment"));
+    assert!(v["surrogate"]["model"]
+        .as_str()
+        .unwrap()
+        .contains("Experiment"));
     // the settings the description holds are not options
     let o = s.run(&[
-        "sample", "--experiment", &gel, "--data", &data, "--box", "C10=0.002,0.01",
-        "--friction", "0.3",
+        "sample",
+        "--experiment",
+        &gel,
+        "--data",
+        &data,
+        "--box",
+        "C10=0.002,0.01",
+        "--friction",
+        "0.3",
     ]);
     refused(&o, &["--friction", "tool.friction"]);
     let o = s.run(&[
-        "sample", "--experiment", &gel, "--data", &data, "--law", "neo-hookean",
+        "sample",
+        "--experiment",
+        &gel,
+        "--data",
+        &data,
+        "--law",
+        "neo-hookean",
     ]);
     refused(&o, &["--law", "--experiment"]);
 }
@@ -108,7 +144,10 @@ fn doe_takes_an_experiment() {
         &s.run(&["doe", "--manifest", &bad, "--experiment", &gel]),
         &["factor `friction`", "C10"],
     );
-    let bad = s.file("bad2.toml", &manifest("C10", "[\"3e-3\", \"5e-3\"]", "law = \"yeoh\"\n"));
+    let bad = s.file(
+        "bad2.toml",
+        &manifest("C10", "[\"3e-3\", \"5e-3\"]", "law = \"yeoh\"\n"),
+    );
     refused(
         &s.run(&["doe", "--manifest", &bad, "--experiment", &gel]),
         &["response.simulation.law", "--experiment"],

@@ -53,7 +53,10 @@ fn record(text: &str, theta: &[f64], noise: f64, seed: u64) -> String {
         .model()
         .unwrap()
         .as_forward()
-        .predict(theta, &Loading::quasi_static(Drive::DisplacementMm, depths.clone()))
+        .predict(
+            theta,
+            &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
+        )
         .unwrap();
     let top = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);

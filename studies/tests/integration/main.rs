@@ -15,6 +15,8 @@ mod common;
 mod diagnose_homogeneous;
 mod experiment_calibrate;
 mod experiment_cli;
+mod experiment_commands;
+mod experiment_diagnose;
 mod homogeneous_kinds;
 mod localize_coverage;
 mod localize_pipeline;
