@@ -17,6 +17,7 @@ mod experiment_calibrate;
 mod experiment_cli;
 mod experiment_commands;
 mod experiment_diagnose;
+mod experiment_thickness;
 mod homogeneous_kinds;
 mod localize_coverage;
 mod localize_pipeline;
