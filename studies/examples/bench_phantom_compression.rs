@@ -148,7 +148,7 @@ fn fits_table(fits: &[Fit], c10_h: f64) -> String {
             f.se,
             f.c10 / c10_h,
             f.friction
-                .map_or("-".into(), |(v, s)| format!("{v:.3} +- {s:.3}")),
+                .map_or("-".into(), |(v, s)| format!("{v:.4} +- {s:.1e}")),
             f.rms,
             f.evaluations,
             f.iterations,
@@ -459,6 +459,29 @@ fn main() -> anyhow::Result<()> {
             std::fs::write(&out, format!("{page}{}", fits_table(&fits, c10_h)))?;
         }
         page += &fits_table(&fits, c10_h);
+        // a fitted friction that fits worse than a fixed one is no optimum
+        let fixed_rms = fits
+            .iter()
+            .filter(|f| f.label.starts_with("FE") && f.friction.is_none())
+            .map(|f| f.rms)
+            .fold(f64::INFINITY, f64::min);
+        if let Some(f) = fits
+            .iter()
+            .find(|f| f.friction.is_some() && f.rms > fixed_rms)
+        {
+            writeln!(
+                page,
+                "The fit with the platen friction fitted is **not an optimum**: it ended at \
+                 friction {:.4} with an RMS of {:.3} N, above the {fixed_rms:.3} N of a fit with \
+                 the friction held. Just past that point the FE run at this mesh fails (an \
+                 element at the platen's edge inverts at about 6.6 mm of compression); every \
+                 trial step there is rejected, so the fit does not abort, but it stops on the \
+                 edge of that region, and its standard errors there mean nothing. Until the \
+                 run holds there, fit C10 at a few fixed frictions (the rows above).\n",
+                f.friction.map_or(f64::NAN, |x| x.0),
+                f.rms
+            )?;
+        }
     }
     std::fs::write(&out, &page)?;
     if !skip_ccx {
