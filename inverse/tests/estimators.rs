@@ -542,6 +542,61 @@ fn a_forward_failure_at_the_start_names_the_set() {
     assert!((r.value("a").unwrap() - 1.0).abs() < 1e-10);
 }
 
+/// `y = a^3 x` whose solve fails (an FE run whose element inverts) for
+/// `a > 1.2`, with its exact sensitivity `3 a^2 x`.
+fn fails_above(a: f64, x: f64) -> Result<f64, ForwardError> {
+    if a > 1.2 {
+        return Err(ForwardError::NotConverged {
+            sample: 0,
+            drive: x,
+            cuts: 1,
+            reason: "element 110 inverted (det F = -9.070e-2)".into(),
+            completed: vec![],
+        });
+    }
+    Ok(a.powi(3) * x)
+}
+
+struct CubeSensitivities;
+impl Sensitivities for CubeSensitivities {
+    fn predict_with_jacobian(
+        &self,
+        t: &[f64],
+        loading: &Loading,
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
+        let pred = loading
+            .drive
+            .iter()
+            .map(|&x| fails_above(t[0], x))
+            .collect::<Result<Vec<_>, _>>()?;
+        let da = loading
+            .drive
+            .iter()
+            .map(|x| 3.0 * t[0] * t[0] * x)
+            .collect();
+        Ok((pred, vec![da]))
+    }
+}
+
+/// With exact sensitivities (one run gives residuals and Jacobian), a trial
+/// step whose run fails is a rejected step: from a = 0.3 the Gauss-Newton
+/// step goes to a = 3.9, where the model fails, and the fit continues with
+/// shorter steps to the truth a = 1.
+#[test]
+fn a_failed_run_at_a_trial_point_is_a_rejected_step_with_exact_sensitivities() {
+    let model: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "fails above 1.2",
+        space: ParamSpace::new(vec![p("a", 0.0, INF, 0.3)]),
+        law: |t, x| fails_above(t[0], x),
+    });
+    let s = set(model, times(10, 2.0), &[1.0]).with_sensitivities(Arc::new(CubeSensitivities));
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    assert!(obj.has_exact_sensitivities());
+    let r = fit(&obj, &lm()).unwrap();
+    assert!((r.value("a").unwrap() - 1.0).abs() < 1e-8, "{r:?}");
+    assert!(r.converged);
+}
+
 #[test]
 fn multistart_escapes_a_local_minimum_and_the_observer_sees_progress() {
     // y = sin(w t): from w0 = 1 the nearest minimum is not the truth w = 3.

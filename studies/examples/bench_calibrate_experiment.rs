@@ -18,7 +18,9 @@
 //! seconds of this process, and each estimate with its standard error and
 //! its distance from the truth in standard errors. The command line runs
 //! in-process (`palpate_studies::cli`, parsed by the CLI's own clap
-//! definitions), so the fit is the one `palpate calibrate` makes.
+//! definitions), so the fit is the one `palpate calibrate` makes. Its
+//! figures are in `docs/validation/fe.md`, "Calibration on an FE experiment
+//! from the command line".
 //!
 //! ```text
 //! nice cargo run -p palpate-studies --example bench_calibrate_experiment -- [n1] [gel] [--noise 0.005] [--level 1]
