@@ -15,7 +15,7 @@
 //! Prints per route the iterations, the FE runs (plain, and with
 //! sensitivities), the runs of each iteration (`plain+sensitivities`, the
 //! start first, the statistics at the optimum last), the CPU seconds (user
-//! + system of this process), the FE-run equivalents (CPU over the CPU of
+//! and system time of this process), the FE-run equivalents (CPU over the CPU of
 //! one plain run at the truth), the CPU of one run with sensitivities, and
 //! the estimates with their standard errors and the difference between the
 //! routes in standard errors of the exact route. The rows are Markdown
