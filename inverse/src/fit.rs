@@ -2,6 +2,7 @@
 //! statistics at the best optimum.
 
 use crate::boundary_polish::boundary_polish;
+use crate::jacobian::ExactEvaluation;
 use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
 use crate::wall_slide::{limit_ahead, wall_slide};
@@ -198,7 +199,8 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
                 (polished.outcome, report)
             }
             None => {
-                let mut report = statistics(objective, &outcome.z, &options.fd)?;
+                let mut report =
+                    statistics_with(objective, &outcome.z, &options.fd, outcome.exact.clone())?;
                 if blocked {
                     report.on_limit = limit_ahead(objective, &options.fd, &outcome.z);
                 }
@@ -224,10 +226,26 @@ pub fn statistics(
     z: &[f64],
     fd: &FdOptions,
 ) -> Result<FitReport, InverseError> {
+    statistics_with(objective, z, fd, None)
+}
+
+/// [`statistics`], from the predictions, residuals and exact Jacobian of a
+/// run with sensitivities at `z` when the solver kept one (no run then;
+/// the report counts no evaluation).
+fn statistics_with(
+    objective: &Objective,
+    z: &[f64],
+    fd: &FdOptions,
+    kept: Option<ExactEvaluation>,
+) -> Result<FitReport, InverseError> {
     let theta = objective.theta_from_unbounded(z);
+    let reused = kept.is_some();
     // With exact sensitivities one run gives the predictions and the
-    // Jacobian; otherwise the predictions, then finite differences.
-    let (predictions, r, jz) = if objective.has_exact_sensitivities() {
+    // Jacobian (none when the solver kept them); otherwise the
+    // predictions, then finite differences.
+    let (predictions, r, jz) = if let Some(kept) = kept {
+        kept
+    } else if objective.has_exact_sensitivities() {
         residuals_and_exact_jacobian(objective, z, "final point")?
     } else {
         let mut evs = objective.evaluators();
@@ -338,7 +356,9 @@ pub fn statistics(
         r_squared: 1.0 - ss_res_all / ss_tot_all,
         n_residuals: m,
         iterations: 0,
-        evaluations: if objective.has_exact_sensitivities() {
+        evaluations: if reused {
+            0
+        } else if objective.has_exact_sensitivities() {
             1
         } else {
             1 + jz.evaluations

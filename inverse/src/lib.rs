@@ -67,7 +67,7 @@ pub use jacobian::{jacobian_unbounded, residuals_and_exact_jacobian, FdOptions, 
 pub use lm::{LevenbergMarquardt, LmOptions, LmState};
 pub use objective::{sum_of_squares, Evaluators, Objective, ParamMap};
 pub use observer::{shared_observer, FitObserver, Progress, SharedObserver};
-pub use problem::{EvaluationCount, LeastSquaresProblem};
+pub use problem::{EvaluationCount, LeastSquaresProblem, Runs};
 pub use report::{BoundSide, FitReport, ParameterEstimate, SetReport};
 pub use residual::ResidualKind;
 pub use run::{Method, QuasiNewtonOptions};

@@ -29,6 +29,22 @@
 //! `mu <- mu * nu`, `nu <- 2 nu`. Initial `mu = tau` (relative to `D^2`).
 //! A failed forward evaluation at a trial point is a rejected step.
 //!
+//! Where the Jacobian comes with the residuals at a price (exact
+//! sensitivities: a run with sensitivities costs a plain run and a
+//! fraction more, [`EvaluationCount::jacobian_with_residuals`]), a trial
+//! is evaluated with its Jacobian only when it will probably be accepted:
+//! when the last trial was accepted with a good gain ratio (`rho > 1/4`,
+//! the quadratic model was trusted). Otherwise (the first trial, any trial
+//! after a rejection or a poor step) it is evaluated plain, and a plain
+//! trial that is accepted gets its Jacobian from one more run. With a
+//! run with sensitivities costing `c` plain runs, this pays `1` for a
+//! rejected plain trial and `1 + c` for an accepted one against `c` for
+//! either with sensitivities: cheaper whenever the acceptance probability
+//! is below `1 - 1/c` (a third at `c = 1.5`), which is the case after a
+//! rejection (the growing damping is still searching for the trust
+//! region) and not after a good step (a trusted model near the optimum
+//! is accepted again).
+//!
 //! Stopping, as MINPACK's `lmder`:
 //! * `ftol`: `|ared| / SSE <= ftol` and `pred / SSE <= ftol` and `rho <= 2`;
 //! * `xtol`: `||D h|| <= xtol (||D z|| + xtol)`;
@@ -36,6 +52,10 @@
 //! * zero residual, evaluation budget, iteration budget (argmin's `max_iters`).
 
 use crate::problem::EvaluationCount;
+
+/// Gain ratio above which the next trial is expected to be accepted (and is
+/// evaluated with its Jacobian where that is cheaper together).
+const TRUSTED_GAIN: f64 = 0.25;
 use crate::Termination;
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, TerminationReason, TerminationStatus, KV,
@@ -84,6 +104,8 @@ pub struct LevenbergMarquardt {
     termination: Option<Termination>,
     /// The last trial since the last accepted step failed to evaluate.
     blocked: bool,
+    /// The last trial was accepted with a gain ratio above [`TRUSTED_GAIN`].
+    trusted: bool,
 }
 
 impl LevenbergMarquardt {
@@ -97,6 +119,7 @@ impl LevenbergMarquardt {
             jacobian: DMatrix::zeros(0, 0),
             termination: None,
             blocked: false,
+            trusted: false,
         }
     }
 
@@ -211,12 +234,17 @@ where
         let z = state
             .take_param()
             .ok_or_else(|| Error::msg("Levenberg-Marquardt needs a starting point"))?;
+        // the start needs its Jacobian: one run for both where they come together
+        if let Some(p) = problem.problem.as_ref() {
+            p.jacobian_with_residuals(true);
+        }
         let r = problem.apply(&z)?;
         self.jacobian = problem.jacobian(&z)?;
         self.update_scale();
         self.mu = self.options.initial_damping;
         self.nu = 2.0;
         self.termination = None;
+        self.trusted = false;
         let sse: f64 = r.iter().map(|v| v * v).sum();
         self.check_converged(&r, sse);
         let g = gradient(&self.jacobian, &r);
@@ -266,6 +294,9 @@ where
             let predicted_sse: f64 = r.iter().zip(jh.iter()).map(|(a, b)| (a + b).powi(2)).sum();
             let pred = sse - predicted_sse;
             let z_new: Vec<f64> = z.iter().zip(&h).map(|(a, b)| a + b).collect();
+            if let Some(p) = problem.problem.as_ref() {
+                p.jacobian_with_residuals(self.trusted);
+            }
             let trial = problem.apply(&z_new).ok().and_then(|r_new| {
                 let sse_new: f64 = r_new.iter().map(|v| v * v).sum();
                 sse_new.is_finite().then_some((r_new, sse_new))
@@ -277,8 +308,10 @@ where
                 }
                 _ => (f64::NEG_INFINITY, None),
             };
+            self.trusted = rho > TRUSTED_GAIN;
             if rho > 1e-4 {
                 let (r_new, sse_new) = accepted.expect("accepted step has residuals");
+                // kept from the trial's run, or one run with sensitivities
                 self.jacobian = problem.jacobian(&z_new)?;
                 self.update_scale();
                 self.mu *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));

@@ -4,17 +4,22 @@
 //! Jacobian) in separate calls with the same parameter vector; the adapter
 //! remembers the last vector and its residuals so they are computed once.
 //!
-//! With exact sensitivities (every data set has them) each evaluation is
-//! one run that gives the residuals and the Jacobian together
-//! ([`crate::jacobian::residuals_and_exact_jacobian`]), and the Jacobian at
-//! the last point is kept: Levenberg-Marquardt evaluates a trial point, and
-//! when it accepts it asks for the Jacobian there, which then costs no
-//! forward run. A rejected trial pays the sensitivities for nothing (the
-//! back-substitutions and assemblies of one run, less than a second run),
-//! so one forward run per trial point is the whole cost
-//! ([`LeastSquaresProblem::evaluations`] counts them).
+//! With exact sensitivities (every data set has them) an evaluation is
+//! either a plain run (residuals only) or a run with sensitivities that
+//! gives the residuals and the Jacobian together
+//! ([`crate::jacobian::residuals_and_exact_jacobian`]); which one, the
+//! solver says before it evaluates a new point
+//! ([`EvaluationCount::jacobian_with_residuals`]: by default, with). The
+//! Jacobian of the last run with sensitivities is kept with its
+//! predictions, so a Jacobian asked for at that point costs no run, nor do
+//! the statistics at an optimum that was evaluated with sensitivities
+//! ([`LeastSquaresProblem::take_exact`]). A run with sensitivities costs
+//! more than a plain one (a tangent factorisation and a few assemblies per
+//! increment), so a trial point the solver will probably reject is better
+//! evaluated plain. [`LeastSquaresProblem::evaluations`] counts runs of
+//! both kinds, [`LeastSquaresProblem::runs`] each kind.
 
-use crate::jacobian::residuals_and_exact_jacobian;
+use crate::jacobian::{residuals_and_exact_jacobian, ExactEvaluation};
 use crate::{jacobian_unbounded, sum_of_squares, Evaluators, FdOptions, InverseError, Objective};
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
 use nalgebra::DMatrix;
@@ -25,6 +30,20 @@ use std::cell::{Cell, RefCell};
 pub trait EvaluationCount {
     /// Objective evaluations so far, finite-difference ones included.
     fn evaluations(&self) -> usize;
+
+    /// Whether the evaluations of new points from now on should also
+    /// compute the Jacobian there, where the two come cheaper together than
+    /// apart (exact sensitivities). A hint: the default ignores it.
+    fn jacobian_with_residuals(&self, _wanted: bool) {}
+}
+
+/// Forward runs of an objective with exact sensitivities, by kind.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Runs {
+    /// Runs for the residuals only.
+    pub plain: usize,
+    /// Runs that also gave the Jacobian.
+    pub with_sensitivities: usize,
 }
 
 /// Residuals, SSE, gradient and Jacobian of an objective in the free
@@ -35,9 +54,15 @@ pub struct LeastSquaresProblem<'a> {
     evaluators: RefCell<Evaluators<'a>>,
     evaluations: Cell<usize>,
     jacobians: Cell<usize>,
+    runs: Cell<Runs>,
+    /// Evaluate new points with sensitivities (exact sensitivities only).
+    with_jacobian: Cell<bool>,
     last: RefCell<Option<(Vec<f64>, Vec<f64>)>>,
-    /// The exact Jacobian at `last`'s point (exact sensitivities only).
-    last_jacobian: RefCell<Option<(Vec<f64>, DMatrix<f64>)>>,
+    /// The last two runs with sensitivities (the last first): point,
+    /// predictions, residuals and Jacobian. Two, so that the one at
+    /// Levenberg-Marquardt's last accepted point survives a rejected trial
+    /// evaluated with sensitivities after it.
+    last_exact: RefCell<Vec<(Vec<f64>, ExactEvaluation)>>,
 }
 
 impl<'a> LeastSquaresProblem<'a> {
@@ -49,9 +74,41 @@ impl<'a> LeastSquaresProblem<'a> {
             evaluators: RefCell::new(objective.evaluators()),
             evaluations: Cell::new(0),
             jacobians: Cell::new(0),
+            runs: Cell::new(Runs::default()),
+            with_jacobian: Cell::new(true),
             last: RefCell::new(None),
-            last_jacobian: RefCell::new(None),
+            last_exact: RefCell::new(Vec::new()),
         }
+    }
+
+    /// Runs so far by kind (exact sensitivities; finite differences count
+    /// in [`LeastSquaresProblem::evaluations`] only).
+    pub fn runs(&self) -> Runs {
+        self.runs.get()
+    }
+
+    /// The predictions, residuals and exact Jacobian of one of the last two
+    /// runs with sensitivities when it was at `z` (taken: a second call
+    /// gives `None`).
+    pub fn take_exact(&self, z: &[f64]) -> Option<ExactEvaluation> {
+        let mut kept = self.last_exact.borrow_mut();
+        let i = kept.iter().position(|(zl, _)| zl.as_slice() == z)?;
+        Some(kept.remove(i).1)
+    }
+
+    /// One run with sensitivities at `z`, kept.
+    fn exact_run(&self, z: &[f64]) -> Result<Vec<f64>, InverseError> {
+        self.evaluations.set(self.evaluations.get() + 1);
+        let mut runs = self.runs.get();
+        runs.with_sensitivities += 1;
+        self.runs.set(runs);
+        let e = residuals_and_exact_jacobian(self.objective, z, "objective evaluation")?;
+        let r = e.1.clone();
+        *self.last.borrow_mut() = Some((z.to_vec(), r.clone()));
+        let mut kept = self.last_exact.borrow_mut();
+        kept.insert(0, (z.to_vec(), e));
+        kept.truncate(2);
+        Ok(r)
     }
 
     /// The objective.
@@ -71,13 +128,15 @@ impl<'a> LeastSquaresProblem<'a> {
                 return Ok(rl.clone());
             }
         }
+        let exact = self.objective.has_exact_sensitivities();
+        if exact && self.with_jacobian.get() {
+            return self.exact_run(z);
+        }
         self.evaluations.set(self.evaluations.get() + 1);
-        if self.objective.has_exact_sensitivities() {
-            let (_, r, j) =
-                residuals_and_exact_jacobian(self.objective, z, "objective evaluation")?;
-            *self.last.borrow_mut() = Some((z.to_vec(), r.clone()));
-            *self.last_jacobian.borrow_mut() = Some((z.to_vec(), j.matrix));
-            return Ok(r);
+        if exact {
+            let mut runs = self.runs.get();
+            runs.plain += 1;
+            self.runs.set(runs);
         }
         let r = self.objective.residuals(
             &mut self.evaluators.borrow_mut(),
@@ -89,17 +148,27 @@ impl<'a> LeastSquaresProblem<'a> {
     }
 
     /// d r / d z at `z`. With exact sensitivities, the one kept from the
-    /// evaluation at `z` (computed by one run when `z` was not evaluated).
+    /// run with sensitivities at `z`, or one such run when there was none
+    /// (`z` not evaluated, or evaluated plain).
     pub fn jacobian_at(&self, z: &[f64]) -> Result<DMatrix<f64>, InverseError> {
         if self.objective.has_exact_sensitivities() {
-            self.residuals_at(z)?;
-            let kept = self.last_jacobian.borrow();
-            if let Some((_, j)) = kept.as_ref().filter(|(zl, _)| zl.as_slice() == z) {
-                self.jacobians.set(self.jacobians.get() + 1);
-                return Ok(j.clone());
-            }
+            let here = |kept: &[(Vec<f64>, ExactEvaluation)]| {
+                kept.iter()
+                    .find(|(zl, _)| zl.as_slice() == z)
+                    .map(|(_, (_, _, j))| j.matrix.clone())
+            };
+            let found = here(&self.last_exact.borrow());
+            let j = match found {
+                Some(j) => j,
+                None => {
+                    self.exact_run(z)?;
+                    here(&self.last_exact.borrow()).expect("the run just kept")
+                }
+            };
+            self.jacobians.set(self.jacobians.get() + 1);
+            return Ok(j);
         }
-        let r0 = if self.fd.central || self.objective.has_exact_sensitivities() {
+        let r0 = if self.fd.central {
             None
         } else {
             Some(self.residuals_at(z)?)
@@ -114,6 +183,10 @@ impl<'a> LeastSquaresProblem<'a> {
 impl EvaluationCount for LeastSquaresProblem<'_> {
     fn evaluations(&self) -> usize {
         self.evaluations.get()
+    }
+
+    fn jacobian_with_residuals(&self, wanted: bool) {
+        self.with_jacobian.set(wanted);
     }
 }
 

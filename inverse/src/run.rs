@@ -2,6 +2,7 @@
 //! `Executor`: Levenberg-Marquardt, BFGS or L-BFGS (the latter two with the
 //! Moré-Thuente line search on `SSE(z)` and the gradient `2 J^T r`).
 
+use crate::jacobian::ExactEvaluation;
 use crate::observer::ArgminBridge;
 use crate::problem::{inverse_error, EvaluationCount, LeastSquaresProblem};
 use crate::{FdOptions, InverseError, LevenbergMarquardt, LmOptions, Objective, Termination};
@@ -74,6 +75,10 @@ pub(crate) struct RunOutcome {
     pub termination: Termination,
     /// Levenberg-Marquardt only: the last trial failed to evaluate.
     pub blocked: bool,
+    /// With exact sensitivities: the predictions, residuals and Jacobian at
+    /// `z` when a run with sensitivities there is still kept (the
+    /// statistics then need no run).
+    pub exact: Option<ExactEvaluation>,
 }
 
 fn argmin_termination(reason: Option<&TerminationReason>) -> Termination {
@@ -108,8 +113,10 @@ pub(crate) fn run(
                 Some(t) => t.clone(),
                 None => argmin_termination(result.state.get_termination_reason()),
             };
+            let z = result.state.get_best_param().cloned().unwrap_or_default();
             Ok(RunOutcome {
-                z: result.state.get_best_param().cloned().unwrap_or_default(),
+                exact: p.take_exact(&z),
+                z,
                 sse: result.state.get_best_cost(),
                 iterations: result.state.get_iter(),
                 evaluations: p.evaluations(),
@@ -154,8 +161,10 @@ pub(crate) fn run(
             }
             let result = executor.run().map_err(|e| inverse_error(e, "BFGS"))?;
             let p = result.problem.problem.as_ref().expect("problem kept");
+            let z = result.state.get_best_param().cloned().unwrap_or_default();
             Ok(RunOutcome {
-                z: result.state.get_best_param().cloned().unwrap_or_default(),
+                exact: p.take_exact(&z),
+                z,
                 sse: result.state.get_best_cost(),
                 iterations: result.state.get_iter(),
                 evaluations: p.evaluations(),
@@ -177,8 +186,10 @@ pub(crate) fn run(
             }
             let result = executor.run().map_err(|e| inverse_error(e, "L-BFGS"))?;
             let p = result.problem.problem.as_ref().expect("problem kept");
+            let z = result.state.get_best_param().cloned().unwrap_or_default();
             Ok(RunOutcome {
-                z: result.state.get_best_param().cloned().unwrap_or_default(),
+                exact: p.take_exact(&z),
+                z,
                 sse: result.state.get_best_cost(),
                 iterations: result.state.get_iter(),
                 evaluations: p.evaluations(),

@@ -255,6 +255,7 @@ pub(crate) fn wall_slide(
         }
     }
     (sse < outcome.sse).then(|| RunOutcome {
+        exact: None,
         z,
         sse,
         iterations,

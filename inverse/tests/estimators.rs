@@ -750,46 +750,191 @@ fn model_sensitivities_are_used_when_the_model_offers_them() {
     }
 }
 
-/// `ExpSensitivities` counting its runs.
-struct CountingSensitivities(std::sync::atomic::AtomicUsize);
-impl Sensitivities for CountingSensitivities {
+/// The exponential decay counting its runs: plain ones (through its
+/// evaluator) and those with sensitivities ([`ExpSensitivities`]).
+struct CountingExp {
+    inner: Arc<dyn ForwardModel>,
+    plain: std::sync::atomic::AtomicUsize,
+    exact: std::sync::atomic::AtomicUsize,
+    /// Every run in order: with sensitivities, and its parameters.
+    log: Mutex<Vec<(bool, Vec<f64>)>>,
+}
+
+impl CountingExp {
+    fn new() -> Arc<CountingExp> {
+        Arc::new(CountingExp {
+            inner: exp_decay(),
+            plain: Default::default(),
+            exact: Default::default(),
+            log: Default::default(),
+        })
+    }
+    /// (plain runs, runs with sensitivities).
+    fn runs(&self) -> (usize, usize) {
+        use std::sync::atomic::Ordering::SeqCst;
+        (self.plain.load(SeqCst), self.exact.load(SeqCst))
+    }
+}
+
+struct CountingEvaluator<'a> {
+    inner: Box<dyn Evaluator + 'a>,
+    model: &'a CountingExp,
+}
+
+impl Evaluator for CountingEvaluator<'_> {
+    fn predict_into(
+        &mut self,
+        theta: &[f64],
+        loading: &Loading,
+        out: &mut [f64],
+    ) -> Result<(), ForwardError> {
+        (self.model.plain).fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        self.model.log.lock().unwrap().push((false, theta.to_vec()));
+        self.inner.predict_into(theta, loading, out)
+    }
+}
+
+impl ForwardModel for CountingExp {
+    fn name(&self) -> String {
+        self.inner.name()
+    }
+    fn space(&self) -> &ParamSpace {
+        self.inner.space()
+    }
+    fn observable(&self) -> Observable {
+        self.inner.observable()
+    }
+    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
+        Box::new(CountingEvaluator {
+            inner: self.inner.evaluator(),
+            model: self,
+        })
+    }
+    fn as_sensitivities(&self) -> Option<&dyn Sensitivities> {
+        Some(self)
+    }
+}
+
+impl Sensitivities for CountingExp {
     fn predict_with_jacobian(
         &self,
         t: &[f64],
         loading: &Loading,
     ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
-        self.0.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        self.exact.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        self.log.lock().unwrap().push((true, t.to_vec()));
         ExpSensitivities.predict_with_jacobian(t, loading)
     }
 }
 
-/// With exact sensitivities Levenberg-Marquardt runs the model once per
-/// point it evaluates: the Jacobian at an accepted trial point comes with
-/// the trial's run, and the statistics at the optimum reuse one run. The
-/// runs are the report's evaluations, and there are fewer than one
-/// evaluation plus one Jacobian per iteration (what recomputing the run
-/// inside each Jacobian cost).
-#[test]
-fn exact_jacobians_reuse_the_run_of_their_point() {
+/// A start of the exponential decay far from its optimum.
+const START_FAR: [f64; 3] = [0.2, 6.0, 2.0];
+
+/// A noisy exponential-decay objective on a [`CountingExp`] with exact
+/// sensitivities.
+fn counted_objective(model: &Arc<CountingExp>) -> Objective {
     let truth = [2.5, 0.7, -0.3];
     let s = noisy(set(exp_decay(), times(30, 6.0), &truth), 0.02, 9);
-    let counter = Arc::new(CountingSensitivities(Default::default()));
-    let obj = Objective::new(
-        vec![s.with_sensitivities(counter.clone())],
-        ResidualKind::Absolute,
-        &[],
-    )
-    .unwrap();
+    let model: Arc<dyn ForwardModel> = model.clone();
+    let s = DataSet { model, ..s }.with_model_sensitivities();
+    assert!(s.sensitivities.is_some());
+    Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap()
+}
+
+/// With exact sensitivities Levenberg-Marquardt gets the Jacobian at an
+/// accepted trial point from a run there, never from a run of its own
+/// when the trial's run had it, and the statistics at the optimum reuse
+/// the optimum's run. The runs of both kinds are the report's evaluations,
+/// and there are fewer than one evaluation plus one Jacobian per iteration
+/// (what recomputing the run inside each Jacobian cost).
+#[test]
+fn exact_jacobians_reuse_the_run_of_their_point() {
+    let model = CountingExp::new();
+    let obj = counted_objective(&model);
     let report = fit(&obj, &lm()).unwrap();
     assert!(report.converged, "{:?}", report.termination);
-    let runs = counter.0.load(std::sync::atomic::Ordering::SeqCst);
-    assert_eq!(runs, report.evaluations, "{report:?}");
+    let (plain, exact) = model.runs();
+    assert_eq!(plain + exact, report.evaluations, "{report:?}");
     // every accepted iteration asked for a Jacobian, none cost a run
     assert!(report.jacobians as u64 > report.iterations, "{report:?}");
     assert!(
-        runs < report.jacobians + report.iterations as usize,
-        "runs {runs}, jacobians {}, iterations {}",
+        plain + exact < report.jacobians + report.iterations as usize,
+        "runs {plain} + {exact}, jacobians {}, iterations {}",
         report.jacobians,
         report.iterations
     );
+    // the start, each accepted point once, and no run for the statistics
+    // (each accepted point's run is kept): at most one rejected trial with
+    // sensitivities per accepted step
+    assert!(
+        exact <= 1 + 2 * report.iterations as usize,
+        "{exact} runs with sensitivities in {} iterations",
+        report.iterations
+    );
+}
+
+/// Trial points Levenberg-Marquardt will probably reject (the first, and
+/// any after a rejection or a poor gain) are evaluated by plain runs; the
+/// start, the accepted points and a trial after a good step run with
+/// sensitivities, and an accepted plain trial gets one more run, with
+/// them. From a start far from the optimum the damping grows through
+/// rejected trials in a row: requesting sensitivities for every trial
+/// would make each of them a run with sensitivities.
+#[test]
+fn rejected_trials_do_not_pay_for_sensitivities() {
+    let model = CountingExp::new();
+    let obj = counted_objective(&model);
+    let accepted = Arc::new(Mutex::new(Vec::<Vec<f64>>::new()));
+    let seen = accepted.clone();
+    let options = FitOptions {
+        start: Some(START_FAR.to_vec()),
+        observer: Some(shared_observer(move |p: &Progress| {
+            seen.lock().unwrap().push(p.theta.clone())
+        })),
+        ..lm()
+    };
+    let report = fit(&obj, &options).unwrap();
+    assert!(report.converged, "{:?}", report.termination);
+    assert!(
+        (report.value("b").unwrap() - 0.7).abs() < 0.05,
+        "{report:?}"
+    );
+    let (plain, exact) = model.runs();
+    assert_eq!(plain + exact, report.evaluations);
+    let accepted = accepted.lock().unwrap().clone();
+    let log = model.log.lock().unwrap().clone();
+    // the start, with sensitivities
+    assert_eq!(log[0], (true, START_FAR.to_vec()));
+    // walk the trials: a rejected one is a point never accepted
+    let (mut rejected, mut rejected_exact, mut after_rejection) = (0, 0, 0);
+    let mut previous_rejected = true; // the first trial has no gain ratio
+    let mut k = 1;
+    while k < log.len() {
+        let (with, theta) = &log[k];
+        if accepted.contains(theta) {
+            // an accepted plain trial: one more run there, with sensitivities
+            if !with {
+                assert_eq!(log.get(k + 1), Some(&(true, theta.clone())), "run {k}");
+                k += 1;
+            }
+            previous_rejected = false;
+        } else {
+            rejected += 1;
+            if *with {
+                rejected_exact += 1;
+                assert!(
+                    !previous_rejected,
+                    "run {k}: sensitivities after a rejection"
+                );
+            } else if previous_rejected {
+                after_rejection += 1;
+            }
+            previous_rejected = true;
+        }
+        k += 1;
+    }
+    // the start is far: the first trials are rejected in a row
+    assert!(after_rejection >= 2, "{log:?}");
+    assert!(rejected_exact < rejected, "{rejected_exact} of {rejected}");
+    assert_eq!(exact, 1 + report.iterations as usize + rejected_exact);
 }
