@@ -17,9 +17,12 @@ use crate::model::calibration::{calibrate, Calibration, Request};
 use crate::records::published::PublishedFit;
 use crate::records::replicates::{batches_from_names, mean_curve, stem, MeanCurve};
 use crate::records::{ReadOptions, TestData, TestKind};
+use crate::report::plot::{thinned, Plot, Series, PALETTE};
 use crate::run::output::write_atomic;
 use crate::run::step::{duplicate, At, Run, Step, StepResult, Study};
-use palpate_uq::likelihood::{HierarchicalPosterior, RandomEffects};
+
+mod hierarchical;
+pub use hierarchical::{hierarchical, hierarchical_table};
 use serde::Deserialize;
 use std::path::PathBuf;
 use anyhow::Context;
@@ -478,8 +481,9 @@ impl Step for ReplicatesStep {
     }
 
     fn inputs(&self) -> Vec<PathBuf> {
+        // a pattern as it is: the runner hashes the files it matches
         let mut out: Vec<PathBuf> = match &self.data {
-            Files::Pattern(_) => Vec::new(),
+            Files::Pattern(p) => vec![PathBuf::from(p)],
             Files::List(l) => l.iter().map(PathBuf::from).collect(),
         };
         out.extend(self.published.iter().map(|p| PathBuf::from(&p.file)));
@@ -509,6 +513,8 @@ pub struct LawFits {
     pub mean_curve_sse: f64,
     pub mean_curve_aic: f64,
     pub mean_curve_converged: bool,
+    /// The mean-curve fit's Drucker-stable stretches in each mode.
+    pub mean_curve_drucker: palpate_material::stability::DruckerReport,
     /// The initial shear modulus of each fit (MPa).
     pub mu0_mean_curve: f64,
     pub mu0_pooled: Option<f64>,
@@ -633,6 +639,14 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
         fits.push(f);
     }
     report.push_str(&replicates_report(step, &records, &curve, &published, unit, &fits));
+    if let TestKind::Homogeneous(mode) = test {
+        let file = format!("{}-fits.svg", step.name);
+        let svg = fits_plot(&step.name, mode, &records, &curve, &fits);
+        write_atomic(&run.out.join("plots").join(&file), svg.as_bytes())?;
+        report.push_str(&format!("
+![the fits of {}](plots/{file})
+", step.name));
+    }
     let table = fits_csv(&fits, unit);
     write_atomic(&run.out.join(format!("{}-fits.csv", step.name)), table.as_bytes())?;
     Ok(serde_json::json!({
@@ -721,6 +735,7 @@ fn fit_law(
         mean_curve: values.clone(),
         mean_curve_sse: sse,
         mean_curve_converged: mean.converged,
+        mean_curve_drucker: mean.drucker,
         mu0_mean_curve: law.shear_modulus(&values),
         mu0_pooled,
         mu0_records_mean: mu0_mean,
@@ -797,6 +812,30 @@ fn replicates_report(
             )),
         }
     }
+    // fits that lose Drucker stability somewhere in the scanned stretches
+    for f in fits {
+        let d = &f.mean_curve_drucker;
+        let full = |r: &palpate_material::stability::StableRange| r.lower <= 0.1 && r.upper >= 10.0;
+        if !(full(&d.uniaxial) && full(&d.biaxial) && full(&d.planar)) {
+            let range = |r: &palpate_material::stability::StableRange| format!("[{:.3}, {:.3}]", r.lower, r.upper);
+            let drive = &curve.record.loading.drive;
+            let lo = drive.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = drive.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let own = match curve.record.test {
+                TestKind::Homogeneous(Mode::Equibiaxial) => &d.biaxial,
+                TestKind::Homogeneous(Mode::Planar) => &d.planar,
+                _ => &d.uniaxial,
+            };
+            out.push_str(&format!(
+                "\n{}: Drucker-stable for stretches uniaxial {}, equibiaxial {}, planar {} (of 0.1 to 10); the curve's stretches {lo:.3} to {hi:.3} are {}.\n",
+                f.law,
+                range(&d.uniaxial),
+                range(&d.biaxial),
+                range(&d.planar),
+                if own.contains(lo) && own.contains(hi) { "inside" } else { "not all inside" }
+            ));
+        }
+    }
     let missing: Vec<&str> = published
         .iter()
         .filter(|p| p.law.is_none())
@@ -832,6 +871,44 @@ fn replicates_report(
         }
     }
     out
+}
+
+/// The records (grey), their mean curve (markers) and each law's fit to
+/// it (lines): stress (kPa) against strain, compression positive when the
+/// records are compressions.
+fn fits_plot(name: &str, mode: Mode, records: &[TestData], curve: &MeanCurve, fits: &[LawFits]) -> String {
+    let compression = curve.record.loading.drive.iter().any(|&l| l < 1.0);
+    let sign = if compression { -1.0 } else { 1.0 };
+    let strain = |l: &[f64]| -> Vec<f64> { l.iter().map(|l| sign * (l - 1.0)).collect() };
+    let stress = |s: &[f64]| -> Vec<f64> { s.iter().map(|s| sign * 1e3 * s).collect() };
+    let what = if compression { "compressive" } else { "tensile" };
+    let mut plot = Plot::new(
+        format!("{name}: records, mean curve and the fits to it"),
+        format!("{what} engineering strain"),
+        format!("{what} engineering stress (kPa)"),
+    );
+    for (k, r) in records.iter().enumerate() {
+        let (x, y) = thinned(&strain(&r.loading.drive), &stress(&r.observed), 150);
+        let label = if k == 0 { format!("{} records", records.len()) } else { String::new() };
+        plot.push(Series::line(label, &x, &y).color("#c8c8c8"));
+    }
+    let grid = &curve.record.loading.drive;
+    let (x, y) = thinned(&strain(grid), &stress(&curve.record.observed), 40);
+    plot.push(Series::markers("mean curve", &x, &y).color("#000000"));
+    for (k, f) in fits.iter().enumerate() {
+        let Ok(law) = f.law.parse::<Law>() else { continue };
+        let (gx, gl) = thinned(grid, grid, 200);
+        let p: Vec<f64> = gl
+            .iter()
+            .map(|&l| match mode {
+                Mode::Uniaxial => homogeneous::uniaxial(&law, &f.mean_curve, l),
+                Mode::Equibiaxial => homogeneous::equibiaxial(&law, &f.mean_curve, l),
+                Mode::Planar => homogeneous::planar(&law, &f.mean_curve, l),
+            })
+            .collect();
+        plot.push(Series::line(f.law.clone(), &strain(&gx), &stress(&p)).color(PALETTE[k % PALETTE.len()]));
+    }
+    plot.to_svg()
 }
 
 fn params_text(names: &[String], values: &[f64]) -> String {
@@ -883,87 +960,6 @@ fn fits_csv(fits: &[LawFits], unit: f64) -> String {
             out.push_str(&format!("{},per-record SD,,,,,{s:.9e}\n", f.law));
         }
     }
-    out
-}
-
-/// The hierarchical posterior of replicates' parameters: each record
-/// fitted alone, then the population mean `mu` and between-test SD `tau`
-/// of each parameter sampled ([`RandomEffects`]; prior scale of `tau`: the
-/// largest |estimate| of the parameter).
-pub fn hierarchical(
-    law: Law,
-    records: &[TestData],
-    seed: u64,
-    max_draws: usize,
-) -> anyhow::Result<(Replicates, HierarchicalPosterior)> {
-    let fitted = |fitted: &[TestData]| {
-        calibrate(Request::least_squares(law, fitted))
-    };
-    let pooled = fitted(records).context("the pooled fit")?;
-    let reps = analyse(law, records, &pooled)?;
-    let estimates: Vec<Vec<f64>> = reps.fits.iter().map(|f| f.values.clone()).collect();
-    let standard_errors: Vec<Vec<f64>> = reps
-        .fits
-        .iter()
-        .map(|f| f.standard_errors.iter().map(|s| s.unwrap_or(0.0)).collect())
-        .collect();
-    let tau_scale = (0..reps.names.len())
-        .map(|j| {
-            estimates
-                .iter()
-                .map(|y| y[j].abs())
-                .fold(0.0, f64::max)
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
-    let model = RandomEffects {
-        names: reps.names.clone(),
-        estimates,
-        standard_errors,
-        tau_scale,
-    };
-    let post = model
-        .sample(seed, max_draws)
-        .map_err(|e| anyhow::anyhow!("the hierarchical posterior: {e}"))?;
-    Ok((reps, post))
-}
-
-/// The hierarchical posterior as a table: per parameter the population
-/// mean and between-test SD (posterior mean, 94 % HDI, R-hat) beside the
-/// per-record fits' mean and SD.
-pub fn hierarchical_table(law: Law, post: &HierarchicalPosterior) -> String {
-    let mut out = format!(
-        "\nhierarchical posterior of {law} over {} records (theta_i ~ N(mu, tau^2); each record's fit with its standard error):\n",
-        post.tests
-    );
-    out.push_str(&format!(
-        "{:<10} {:>12} {:>25} {:>12} {:>25} {:>12} {:>12} {:>8}\n",
-        "parameter", "mu", "mu 94% HDI", "tau", "tau 94% HDI", "fits mean", "fits SD", "R-hat"
-    ));
-    for p in &post.parameters {
-        out.push_str(&format!(
-            "{:<10} {:>12} {:>25} {:>12} {:>25} {:>12} {:>12} {:>8.4}\n",
-            p.name,
-            sig4(p.mu.mean),
-            format!("[{}, {}]", sig4(p.mu.hdi_3), sig4(p.mu.hdi_97)),
-            sig4(p.tau.mean),
-            format!("[{}, {}]", sig4(p.tau.hdi_3), sig4(p.tau.hdi_97)),
-            sig4(p.estimates_mean),
-            sig4(p.estimates_sd),
-            p.mu.rhat.max(p.tau.rhat)
-        ));
-    }
-    out.push_str(&format!(
-        "{} chains x {} draws, max R-hat {:.4}{}\n",
-        post.chains,
-        post.draws_per_chain,
-        post.rhat_max,
-        if post.converged {
-            ""
-        } else {
-            " (NOT CONVERGED: the cap of draws was reached)"
-        }
-    ));
     out
 }
 
