@@ -757,7 +757,10 @@ fn fixed_values_outside_the_laws_domain_name_the_option() {
             let v: serde_json::Value =
                 serde_json::from_str(&std::fs::read_to_string(&json).unwrap()).unwrap();
             let other = v["params"][free]["value"].as_f64().unwrap();
-            assert!(other > 0.1, "{fix}: {free} = {other}: C10 + C01 must stay > 0");
+            assert!(
+                other > 0.1,
+                "{fix}: {free} = {other}: C10 + C01 must stay > 0"
+            );
         }
     }
 }
