@@ -77,7 +77,9 @@ impl Step for ReplicatesSummaryStep {
         }
         for s in &self.steps {
             let Some(j) = study.steps.iter().position(|r| r.name() == s) else {
-                anyhow::bail!("{at}.steps: no step named \"{s}\" (a replicates step before this one)");
+                anyhow::bail!(
+                    "{at}.steps: no step named \"{s}\" (a replicates step before this one)"
+                );
             };
             anyhow::ensure!(
                 j < site.index,
@@ -249,7 +251,8 @@ fn run_summary(
         }
         let n = mu0s.len() as f64;
         let mean = mu0s.iter().sum::<f64>() / n;
-        let sd = (mu0s.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
+        let sd =
+            (mu0s.iter().map(|m| (m - mean) * (m - mean)).sum::<f64>() / (n - 1.0).max(1.0)).sqrt();
         materials.push(MaterialModulus {
             step: s.clone(),
             levels: step
@@ -263,7 +266,12 @@ fn run_summary(
             records: mu0s.len(),
         });
     }
-    let _ = writeln!(report, "\n## Summary `{}` over {} replicates steps\n", step.name, step.steps.len());
+    let _ = writeln!(
+        report,
+        "\n## Summary `{}` over {} replicates steps\n",
+        step.name,
+        step.steps.len()
+    );
     verdict_table(report, &law_order, &verdicts);
     modulus_table(report, step, &law_name, &materials);
     if let Some(x) = &step.x {
@@ -294,9 +302,13 @@ fn run_summary(
         let a = analyse("mu0", &factors, &y, &options).context("ANOVA of mu0")?;
         let batch = if rows.iter().all(|r| r.batch.is_some()) {
             let mut with_batch = factors.clone();
-            let b: Vec<String> = rows.iter().map(|r| r.batch.clone().unwrap_or_default()).collect();
+            let b: Vec<String> = rows
+                .iter()
+                .map(|r| r.batch.clone().unwrap_or_default())
+                .collect();
             with_batch.push(FactorColumn::from_names("batch", &b));
-            let nested = analyse("mu0", &with_batch, &y, &options).context("ANOVA of mu0 with the batches")?;
+            let nested = analyse("mu0", &with_batch, &y, &options)
+                .context("ANOVA of mu0 with the batches")?;
             batch_effect(&a, &nested)
         } else {
             None
@@ -311,7 +323,15 @@ fn run_summary(
     } else {
         (None, None)
     };
-    anova_report(report, step, &law_name, &kept, &dropped, analysis.as_ref(), batch.as_ref());
+    anova_report(
+        report,
+        step,
+        &law_name,
+        &kept,
+        &dropped,
+        analysis.as_ref(),
+        batch.as_ref(),
+    );
     let mut csv = String::from("step");
     for f in step.factors.keys() {
         let _ = write!(csv, ",{f}");
@@ -330,7 +350,10 @@ fn run_summary(
             r.mu0_kpa
         );
     }
-    write_atomic(&run.out.join(format!("{}-modulus.csv", step.name)), csv.as_bytes())?;
+    write_atomic(
+        &run.out.join(format!("{}-modulus.csv", step.name)),
+        csv.as_bytes(),
+    )?;
     Ok(serde_json::json!({
         "name": step.name.clone(),
         "law": law_name,
@@ -382,7 +405,8 @@ fn complete_crossing(
                 .map(|(_, l)| l.len())
                 .product();
             for l in ls {
-                let with: Vec<&&MaterialModulus> = kept.iter().filter(|m| &m.levels[*f] == l).collect();
+                let with: Vec<&&MaterialModulus> =
+                    kept.iter().filter(|m| &m.levels[*f] == l).collect();
                 let mut combos: Vec<Vec<&String>> = with
                     .iter()
                     .map(|m| {
@@ -473,14 +497,24 @@ fn verdict_table(
     laws: &[String],
     verdicts: &BTreeMap<String, BTreeMap<String, Vec<String>>>,
 ) {
-    let columns = ["same", "lower SSE", "same SSE, other parameters", "higher SSE", "not in the table"];
+    let columns = [
+        "same",
+        "lower SSE",
+        "same SSE, other parameters",
+        "higher SSE",
+        "not in the table",
+    ];
     let _ = writeln!(
         report,
         "Fits to the mean curves beside the published table, per law: how many materials give each verdict \
          (`same`: every parameter within 5e-4 relative and the SSE within 1e-4; `lower SSE`: palpate's optimum \
          is better on the same curve).\n"
     );
-    let _ = writeln!(report, "| law | {} | materials with `higher SSE` |", columns.join(" | "));
+    let _ = writeln!(
+        report,
+        "| law | {} | materials with `higher SSE` |",
+        columns.join(" | ")
+    );
     let _ = writeln!(report, "|---|{}---|", "---|".repeat(columns.len()));
     for l in laws {
         let v = &verdicts[l];
@@ -496,7 +530,12 @@ fn verdict_table(
     }
 }
 
-fn modulus_table(report: &mut String, step: &ReplicatesSummaryStep, law: &str, m: &[MaterialModulus]) {
+fn modulus_table(
+    report: &mut String,
+    step: &ReplicatesSummaryStep,
+    law: &str,
+    m: &[MaterialModulus],
+) {
     let _ = writeln!(
         report,
         "\nInitial shear modulus mu0 of {law} (kPa): its fit to the mean curve, and the mean and SD of the \
@@ -571,7 +610,11 @@ fn modulus_plot(
                 (&group(&m.levels) == g).then(|| (value(m), r.mu0_kpa))
             })
             .unzip();
-        let name = if g.is_empty() { step.name.clone() } else { g.clone() };
+        let name = if g.is_empty() {
+            step.name.clone()
+        } else {
+            g.clone()
+        };
         plot.push(Series::line(format!("{name}: mean curve"), &lx, &ly).color(color));
         plot.push(Series::markers(format!("{name}: each record"), &px, &py).color(color));
     }
@@ -592,7 +635,11 @@ fn anova_report(
         report,
         "\n### ANOVA of mu0 ({law}, kPa) on {names}, the records as replicates\n"
     );
-    let _ = writeln!(report, "Materials in the complete crossing: {}.", kept.join(", "));
+    let _ = writeln!(
+        report,
+        "Materials in the complete crossing: {}.",
+        kept.join(", ")
+    );
     if !dropped.is_empty() {
         let _ = writeln!(
             report,
@@ -601,11 +648,17 @@ fn anova_report(
         );
     }
     let Some(a) = a else {
-        let _ = writeln!(report, "\nNo ANOVA: the crossing has a factor with one level, or no replicates.");
+        let _ = writeln!(
+            report,
+            "\nNo ANOVA: the crossing has a factor with one level, or no replicates."
+        );
         return;
     };
     let t = &a.table;
-    let _ = writeln!(report, "\n| source | DF | SS | MS | F | p | eta^2 |\n|---|---|---|---|---|---|---|");
+    let _ = writeln!(
+        report,
+        "\n| source | DF | SS | MS | F | p | eta^2 |\n|---|---|---|---|---|---|---|"
+    );
     for r in &t.terms {
         let _ = writeln!(
             report,
@@ -627,7 +680,12 @@ fn anova_report(
         t.residual.ms.map(sig4).unwrap_or_else(|| "-".into()),
         t.residual.ss / t.total.ss.max(f64::MIN_POSITIVE)
     );
-    let _ = writeln!(report, "| total | {} | {} | | | | |", t.total.df, sig4(t.total.ss));
+    let _ = writeln!(
+        report,
+        "| total | {} | {} | | | | |",
+        t.total.df,
+        sig4(t.total.ss)
+    );
     let _ = writeln!(report);
     for m in &a.main_effects {
         let means: Vec<String> = m
@@ -636,7 +694,12 @@ fn anova_report(
             .zip(&m.means)
             .map(|(l, v)| format!("{l}: {}", sig4(*v)))
             .collect();
-        let _ = writeln!(report, "* means of `{}` (kPa): {}", m.factor, means.join(", "));
+        let _ = writeln!(
+            report,
+            "* means of `{}` (kPa): {}",
+            m.factor,
+            means.join(", ")
+        );
     }
     let rj = a
         .ryan_joiner
@@ -646,9 +709,18 @@ fn anova_report(
     let b = a
         .bartlett
         .as_ref()
-        .map(|t| format!("Bartlett statistic = {:.2}, p = {}", t.statistic, p_text(t.p)))
+        .map(|t| {
+            format!(
+                "Bartlett statistic = {:.2}, p = {}",
+                t.statistic,
+                p_text(t.p)
+            )
+        })
         .unwrap_or_else(|| "Bartlett: not available".into());
-    let _ = writeln!(report, "* residuals: {rj}; equal variances across cells: {b}");
+    let _ = writeln!(
+        report,
+        "* residuals: {rj}; equal variances across cells: {b}"
+    );
     for n in &a.notes {
         let _ = writeln!(report, "  * note: {n}");
     }
@@ -718,20 +790,21 @@ mod tests {
     fn the_batch_effect_is_the_nested_term() {
         // 2 x 2 cells, 2 batches each, 3 records per batch
         let mut rows = Vec::new();
-        for (c, (f, t)) in [("x", "0"), ("x", "1"), ("y", "0"), ("y", "1")].iter().enumerate() {
+        for (c, (f, t)) in [("x", "0"), ("x", "1"), ("y", "0"), ("y", "1")]
+            .iter()
+            .enumerate()
+        {
             for (b, batch) in ["A", "B"].iter().enumerate() {
                 for k in 0..3 {
-                    let y = 10.0 * c as f64 + 0.7 * b as f64 * (c as f64 - 1.5)
+                    let y = 10.0 * c as f64
+                        + 0.7 * b as f64 * (c as f64 - 1.5)
                         + [0.31, -0.12, 0.05][k] * (1.0 + 0.2 * (c + b) as f64);
                     rows.push((f.to_string(), t.to_string(), batch.to_string(), y));
                 }
             }
         }
         let col = |name: &str, k: usize| {
-            let v: Vec<String> = rows
-                .iter()
-                .map(|r| [&r.0, &r.1, &r.2][k].clone())
-                .collect();
+            let v: Vec<String> = rows.iter().map(|r| [&r.0, &r.1, &r.2][k].clone()).collect();
             FactorColumn::from_names(name, &v)
         };
         let y: Vec<f64> = rows.iter().map(|r| r.3).collect();
@@ -751,7 +824,11 @@ mod tests {
         }
         assert_eq!((b.df, b.error_df), (4, 16));
         assert!((b.ss - ss_b).abs() <= 1e-9 * ss_b, "{} {ss_b}", b.ss);
-        assert!((b.error_ms - ss_e / 16.0).abs() <= 1e-9 * ss_e, "{} {ss_e}", b.error_ms);
+        assert!(
+            (b.error_ms - ss_e / 16.0).abs() <= 1e-9 * ss_e,
+            "{} {ss_e}",
+            b.error_ms
+        );
         let f = (ss_b / 4.0) / (ss_e / 16.0);
         assert!((b.f - f).abs() <= 1e-9 * f);
         let p = FisherSnedecor::new(4.0, 16.0).unwrap().sf(f);
@@ -771,15 +848,35 @@ mod tests {
             material("b50", "00-30", "50"),
         ];
         let levels = |l: &[(&str, &str)]| -> BTreeMap<String, String> {
-            l.iter().map(|(s, v)| (s.to_string(), v.to_string())).collect()
+            l.iter()
+                .map(|(s, v)| (s.to_string(), v.to_string()))
+                .collect()
         };
         let step = ReplicatesSummaryStep {
             name: "s".into(),
             steps: m.iter().map(|x| x.step.clone()).collect(),
             law: "neo-hookean".into(),
             factors: [
-                ("family".to_string(), levels(&[("a0", "00-10"), ("a50", "00-10"), ("a100", "00-10"), ("b0", "00-30"), ("b50", "00-30")])),
-                ("thinner".to_string(), levels(&[("a0", "0"), ("a50", "50"), ("a100", "100"), ("b0", "0"), ("b50", "50")])),
+                (
+                    "family".to_string(),
+                    levels(&[
+                        ("a0", "00-10"),
+                        ("a50", "00-10"),
+                        ("a100", "00-10"),
+                        ("b0", "00-30"),
+                        ("b50", "00-30"),
+                    ]),
+                ),
+                (
+                    "thinner".to_string(),
+                    levels(&[
+                        ("a0", "0"),
+                        ("a50", "50"),
+                        ("a100", "100"),
+                        ("b0", "0"),
+                        ("b50", "50"),
+                    ]),
+                ),
             ]
             .into_iter()
             .collect(),

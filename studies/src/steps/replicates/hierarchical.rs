@@ -19,9 +19,7 @@ pub fn hierarchical(
     seed: u64,
     max_draws: usize,
 ) -> anyhow::Result<(Replicates, HierarchicalPosterior)> {
-    let fitted = |fitted: &[TestData]| {
-        calibrate(Request::least_squares(law, fitted))
-    };
+    let fitted = |fitted: &[TestData]| calibrate(Request::least_squares(law, fitted));
     let pooled = fitted(records).context("the pooled fit")?;
     let reps = analyse(law, records, &pooled)?;
     let estimates: Vec<Vec<f64>> = reps.fits.iter().map(|f| f.values.clone()).collect();

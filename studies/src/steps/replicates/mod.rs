@@ -22,14 +22,14 @@ use crate::run::output::write_atomic;
 use crate::run::step::{duplicate, At, Run, Step, StepResult, Study};
 
 mod hierarchical;
-pub use hierarchical::{hierarchical, hierarchical_table};
-use serde::Deserialize;
-use std::path::PathBuf;
 use anyhow::Context;
+pub use hierarchical::{hierarchical, hierarchical_table};
 use palpate_analytic::Mode;
 use palpate_material::{homogeneous, Law};
+use serde::Deserialize;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
+use std::path::PathBuf;
 
 /// One record's own fit.
 #[derive(Debug, Clone, Serialize)]
@@ -164,7 +164,7 @@ pub fn analyse(law: Law, records: &[TestData], pooled: &Calibration) -> anyhow::
     let mut fits = Vec::with_capacity(records.len());
     for (k, r) in records.iter().enumerate() {
         let c = calibrate(Request::least_squares(law, std::slice::from_ref(r)))
-        .with_context(|| format!("replicate {}", r.file))?;
+            .with_context(|| format!("replicate {}", r.file))?;
         fits.push(ReplicateFit {
             record: stems[k].clone(),
             batch: batch_of[k].clone(),
@@ -464,7 +464,9 @@ impl Step for ReplicatesStep {
             "{at}.grid_points = {}: give 2 at least",
             self.grid_points
         );
-        let files = self.files(site.dir).map_err(|e| anyhow::anyhow!("{at}.{e}"))?;
+        let files = self
+            .files(site.dir)
+            .map_err(|e| anyhow::anyhow!("{at}.{e}"))?;
         anyhow::ensure!(
             files.len() >= 2,
             "{at}.data: {} file; replicates need two files at least",
@@ -474,8 +476,13 @@ impl Step for ReplicatesStep {
             anyhow::ensure!(f.is_file(), "{at}.data: {} does not exist", f.display());
         }
         if let Some(p) = &self.published {
-            crate::records::published::read(&site.dir.join(&p.file), &p.format, &p.material, &p.measure)
-                .map_err(|e| anyhow::anyhow!("{at}.published: {e}"))?;
+            crate::records::published::read(
+                &site.dir.join(&p.file),
+                &p.format,
+                &p.material,
+                &p.measure,
+            )
+            .map_err(|e| anyhow::anyhow!("{at}.published: {e}"))?;
         }
         Ok(())
     }
@@ -574,7 +581,15 @@ pub fn verdict(
         .iter()
         .zip(published)
         .filter(|(b, v)| **v < b.lower || **v > b.upper)
-        .map(|(b, v)| format!("{} = {} outside [{}, {}]", b.name, sig4(*v), b.lower, b.upper))
+        .map(|(b, v)| {
+            format!(
+                "{} = {} outside [{}, {}]",
+                b.name,
+                sig4(*v),
+                b.lower,
+                b.upper
+            )
+        })
         .collect();
     let text = if max_rel <= 5e-4 && same_sse {
         "same".to_string()
@@ -583,14 +598,21 @@ pub fn verdict(
     } else if same_sse {
         "same SSE, other parameters".to_string()
     } else if !outside.is_empty() {
-        format!("higher SSE: the published optimum has {}, palpate's bounds", outside.join(", "))
+        format!(
+            "higher SSE: the published optimum has {}, palpate's bounds",
+            outside.join(", ")
+        )
     } else {
         "higher SSE".to_string()
     };
     (max_rel, text)
 }
 
-fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyhow::Result<serde_json::Value> {
+fn run_replicates(
+    run: &Run,
+    step: &ReplicatesStep,
+    report: &mut String,
+) -> anyhow::Result<serde_json::Value> {
     let test = TestKind::parse(&step.test)?;
     let files = step.files(run.manifest_dir)?;
     let records: Vec<TestData> = files
@@ -609,7 +631,8 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
         })
         .collect::<anyhow::Result<_>>()
         .with_context(|| format!("step `{}`", step.name))?;
-    let curve = mean_curve(&records, step.grid_points).with_context(|| format!("step `{}`", step.name))?;
+    let curve =
+        mean_curve(&records, step.grid_points).with_context(|| format!("step `{}`", step.name))?;
     let published = match &step.published {
         Some(p) => crate::records::published::read(
             &run.manifest_dir.join(&p.file),
@@ -628,7 +651,15 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
             .as_ref()
             .is_none_or(|l| l.contains(text));
         let label = format!("{}: {law}", step.name);
-        let inputs = ("replicates", &step.name, law.to_string(), &records, step.grid_points, per_record, &published);
+        let inputs = (
+            "replicates",
+            &step.name,
+            law.to_string(),
+            &records,
+            step.grid_points,
+            per_record,
+            &published,
+        );
         let Some(f): Option<LawFits> = run.unit(&label, &inputs, || {
             fit_law(law, &records, &curve, &published, unit, per_record)
                 .with_context(|| format!("step `{}`: {law}", step.name))
@@ -638,17 +669,25 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
         };
         fits.push(f);
     }
-    report.push_str(&replicates_report(step, &records, &curve, &published, unit, &fits));
+    report.push_str(&replicates_report(
+        step, &records, &curve, &published, unit, &fits,
+    ));
     if let TestKind::Homogeneous(mode) = test {
         let file = format!("{}-fits.svg", step.name);
         let svg = fits_plot(&step.name, mode, &records, &curve, &fits);
         write_atomic(&run.out.join("plots").join(&file), svg.as_bytes())?;
-        report.push_str(&format!("
+        report.push_str(&format!(
+            "
 ![the fits of {}](plots/{file})
-", step.name));
+",
+            step.name
+        ));
     }
     let table = fits_csv(&fits, unit);
-    write_atomic(&run.out.join(format!("{}-fits.csv", step.name)), table.as_bytes())?;
+    write_atomic(
+        &run.out.join(format!("{}-fits.csv", step.name)),
+        table.as_bytes(),
+    )?;
     Ok(serde_json::json!({
         "name": step.name.clone(),
         "records": records.iter().map(|r| r.file.clone()).collect::<Vec<_>>(),
@@ -679,7 +718,13 @@ fn fit_law(
     let sse_of = |theta: &[f64]| -> anyhow::Result<f64> {
         law.check(theta)?;
         let mut sse = 0.0;
-        for (&l, o) in curve.record.loading.drive.iter().zip(&curve.record.observed) {
+        for (&l, o) in curve
+            .record
+            .loading
+            .drive
+            .iter()
+            .zip(&curve.record.observed)
+        {
             let p = match mode {
                 Mode::Uniaxial => homogeneous::uniaxial(&law, theta, l),
                 Mode::Equibiaxial => homogeneous::equibiaxial(&law, theta, l),
@@ -687,7 +732,10 @@ fn fit_law(
             };
             sse += (p - o) * (p - o);
         }
-        anyhow::ensure!(sse.is_finite(), "{law} {theta:?}: the stress is not finite on the curve");
+        anyhow::ensure!(
+            sse.is_finite(),
+            "{law} {theta:?}: the stress is not finite on the curve"
+        );
         Ok(sse)
     };
     let sse = sse_of(&values)?;
@@ -715,7 +763,11 @@ fn fit_law(
         let pooled = request(records).context("the pooled fit")?;
         let reps = analyse(law, records, &pooled)?;
         let theta: Vec<f64> = pooled.params.iter().map(|(_, v)| v.value).collect();
-        let mu0s: Vec<f64> = reps.fits.iter().map(|f| law.shear_modulus(&f.values)).collect();
+        let mu0s: Vec<f64> = reps
+            .fits
+            .iter()
+            .map(|f| law.shear_modulus(&f.values))
+            .collect();
         let (m, v) = mean_var(&mu0s);
         (
             Some(law.shear_modulus(&theta)),
@@ -770,7 +822,11 @@ fn replicates_report(
     out.push_str(&format!(
         "{} records: {}\n\nmean curve: {}\n",
         records.len(),
-        records.iter().map(|r| stem(&r.file)).collect::<Vec<_>>().join(", "),
+        records
+            .iter()
+            .map(|r| stem(&r.file))
+            .collect::<Vec<_>>()
+            .join(", "),
         curve.describe()
     ));
     if let Some(p) = &step.published {
@@ -799,7 +855,9 @@ fn replicates_report(
                 params_text(&f.names, &c.values),
                 c.sse,
                 c.sse_here,
-                c.aic.map(|a| format!("{a:.3}")).unwrap_or_else(|| "-".into()),
+                c.aic
+                    .map(|a| format!("{a:.3}"))
+                    .unwrap_or_else(|| "-".into()),
                 c.max_relative_difference,
                 c.verdict
             )),
@@ -817,7 +875,9 @@ fn replicates_report(
         let d = &f.mean_curve_drucker;
         let full = |r: &palpate_material::stability::StableRange| r.lower <= 0.1 && r.upper >= 10.0;
         if !(full(&d.uniaxial) && full(&d.biaxial) && full(&d.planar)) {
-            let range = |r: &palpate_material::stability::StableRange| format!("[{:.3}, {:.3}]", r.lower, r.upper);
+            let range = |r: &palpate_material::stability::StableRange| {
+                format!("[{:.3}, {:.3}]", r.lower, r.upper)
+            };
             let drive = &curve.record.loading.drive;
             let lo = drive.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = drive.iter().copied().fold(f64::NEG_INFINITY, f64::max);
@@ -851,7 +911,9 @@ fn replicates_report(
         out.push_str("\n### initial shear modulus mu0 (MPa): mean curve, pooled records, per-record fits\n\n");
         out.push_str("| law | mean curve | pooled | pooled / mean curve - 1 | per-record mean | SD | per-record mean / mean curve - 1 |\n|---|---|---|---|---|---|---|\n");
         for f in fits {
-            if let (Some(p), Some(m), Some(s)) = (f.mu0_pooled, f.mu0_records_mean, f.mu0_records_sd) {
+            if let (Some(p), Some(m), Some(s)) =
+                (f.mu0_pooled, f.mu0_records_mean, f.mu0_records_sd)
+            {
                 out.push_str(&format!(
                     "| {} | {} | {} | {:+.2} % | {} | {} | {:+.2} % |\n",
                     f.law,
@@ -876,12 +938,22 @@ fn replicates_report(
 /// The records (grey), their mean curve (markers) and each law's fit to
 /// it (lines): stress (kPa) against strain, compression positive when the
 /// records are compressions.
-fn fits_plot(name: &str, mode: Mode, records: &[TestData], curve: &MeanCurve, fits: &[LawFits]) -> String {
+fn fits_plot(
+    name: &str,
+    mode: Mode,
+    records: &[TestData],
+    curve: &MeanCurve,
+    fits: &[LawFits],
+) -> String {
     let compression = curve.record.loading.drive.iter().any(|&l| l < 1.0);
     let sign = if compression { -1.0 } else { 1.0 };
     let strain = |l: &[f64]| -> Vec<f64> { l.iter().map(|l| sign * (l - 1.0)).collect() };
     let stress = |s: &[f64]| -> Vec<f64> { s.iter().map(|s| sign * 1e3 * s).collect() };
-    let what = if compression { "compressive" } else { "tensile" };
+    let what = if compression {
+        "compressive"
+    } else {
+        "tensile"
+    };
     let mut plot = Plot::new(
         format!("{name}: records, mean curve and the fits to it"),
         format!("{what} engineering strain"),
@@ -889,14 +961,20 @@ fn fits_plot(name: &str, mode: Mode, records: &[TestData], curve: &MeanCurve, fi
     );
     for (k, r) in records.iter().enumerate() {
         let (x, y) = thinned(&strain(&r.loading.drive), &stress(&r.observed), 150);
-        let label = if k == 0 { format!("{} records", records.len()) } else { String::new() };
+        let label = if k == 0 {
+            format!("{} records", records.len())
+        } else {
+            String::new()
+        };
         plot.push(Series::line(label, &x, &y).color("#c8c8c8"));
     }
     let grid = &curve.record.loading.drive;
     let (x, y) = thinned(&strain(grid), &stress(&curve.record.observed), 40);
     plot.push(Series::markers("mean curve", &x, &y).color("#000000"));
     for (k, f) in fits.iter().enumerate() {
-        let Ok(law) = f.law.parse::<Law>() else { continue };
+        let Ok(law) = f.law.parse::<Law>() else {
+            continue;
+        };
         let (gx, gl) = thinned(grid, grid, 200);
         let p: Vec<f64> = gl
             .iter()
@@ -906,7 +984,10 @@ fn fits_plot(name: &str, mode: Mode, records: &[TestData], curve: &MeanCurve, fi
                 Mode::Planar => homogeneous::planar(&law, &f.mean_curve, l),
             })
             .collect();
-        plot.push(Series::line(f.law.clone(), &strain(&gx), &stress(&p)).color(PALETTE[k % PALETTE.len()]));
+        plot.push(
+            Series::line(f.law.clone(), &strain(&gx), &stress(&p))
+                .color(PALETTE[k % PALETTE.len()]),
+        );
     }
     plot.to_svg()
 }
@@ -928,7 +1009,12 @@ fn fits_csv(fits: &[LawFits], unit: f64) -> String {
         u = unit_name(unit)
     );
     for f in fits {
-        let join = |v: &[f64]| v.iter().map(|x| format!("{x:.9e}")).collect::<Vec<_>>().join(" ");
+        let join = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:.9e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         let names = f.names.join(" ");
         out.push_str(&format!(
             "{},mean curve,{names},{},{:.6},{:.4},{:.9e}\n",
