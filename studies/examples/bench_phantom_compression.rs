@@ -1,5 +1,5 @@
 //! The silicone phantom between platens: a real compression record of the
-//! phantom database (`studies/tests/data/phantom_dawood2026/EF10_0T_A1.csv`,
+//! phantom database (`studies/data/real/phantom_dawood2026/EF10_0T/EF10_0T_A1.csv`,
 //! Ecoflex 00-10, a cylinder 50 mm across and 30 mm high, testing-machine
 //! format) fitted by the homogeneous model and by the finite-element
 //! cylinder between platens with friction 0, 0.3, bonded and fitted, all
@@ -34,7 +34,7 @@ use std::path::{Path, PathBuf};
 mod cpu;
 use cpu::cpu_seconds;
 
-const RECORD: &str = "studies/tests/data/phantom_dawood2026/EF10_0T_A1.csv";
+const RECORD: &str = "studies/data/real/phantom_dawood2026/EF10_0T/EF10_0T_A1.csv";
 const DESCRIPTION: &str = "studies/experiments/phantom-platens.toml";
 const CCX: &str = "docs/validation/experiments/cylinder_platens_60";
 const STRAIN: f64 = 0.6;

@@ -1,5 +1,5 @@
 //! Testing-machine files read as they come: the phantom compression tests
-//! of Dawood et al. (2026, CC BY 4.0; `tests/data/phantom_dawood2026/README.md`)
+//! of Dawood et al. (2026, CC BY 4.0; `data/real/phantom_dawood2026/README.md`)
 //! with their metadata lines, column names with units and sign
 //! conventions, and copies of them written as other machines write files
 //! (compression positive, tabs, semicolons with decimal commas, trailing
@@ -10,9 +10,13 @@ use palpate_studies::records::{ReadOptions, TestData, TestKind};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// A file of the database (`EF10_0T_A1.csv` is in its folder `EF10_0T`);
+/// `""`: the folder of EF10_0T.
 fn phantom(name: &str) -> PathBuf {
+    let folder = name.rsplit_once('_').map_or("EF10_0T", |(f, _)| f);
     Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data/phantom_dawood2026")
+        .join("data/real/phantom_dawood2026")
+        .join(folder)
         .join(name)
 }
 
@@ -614,7 +618,8 @@ fn replicates_are_fitted_pooled_and_one_by_one_with_the_batch_test() {
     assert!(close(w.df, 2.1515990107941065, 1e-4), "{}", w.df);
     assert!(close(w.p, 0.09644479955522474, 1e-4), "{}", w.p);
 
-    // The CLI: a file pattern declares replicates; the table says the same.
+    // The CLI: a file pattern declares replicates (the phantom's ten
+    // tests); the table says the same as the library on them.
     let pattern = phantom("EF10_0T_*.csv");
     let out = palpate(&[
         "calibrate",
@@ -630,15 +635,15 @@ fn replicates_are_fitted_pooled_and_one_by_one_with_the_batch_test() {
         String::from_utf8_lossy(&out.stderr)
     );
     for says in [
-        "replicates: 6 records, neo-hookean fitted pooled and one by one",
-        "EF10_0T_B3",
+        "replicates: 10 records, neo-hookean fitted pooled and one by one",
+        "EF10_0T_B5",
         "0.01056",
         "rep. mean",
-        "0.01094",
-        "2.172e-4",
-        "batch A (3 records) against batch B (3 records), batches from the file names",
-        "-2.841",
-        "9.644e-2",
+        "0.01101",
+        "2.056e-4",
+        "batch A (5 records) against batch B (5 records), batches from the file names",
+        "-3.245",
+        "1.808e-2",
     ] {
         assert!(stdout.contains(says), "{says}:\n{stdout}");
     }

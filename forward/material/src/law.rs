@@ -133,13 +133,16 @@ impl Law {
     /// The parameters, in the order the evaluation functions expect them.
     ///
     /// Moduli that must be positive have lower bound 0; higher-order polynomial coefficients and
-    /// `C01` may be negative; `lambda_m` in (1, 100); Ogden `alpha_i` in (-[`OGDEN_ALPHA_BOUND`], [`OGDEN_ALPHA_BOUND`]) = (-50, 50), `mu_i` of either sign.
+    /// Mooney-Rivlin's `C10` and `C01` may be negative (their sum may not: [`Law::check`]); `lambda_m` in (1, 100); Ogden `alpha_i` in (-[`OGDEN_ALPHA_BOUND`], [`OGDEN_ALPHA_BOUND`]) = (-50, 50), `mu_i` of either sign.
     pub fn params(&self) -> Vec<MaterialParam> {
         let inf = f64::INFINITY;
         match *self {
             Law::NeoHookean => vec![MaterialParam::new("C10", "MPa", 0.0, inf, 1e-3)],
+            // Each of C10 and C01 may be negative: the law's own condition
+            // is C10 + C01 > 0 (Law::check), which the estimators keep by
+            // rejecting a step outside it, not a box bound on C10.
             Law::MooneyRivlin => vec![
-                MaterialParam::new("C10", "MPa", 0.0, inf, 1e-3),
+                MaterialParam::new("C10", "MPa", -inf, inf, 1e-3),
                 MaterialParam::new("C01", "MPa", -inf, inf, 1e-4),
             ],
             Law::ReducedPolynomial(n) => (1..=n)

@@ -349,7 +349,7 @@ pub fn degeneracy(law: &Law, theta: &[f64], predictions: &[Prediction]) -> Vec<S
 /// A start inside the law's domain when fixed values push the default one
 /// out of it (`--fix C01=-0.1` on Mooney-Rivlin: C10 + C01 > 0 needs
 /// C10 > 0.1 MPa, the default start is C10 = 1e-3): the free moduli (MPa,
-/// lower bound 0, or Ogden's mu_i) are raised by the fixed moduli's
+/// those that raise the initial shear modulus) are raised by the fixed moduli's
 /// magnitude. `None`: the default start is admissible (or the law has no
 /// fixed value). An error names the fixed values when no such start exists.
 pub(crate) fn admissible_start(
@@ -376,9 +376,18 @@ pub(crate) fn admissible_start(
         .filter_map(value)
         .map(f64::abs)
         .sum();
+    // the free moduli: bounded below by 0, an Ogden mu_i, or one that
+    // raises the initial shear modulus (C10 and C01 of Mooney-Rivlin; not
+    // a higher polynomial term)
+    let base = p.clone();
     for (k, s) in specs.iter().enumerate() {
-        let modulus = s.unit == "MPa" && (s.lower == 0.0 || s.name.starts_with("mu"));
-        if value(s).is_none() && modulus {
+        let raises = {
+            let mut q = base.clone();
+            q[k] += 1.0;
+            law.shear_modulus(&q) > law.shear_modulus(&base)
+        };
+        let modulus = s.lower == 0.0 || s.name.starts_with("mu") || raises;
+        if value(s).is_none() && s.unit == "MPa" && modulus {
             p[k] = s.initial.abs().max(1e-3) + shift;
         }
     }

@@ -110,7 +110,8 @@ pub struct Plot {
     pub height: f64,
 }
 
-const PALETTE: [&str; 8] = [
+/// The colours series take in turn.
+pub const PALETTE: [&str; 8] = [
     "#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2", "#17becf",
 ];
 

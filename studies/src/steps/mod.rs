@@ -52,6 +52,7 @@ registry! {
     localize => Localize(LocalizeStep),
     sample => Sample(SampleStep),
     replicates => Replicates(ReplicatesStep),
+    replicates_summary => ReplicatesSummary(ReplicatesSummaryStep),
     plan => Plan(PlanStep),
 }
 

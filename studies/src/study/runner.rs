@@ -134,19 +134,20 @@ pub fn run_study_counted(
             .map_err(|e| anyhow::anyhow!("{}: data.{name}: {e:#}", path.display()))?;
         data.insert(name.clone(), d);
     }
-    // Data files, then the published tables of anova steps.
-    let data_files: Vec<PathBuf> = manifest
-        .data
-        .values()
-        .map(|d| dir.join(&d.file))
-        .chain(
-            manifest
-                .steps
-                .iter()
-                .flat_map(|s| s.step().inputs())
-                .map(|p| dir.join(p)),
-        )
-        .collect();
+    // Data files, then the steps' own inputs (published tables, replicate
+    // files), a pattern as the files it matches now.
+    let mut data_files: Vec<PathBuf> = manifest.data.values().map(|d| dir.join(&d.file)).collect();
+    for p in manifest.steps.iter().flat_map(|s| s.step().inputs()) {
+        let p = dir.join(p);
+        if crate::records::replicates::is_pattern(&p.to_string_lossy()) {
+            data_files.extend(
+                crate::records::replicates::expand(&p.to_string_lossy())
+                    .with_context(|| format!("{}: a step's input", path.display()))?,
+            );
+        } else {
+            data_files.push(p);
+        }
+    }
     let inputs: Vec<PathBuf> = std::iter::once(path.to_path_buf())
         .chain(data_files.iter().cloned())
         .collect();

@@ -17,16 +17,19 @@ use crate::model::calibration::{calibrate, Calibration, Request};
 use crate::records::published::PublishedFit;
 use crate::records::replicates::{batches_from_names, mean_curve, stem, MeanCurve};
 use crate::records::{ReadOptions, TestData, TestKind};
+use crate::report::plot::{thinned, Plot, Series, PALETTE};
 use crate::run::output::write_atomic;
 use crate::run::step::{duplicate, At, Run, Step, StepResult, Study};
-use palpate_uq::likelihood::{HierarchicalPosterior, RandomEffects};
-use serde::Deserialize;
-use std::path::PathBuf;
+
+mod hierarchical;
 use anyhow::Context;
+pub use hierarchical::{hierarchical, hierarchical_table};
 use palpate_analytic::Mode;
 use palpate_material::{homogeneous, Law};
+use serde::Deserialize;
 use serde::Serialize;
 use statrs::distribution::{ContinuousCDF, StudentsT};
+use std::path::PathBuf;
 
 /// One record's own fit.
 #[derive(Debug, Clone, Serialize)]
@@ -161,7 +164,7 @@ pub fn analyse(law: Law, records: &[TestData], pooled: &Calibration) -> anyhow::
     let mut fits = Vec::with_capacity(records.len());
     for (k, r) in records.iter().enumerate() {
         let c = calibrate(Request::least_squares(law, std::slice::from_ref(r)))
-        .with_context(|| format!("replicate {}", r.file))?;
+            .with_context(|| format!("replicate {}", r.file))?;
         fits.push(ReplicateFit {
             record: stems[k].clone(),
             batch: batch_of[k].clone(),
@@ -461,7 +464,9 @@ impl Step for ReplicatesStep {
             "{at}.grid_points = {}: give 2 at least",
             self.grid_points
         );
-        let files = self.files(site.dir).map_err(|e| anyhow::anyhow!("{at}.{e}"))?;
+        let files = self
+            .files(site.dir)
+            .map_err(|e| anyhow::anyhow!("{at}.{e}"))?;
         anyhow::ensure!(
             files.len() >= 2,
             "{at}.data: {} file; replicates need two files at least",
@@ -471,15 +476,21 @@ impl Step for ReplicatesStep {
             anyhow::ensure!(f.is_file(), "{at}.data: {} does not exist", f.display());
         }
         if let Some(p) = &self.published {
-            crate::records::published::read(&site.dir.join(&p.file), &p.format, &p.material, &p.measure)
-                .map_err(|e| anyhow::anyhow!("{at}.published: {e}"))?;
+            crate::records::published::read(
+                &site.dir.join(&p.file),
+                &p.format,
+                &p.material,
+                &p.measure,
+            )
+            .map_err(|e| anyhow::anyhow!("{at}.published: {e}"))?;
         }
         Ok(())
     }
 
     fn inputs(&self) -> Vec<PathBuf> {
+        // a pattern as it is: the runner hashes the files it matches
         let mut out: Vec<PathBuf> = match &self.data {
-            Files::Pattern(_) => Vec::new(),
+            Files::Pattern(p) => vec![PathBuf::from(p)],
             Files::List(l) => l.iter().map(PathBuf::from).collect(),
         };
         out.extend(self.published.iter().map(|p| PathBuf::from(&p.file)));
@@ -509,6 +520,8 @@ pub struct LawFits {
     pub mean_curve_sse: f64,
     pub mean_curve_aic: f64,
     pub mean_curve_converged: bool,
+    /// The mean-curve fit's Drucker-stable stretches in each mode.
+    pub mean_curve_drucker: palpate_material::stability::DruckerReport,
     /// The initial shear modulus of each fit (MPa).
     pub mu0_mean_curve: f64,
     pub mu0_pooled: Option<f64>,
@@ -568,7 +581,15 @@ pub fn verdict(
         .iter()
         .zip(published)
         .filter(|(b, v)| **v < b.lower || **v > b.upper)
-        .map(|(b, v)| format!("{} = {} outside [{}, {}]", b.name, sig4(*v), b.lower, b.upper))
+        .map(|(b, v)| {
+            format!(
+                "{} = {} outside [{}, {}]",
+                b.name,
+                sig4(*v),
+                b.lower,
+                b.upper
+            )
+        })
         .collect();
     let text = if max_rel <= 5e-4 && same_sse {
         "same".to_string()
@@ -577,14 +598,21 @@ pub fn verdict(
     } else if same_sse {
         "same SSE, other parameters".to_string()
     } else if !outside.is_empty() {
-        format!("higher SSE: the published optimum has {}, palpate's bounds", outside.join(", "))
+        format!(
+            "higher SSE: the published optimum has {}, palpate's bounds",
+            outside.join(", ")
+        )
     } else {
         "higher SSE".to_string()
     };
     (max_rel, text)
 }
 
-fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyhow::Result<serde_json::Value> {
+fn run_replicates(
+    run: &Run,
+    step: &ReplicatesStep,
+    report: &mut String,
+) -> anyhow::Result<serde_json::Value> {
     let test = TestKind::parse(&step.test)?;
     let files = step.files(run.manifest_dir)?;
     let records: Vec<TestData> = files
@@ -603,7 +631,8 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
         })
         .collect::<anyhow::Result<_>>()
         .with_context(|| format!("step `{}`", step.name))?;
-    let curve = mean_curve(&records, step.grid_points).with_context(|| format!("step `{}`", step.name))?;
+    let curve =
+        mean_curve(&records, step.grid_points).with_context(|| format!("step `{}`", step.name))?;
     let published = match &step.published {
         Some(p) => crate::records::published::read(
             &run.manifest_dir.join(&p.file),
@@ -622,7 +651,15 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
             .as_ref()
             .is_none_or(|l| l.contains(text));
         let label = format!("{}: {law}", step.name);
-        let inputs = ("replicates", &step.name, law.to_string(), &records, step.grid_points, per_record, &published);
+        let inputs = (
+            "replicates",
+            &step.name,
+            law.to_string(),
+            &records,
+            step.grid_points,
+            per_record,
+            &published,
+        );
         let Some(f): Option<LawFits> = run.unit(&label, &inputs, || {
             fit_law(law, &records, &curve, &published, unit, per_record)
                 .with_context(|| format!("step `{}`: {law}", step.name))
@@ -632,9 +669,25 @@ fn run_replicates(run: &Run, step: &ReplicatesStep, report: &mut String) -> anyh
         };
         fits.push(f);
     }
-    report.push_str(&replicates_report(step, &records, &curve, &published, unit, &fits));
+    report.push_str(&replicates_report(
+        step, &records, &curve, &published, unit, &fits,
+    ));
+    if let TestKind::Homogeneous(mode) = test {
+        let file = format!("{}-fits.svg", step.name);
+        let svg = fits_plot(&step.name, mode, &records, &curve, &fits);
+        write_atomic(&run.out.join("plots").join(&file), svg.as_bytes())?;
+        report.push_str(&format!(
+            "
+![the fits of {}](plots/{file})
+",
+            step.name
+        ));
+    }
     let table = fits_csv(&fits, unit);
-    write_atomic(&run.out.join(format!("{}-fits.csv", step.name)), table.as_bytes())?;
+    write_atomic(
+        &run.out.join(format!("{}-fits.csv", step.name)),
+        table.as_bytes(),
+    )?;
     Ok(serde_json::json!({
         "name": step.name.clone(),
         "records": records.iter().map(|r| r.file.clone()).collect::<Vec<_>>(),
@@ -665,7 +718,13 @@ fn fit_law(
     let sse_of = |theta: &[f64]| -> anyhow::Result<f64> {
         law.check(theta)?;
         let mut sse = 0.0;
-        for (&l, o) in curve.record.loading.drive.iter().zip(&curve.record.observed) {
+        for (&l, o) in curve
+            .record
+            .loading
+            .drive
+            .iter()
+            .zip(&curve.record.observed)
+        {
             let p = match mode {
                 Mode::Uniaxial => homogeneous::uniaxial(&law, theta, l),
                 Mode::Equibiaxial => homogeneous::equibiaxial(&law, theta, l),
@@ -673,7 +732,10 @@ fn fit_law(
             };
             sse += (p - o) * (p - o);
         }
-        anyhow::ensure!(sse.is_finite(), "{law} {theta:?}: the stress is not finite on the curve");
+        anyhow::ensure!(
+            sse.is_finite(),
+            "{law} {theta:?}: the stress is not finite on the curve"
+        );
         Ok(sse)
     };
     let sse = sse_of(&values)?;
@@ -701,7 +763,11 @@ fn fit_law(
         let pooled = request(records).context("the pooled fit")?;
         let reps = analyse(law, records, &pooled)?;
         let theta: Vec<f64> = pooled.params.iter().map(|(_, v)| v.value).collect();
-        let mu0s: Vec<f64> = reps.fits.iter().map(|f| law.shear_modulus(&f.values)).collect();
+        let mu0s: Vec<f64> = reps
+            .fits
+            .iter()
+            .map(|f| law.shear_modulus(&f.values))
+            .collect();
         let (m, v) = mean_var(&mu0s);
         (
             Some(law.shear_modulus(&theta)),
@@ -721,6 +787,7 @@ fn fit_law(
         mean_curve: values.clone(),
         mean_curve_sse: sse,
         mean_curve_converged: mean.converged,
+        mean_curve_drucker: mean.drucker,
         mu0_mean_curve: law.shear_modulus(&values),
         mu0_pooled,
         mu0_records_mean: mu0_mean,
@@ -755,7 +822,11 @@ fn replicates_report(
     out.push_str(&format!(
         "{} records: {}\n\nmean curve: {}\n",
         records.len(),
-        records.iter().map(|r| stem(&r.file)).collect::<Vec<_>>().join(", "),
+        records
+            .iter()
+            .map(|r| stem(&r.file))
+            .collect::<Vec<_>>()
+            .join(", "),
         curve.describe()
     ));
     if let Some(p) = &step.published {
@@ -784,7 +855,9 @@ fn replicates_report(
                 params_text(&f.names, &c.values),
                 c.sse,
                 c.sse_here,
-                c.aic.map(|a| format!("{a:.3}")).unwrap_or_else(|| "-".into()),
+                c.aic
+                    .map(|a| format!("{a:.3}"))
+                    .unwrap_or_else(|| "-".into()),
                 c.max_relative_difference,
                 c.verdict
             )),
@@ -795,6 +868,32 @@ fn replicates_report(
                 f.mean_curve_sse / (unit * unit),
                 f.mean_curve_aic
             )),
+        }
+    }
+    // fits that lose Drucker stability somewhere in the scanned stretches
+    for f in fits {
+        let d = &f.mean_curve_drucker;
+        let full = |r: &palpate_material::stability::StableRange| r.lower <= 0.1 && r.upper >= 10.0;
+        if !(full(&d.uniaxial) && full(&d.biaxial) && full(&d.planar)) {
+            let range = |r: &palpate_material::stability::StableRange| {
+                format!("[{:.3}, {:.3}]", r.lower, r.upper)
+            };
+            let drive = &curve.record.loading.drive;
+            let lo = drive.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = drive.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            let own = match curve.record.test {
+                TestKind::Homogeneous(Mode::Equibiaxial) => &d.biaxial,
+                TestKind::Homogeneous(Mode::Planar) => &d.planar,
+                _ => &d.uniaxial,
+            };
+            out.push_str(&format!(
+                "\n{}: Drucker-stable for stretches uniaxial {}, equibiaxial {}, planar {} (of 0.1 to 10); the curve's stretches {lo:.3} to {hi:.3} are {}.\n",
+                f.law,
+                range(&d.uniaxial),
+                range(&d.biaxial),
+                range(&d.planar),
+                if own.contains(lo) && own.contains(hi) { "inside" } else { "not all inside" }
+            ));
         }
     }
     let missing: Vec<&str> = published
@@ -812,7 +911,9 @@ fn replicates_report(
         out.push_str("\n### initial shear modulus mu0 (MPa): mean curve, pooled records, per-record fits\n\n");
         out.push_str("| law | mean curve | pooled | pooled / mean curve - 1 | per-record mean | SD | per-record mean / mean curve - 1 |\n|---|---|---|---|---|---|---|\n");
         for f in fits {
-            if let (Some(p), Some(m), Some(s)) = (f.mu0_pooled, f.mu0_records_mean, f.mu0_records_sd) {
+            if let (Some(p), Some(m), Some(s)) =
+                (f.mu0_pooled, f.mu0_records_mean, f.mu0_records_sd)
+            {
                 out.push_str(&format!(
                     "| {} | {} | {} | {:+.2} % | {} | {} | {:+.2} % |\n",
                     f.law,
@@ -834,6 +935,63 @@ fn replicates_report(
     out
 }
 
+/// The records (grey), their mean curve (markers) and each law's fit to
+/// it (lines): stress (kPa) against strain, compression positive when the
+/// records are compressions.
+fn fits_plot(
+    name: &str,
+    mode: Mode,
+    records: &[TestData],
+    curve: &MeanCurve,
+    fits: &[LawFits],
+) -> String {
+    let compression = curve.record.loading.drive.iter().any(|&l| l < 1.0);
+    let sign = if compression { -1.0 } else { 1.0 };
+    let strain = |l: &[f64]| -> Vec<f64> { l.iter().map(|l| sign * (l - 1.0)).collect() };
+    let stress = |s: &[f64]| -> Vec<f64> { s.iter().map(|s| sign * 1e3 * s).collect() };
+    let what = if compression {
+        "compressive"
+    } else {
+        "tensile"
+    };
+    let mut plot = Plot::new(
+        format!("{name}: records, mean curve and the fits to it"),
+        format!("{what} engineering strain"),
+        format!("{what} engineering stress (kPa)"),
+    );
+    for (k, r) in records.iter().enumerate() {
+        let (x, y) = thinned(&strain(&r.loading.drive), &stress(&r.observed), 150);
+        let label = if k == 0 {
+            format!("{} records", records.len())
+        } else {
+            String::new()
+        };
+        plot.push(Series::line(label, &x, &y).color("#c8c8c8"));
+    }
+    let grid = &curve.record.loading.drive;
+    let (x, y) = thinned(&strain(grid), &stress(&curve.record.observed), 40);
+    plot.push(Series::markers("mean curve", &x, &y).color("#000000"));
+    for (k, f) in fits.iter().enumerate() {
+        let Ok(law) = f.law.parse::<Law>() else {
+            continue;
+        };
+        let (gx, gl) = thinned(grid, grid, 200);
+        let p: Vec<f64> = gl
+            .iter()
+            .map(|&l| match mode {
+                Mode::Uniaxial => homogeneous::uniaxial(&law, &f.mean_curve, l),
+                Mode::Equibiaxial => homogeneous::equibiaxial(&law, &f.mean_curve, l),
+                Mode::Planar => homogeneous::planar(&law, &f.mean_curve, l),
+            })
+            .collect();
+        plot.push(
+            Series::line(f.law.clone(), &strain(&gx), &stress(&p))
+                .color(PALETTE[k % PALETTE.len()]),
+        );
+    }
+    plot.to_svg()
+}
+
 fn params_text(names: &[String], values: &[f64]) -> String {
     names
         .iter()
@@ -851,7 +1009,12 @@ fn fits_csv(fits: &[LawFits], unit: f64) -> String {
         u = unit_name(unit)
     );
     for f in fits {
-        let join = |v: &[f64]| v.iter().map(|x| format!("{x:.9e}")).collect::<Vec<_>>().join(" ");
+        let join = |v: &[f64]| {
+            v.iter()
+                .map(|x| format!("{x:.9e}"))
+                .collect::<Vec<_>>()
+                .join(" ")
+        };
         let names = f.names.join(" ");
         out.push_str(&format!(
             "{},mean curve,{names},{},{:.6},{:.4},{:.9e}\n",
@@ -883,87 +1046,6 @@ fn fits_csv(fits: &[LawFits], unit: f64) -> String {
             out.push_str(&format!("{},per-record SD,,,,,{s:.9e}\n", f.law));
         }
     }
-    out
-}
-
-/// The hierarchical posterior of replicates' parameters: each record
-/// fitted alone, then the population mean `mu` and between-test SD `tau`
-/// of each parameter sampled ([`RandomEffects`]; prior scale of `tau`: the
-/// largest |estimate| of the parameter).
-pub fn hierarchical(
-    law: Law,
-    records: &[TestData],
-    seed: u64,
-    max_draws: usize,
-) -> anyhow::Result<(Replicates, HierarchicalPosterior)> {
-    let fitted = |fitted: &[TestData]| {
-        calibrate(Request::least_squares(law, fitted))
-    };
-    let pooled = fitted(records).context("the pooled fit")?;
-    let reps = analyse(law, records, &pooled)?;
-    let estimates: Vec<Vec<f64>> = reps.fits.iter().map(|f| f.values.clone()).collect();
-    let standard_errors: Vec<Vec<f64>> = reps
-        .fits
-        .iter()
-        .map(|f| f.standard_errors.iter().map(|s| s.unwrap_or(0.0)).collect())
-        .collect();
-    let tau_scale = (0..reps.names.len())
-        .map(|j| {
-            estimates
-                .iter()
-                .map(|y| y[j].abs())
-                .fold(0.0, f64::max)
-                .max(f64::MIN_POSITIVE)
-        })
-        .collect();
-    let model = RandomEffects {
-        names: reps.names.clone(),
-        estimates,
-        standard_errors,
-        tau_scale,
-    };
-    let post = model
-        .sample(seed, max_draws)
-        .map_err(|e| anyhow::anyhow!("the hierarchical posterior: {e}"))?;
-    Ok((reps, post))
-}
-
-/// The hierarchical posterior as a table: per parameter the population
-/// mean and between-test SD (posterior mean, 94 % HDI, R-hat) beside the
-/// per-record fits' mean and SD.
-pub fn hierarchical_table(law: Law, post: &HierarchicalPosterior) -> String {
-    let mut out = format!(
-        "\nhierarchical posterior of {law} over {} records (theta_i ~ N(mu, tau^2); each record's fit with its standard error):\n",
-        post.tests
-    );
-    out.push_str(&format!(
-        "{:<10} {:>12} {:>25} {:>12} {:>25} {:>12} {:>12} {:>8}\n",
-        "parameter", "mu", "mu 94% HDI", "tau", "tau 94% HDI", "fits mean", "fits SD", "R-hat"
-    ));
-    for p in &post.parameters {
-        out.push_str(&format!(
-            "{:<10} {:>12} {:>25} {:>12} {:>25} {:>12} {:>12} {:>8.4}\n",
-            p.name,
-            sig4(p.mu.mean),
-            format!("[{}, {}]", sig4(p.mu.hdi_3), sig4(p.mu.hdi_97)),
-            sig4(p.tau.mean),
-            format!("[{}, {}]", sig4(p.tau.hdi_3), sig4(p.tau.hdi_97)),
-            sig4(p.estimates_mean),
-            sig4(p.estimates_sd),
-            p.mu.rhat.max(p.tau.rhat)
-        ));
-    }
-    out.push_str(&format!(
-        "{} chains x {} draws, max R-hat {:.4}{}\n",
-        post.chains,
-        post.draws_per_chain,
-        post.rhat_max,
-        if post.converged {
-            ""
-        } else {
-            " (NOT CONVERGED: the cap of draws was reached)"
-        }
-    ));
     out
 }
 
