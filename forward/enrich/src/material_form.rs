@@ -407,3 +407,55 @@ impl Enrichable for MaterialForm {
         v
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use palpate_material::homogeneous;
+
+    #[test]
+    fn every_richer_law_of_neo_hookean_reproduces_it_at_off_and_departs_from_it() {
+        let family = richer_laws(&Law::NeoHookean);
+        let names: Vec<String> = family.iter().map(RicherLaw::name).collect();
+        assert_eq!(family.len(), 7, "{names:?}");
+        assert_eq!(family[0], richer_law(&Law::NeoHookean).unwrap());
+        let c10 = 1.2e-3;
+        for r in &family {
+            let mut off = vec![c10];
+            off.extend_from_slice(&r.embed_law_params);
+            assert!(
+                r.space.check(&off).is_ok(),
+                "{}: off outside its space",
+                r.name()
+            );
+            let law_params = r.map.to_law(&off);
+            for s in [0.7, 0.9, 1.2, 1.6] {
+                let nh = homogeneous::uniaxial(&Law::NeoHookean, &[c10], s);
+                let rich = homogeneous::uniaxial(&r.law, &law_params, s);
+                // Gent's off point is its largest Jm (1e4): neo-Hookean to 1e-4
+                assert!(
+                    (rich - nh).abs() <= 1e-4 * nh.abs(),
+                    "{} at stretch {s}: {rich} for {nh}",
+                    r.name()
+                );
+            }
+            // the starting point of the added terms changes the response
+            let start = r.space.initial();
+            let mut moved = vec![c10];
+            moved.extend_from_slice(&start[1..]);
+            let law_params = r.map.to_law(&moved);
+            let (nh, rich) = (
+                homogeneous::uniaxial(&Law::NeoHookean, &[c10], 1.6),
+                homogeneous::uniaxial(&r.law, &law_params, 1.6),
+            );
+            assert!(
+                (rich - nh).abs() > 1e-3 * nh.abs(),
+                "{}: {rich} {nh}",
+                r.name()
+            );
+        }
+        // another base law has its next richer law only
+        assert_eq!(richer_laws(&Law::ReducedPolynomial(2)).len(), 1);
+        assert!(richer_laws(&Law::MooneyRivlin).is_empty());
+    }
+}
