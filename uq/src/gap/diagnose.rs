@@ -25,6 +25,10 @@ use rayon::prelude::*;
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
+/// One form of a candidate: the effect, the form's index and name, the
+/// enriched model and its predictions at "off".
+type Form = (Effect, usize, String, Arc<dyn ForwardModel>, Vec<f64>);
+
 /// Fewest samples the diagnosis works with: the noise estimate from second
 /// differences needs them.
 const MIN_SAMPLES: usize = 8;
@@ -152,7 +156,7 @@ pub fn diagnose(
     // effect (the richer laws of `material_form`): enrichments that cannot
     // run on this history (e.g. no time for QLV) are skipped, the others
     // reuse them in their score test.
-    let enriched: Vec<(Effect, usize, String, Arc<dyn ForwardModel>, Vec<f64>)> = effects
+    let enriched: Vec<Form> = effects
         .into_par_iter()
         .flat_map_iter(|e| {
             let forms = enrich_forms(base, e).unwrap_or_default();
@@ -199,7 +203,7 @@ pub fn diagnose(
     // A zero offset fitted where the record carries load is refitted within
     // what the record permits.
     let offsets = offset_range(loading, observed, sigma);
-    let assess_all = |enriched: Vec<(Effect, usize, String, Arc<dyn ForwardModel>, Vec<f64>)>| {
+    let assess_all = |enriched: Vec<Form>| {
         enriched
         .into_par_iter()
         .map(|(e, k, name, rich, f_off)| {
