@@ -43,7 +43,7 @@ fn main() {
         .collect();
     names.sort();
     let (mut right, mut cpu_total, mut cpu_max) = (0, 0.0, 0.0f64);
-    println!("record,planted,explanation,remainder_over_noise,cpu_s,wall_s");
+    println!("record,planted,explanation,remainder_over_noise,cpu_s,wall_s[,form]");
     for name in &names {
         let table = Table::read(dir.join(format!("{name}.csv"))).expect("record");
         let t = table.column("time_s").expect("time").to_vec();
@@ -85,11 +85,21 @@ fn main() {
         }
         cpu_total += cpu;
         cpu_max = cpu_max.max(cpu);
+        let forms: Vec<String> = r
+            .explanation_set
+            .iter()
+            .filter_map(|m| m.form.clone())
+            .collect();
         println!(
-            "{name},{},{},{:.2},{cpu:.2},{wall:.2}",
+            "{name},{},{},{:.2},{cpu:.2},{wall:.2}{}",
             planted.join("+"),
             found.join("+"),
-            r.remainder.misfit_over_noise
+            r.remainder.misfit_over_noise,
+            if forms.is_empty() {
+                String::new()
+            } else {
+                format!(",form {}", forms.join(" "))
+            }
         );
     }
     println!(

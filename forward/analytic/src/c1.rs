@@ -2,12 +2,12 @@
 
 use crate::convert::{check_law_params, check_loading, law_space};
 use crate::Compressible;
-use palpate_core::enrichable::not_applicable;
+use palpate_core::enrichable::{not_applicable, one_form, EffectForm};
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
-use palpate_enrich::{richer_law, wrap, MaterialForm};
+use palpate_enrich::{material_forms, richer_law, wrap, MaterialForm};
 use palpate_material::{homogeneous, Law};
 use serde::{Deserialize, Serialize};
 use std::sync::Arc;
@@ -162,6 +162,15 @@ impl Enrichable for C1Compression {
             Effect::ToolCompliance,
         ]);
         e
+    }
+    /// `material_form`: the family of richer laws (`palpate_enrich::richer_laws`).
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        match effect {
+            Effect::MaterialForm => material_forms(&self.law, |l| {
+                Ok(Box::new(C1Compression::with_geometry(l, self.geometry)))
+            }),
+            _ => Ok(one_form(self.enrich(effect)?)),
+        }
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {

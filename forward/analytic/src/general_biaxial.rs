@@ -1,12 +1,12 @@
 //! General biaxial extension of an incompressible sheet (Kawabata et al. 1981).
 
 use crate::convert::{check_law_params, check_loading, law_space};
-use palpate_core::enrichable::not_applicable;
+use palpate_core::enrichable::{not_applicable, one_form, EffectForm};
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
-use palpate_enrich::{richer_law, MaterialForm};
+use palpate_enrich::{material_forms, richer_law, MaterialForm};
 use palpate_material::Law;
 
 /// Nominal stresses of a sheet stretched by `lambda1` and `lambda2` in its
@@ -123,6 +123,15 @@ impl Enrichable for GeneralBiaxial {
             vec![Effect::MaterialForm]
         } else {
             Vec::new()
+        }
+    }
+    /// `material_form`: the family of richer laws (`palpate_enrich::richer_laws`).
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        match effect {
+            Effect::MaterialForm => {
+                material_forms(&self.law, |l| Ok(Box::new(GeneralBiaxial::new(l))))
+            }
+            _ => Ok(one_form(self.enrich(effect)?)),
         }
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {

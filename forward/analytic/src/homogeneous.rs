@@ -2,14 +2,14 @@
 
 use crate::convert::{check_law_params, check_loading, law_space};
 use crate::Mode;
-use palpate_core::enrichable::not_applicable;
+use palpate_core::enrichable::{not_applicable, one_form, EffectForm};
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
 use palpate_enrich::{
-    richer_law, MaterialForm, TensionCompressionAsymmetry, Viscoelastic, ZeroOffset,
-    DEFAULT_PRONY_TERMS,
+    material_forms, richer_law, MaterialForm, TensionCompressionAsymmetry, Viscoelastic,
+    ZeroOffset, DEFAULT_PRONY_TERMS,
 };
 use palpate_material::stability::Mode as StretchMode;
 use palpate_material::{homogeneous, Law};
@@ -120,6 +120,15 @@ impl Enrichable for Homogeneous {
         e.push(Effect::ZeroOffset);
         e.push(Effect::TensionCompressionAsymmetry);
         e
+    }
+    /// `material_form`: the family of richer laws (`palpate_enrich::richer_laws`).
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        match effect {
+            Effect::MaterialForm => {
+                material_forms(&self.law, |l| Ok(Box::new(Homogeneous::new(l, self.mode))))
+            }
+            _ => Ok(one_form(self.enrich(effect)?)),
+        }
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {

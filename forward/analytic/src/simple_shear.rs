@@ -2,12 +2,12 @@
 //! on an axial stretch normal to the sheared plates.
 
 use crate::convert::{check_law_params, check_loading, law_space};
-use palpate_core::enrichable::not_applicable;
+use palpate_core::enrichable::{not_applicable, one_form, EffectForm};
 use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace,
 };
-use palpate_enrich::{richer_law, MaterialForm, Viscoelastic, DEFAULT_PRONY_TERMS};
+use palpate_enrich::{material_forms, richer_law, MaterialForm, Viscoelastic, DEFAULT_PRONY_TERMS};
 use palpate_material::{Law, Volumetric};
 
 /// Simple shear of amount `gamma` superposed on an axial stretch `lambda`
@@ -143,6 +143,15 @@ impl Enrichable for SimpleShear {
         }
         e.push(Effect::Viscoelasticity);
         e
+    }
+    /// `material_form`: the family of richer laws (`palpate_enrich::richer_laws`).
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        match effect {
+            Effect::MaterialForm => material_forms(&self.law, |l| {
+                Ok(Box::new(SimpleShear::new(l, self.axial_stretch)?))
+            }),
+            _ => Ok(one_form(self.enrich(effect)?)),
+        }
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         match effect {

@@ -44,11 +44,47 @@ pub trait Enrichable: ForwardModel {
     /// model to the enriched model's "effect off" point.
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError>;
 
+    /// The forms `effect` can take when there are several (the richer laws
+    /// of `material_form`), each named and enriched as by
+    /// [`Enrichable::enrich`] (parameters and "off" point alike); the first
+    /// is the one [`Enrichable::enrich`] gives. Default: that one alone,
+    /// named after the enriched model.
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        Ok(one_form(self.enrich(effect)?))
+    }
+
     /// For an enriched model: the parameter vector that reproduces the base
     /// model with parameters `base_theta` (the effect switched off).
     /// Default: [`default_embed`].
     fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
         default_embed(self.space(), base_theta)
+    }
+}
+
+/// One form of an effect ([`Enrichable::enrich_forms`]): a short name (e.g.
+/// the richer law, `ogden:1`) and the enriched model.
+pub struct EffectForm {
+    pub name: String,
+    pub model: Box<dyn ForwardModel>,
+}
+
+/// An effect of one form: `model`, named after itself.
+pub fn one_form(model: Box<dyn ForwardModel>) -> Vec<EffectForm> {
+    vec![EffectForm {
+        name: model.name(),
+        model,
+    }]
+}
+
+/// The forms of `effect` that `model` offers ([`Enrichable::enrich_forms`]),
+/// or the error of [`enrich`].
+pub fn enrich_forms(
+    model: &dyn ForwardModel,
+    effect: Effect,
+) -> Result<Vec<EffectForm>, ForwardError> {
+    match model.as_enrichable() {
+        Some(e) => e.enrich_forms(effect),
+        None => Err(not_applicable(effect, &model.name())),
     }
 }
 

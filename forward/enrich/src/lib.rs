@@ -11,7 +11,10 @@
 //!   tests, the usual force-level approximation for a structure);
 //! * [`TensionCompressionAsymmetry`] — a bimodular homogeneous response;
 //! * [`MaterialForm`] with [`richer_law`] — the next richer law of the same
-//!   family, with the "off" point that reproduces the base law.
+//!   family, with the "off" point that reproduces the base law; of
+//!   neo-Hookean, a small family of richer laws ([`richer_laws`]: reduced
+//!   polynomial 2-3, Mooney-Rivlin, Ogden 1-2, Gent, Humphrey), each a form
+//!   the diagnosis chooses among ([`material_forms`]).
 //!
 //! Each is zero ("off") at a reachable parameter value, so a score test can
 //! differentiate there, and each implements
@@ -50,7 +53,7 @@ mod zero_offset;
 
 pub use asymmetry::TensionCompressionAsymmetry;
 pub use convert::law_space;
-pub use material_form::{richer_law, MaterialForm, RicherLaw};
+pub use material_form::{material_forms, richer_law, richer_laws, LawMap, MaterialForm, RicherLaw};
 pub use tool_compliance::ToolCompliance;
 pub use viscoelastic::{prony_params, qlv_convolve, Viscoelastic};
 pub use wrap::{wrap, wrapper_effects, DEFAULT_PRONY_TERMS, WRAPPER_EFFECTS};

@@ -436,6 +436,7 @@ pub(crate) fn assess(
         earns,
         practical,
         model: rich.name(),
+        form: None,
         all_params,
         standard_errors,
         score,

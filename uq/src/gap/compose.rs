@@ -15,11 +15,12 @@
 //! prefix model exactly.
 
 use super::plausible::bound_offsets;
-use palpate_core::enrichable::{embed, enrich, not_applicable};
+use palpate_core::enrichable::{embed, enrich, enrich_forms, not_applicable};
 use palpate_core::{
     Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
     ParamSpace, ParamSpec,
 };
+use std::collections::BTreeMap;
 
 /// Order in which effects are stacked on the base model: the effects that
 /// change the law or the setup first (they are offered by the bare model
@@ -72,6 +73,23 @@ fn permutations(items: &[Effect]) -> Vec<Vec<Effect>> {
     out
 }
 
+/// `model` with `effect` in the form `forms` names (by its index among
+/// [`enrich_forms`]; the default form when absent).
+pub(crate) fn enrich_form(
+    model: &dyn ForwardModel,
+    effect: Effect,
+    forms: &BTreeMap<Effect, usize>,
+) -> Option<Box<dyn ForwardModel>> {
+    match forms.get(&effect) {
+        Some(&k) if k > 0 => enrich_forms(model, effect)
+            .ok()?
+            .into_iter()
+            .nth(k)
+            .map(|f| f.model),
+        _ => enrich(model, effect).ok(),
+    }
+}
+
 /// A chain of effects on a base model: the model, its parameter specs and
 /// its "off" point.
 type Chain = (Box<dyn ForwardModel>, Vec<ParamSpec>, Vec<f64>);
@@ -80,14 +98,19 @@ type Chain = (Box<dyn ForwardModel>, Vec<ParamSpec>, Vec<f64>);
 /// spec where it first appears: the base's own, then each effect's, so
 /// that an effect's narrower bounds survive the steps after it) and the
 /// chain's "off" point for `base_theta`.
-fn chain(base: &dyn ForwardModel, order: &[Effect], base_theta: &[f64]) -> Option<Chain> {
+fn chain(
+    base: &dyn ForwardModel,
+    order: &[Effect],
+    base_theta: &[f64],
+    forms: &BTreeMap<Effect, usize>,
+) -> Option<Chain> {
     let mut first: Vec<ParamSpec> = base.space().params.clone();
     let mut theta = base_theta.to_vec();
     let mut model: Option<Box<dyn ForwardModel>> = None;
     for &e in order {
         let next = match &model {
-            None => enrich(base, e).ok()?,
-            Some(m) => enrich(m.as_ref(), e).ok()?,
+            None => enrich_form(base, e, forms)?,
+            Some(m) => enrich_form(m.as_ref(), e, forms)?,
         };
         theta = embed(next.as_ref(), &theta);
         if theta.len() != next.space().len() {
@@ -120,7 +143,8 @@ fn chain(base: &dyn ForwardModel, order: &[Effect], base_theta: &[f64]) -> Optio
 /// `prefix` (names of the model the newest effect is added to) followed by
 /// the rest; `base_theta` (the base model's parameters) gives the "off"
 /// values of the rest; zero offsets held within `offsets` (what the record
-/// permits, [`super::plausible::offset_range`]). `None` when no order of
+/// permits, [`super::plausible::offset_range`]); each effect in the form
+/// `forms` names ([`enrich_form`]). `None` when no order of
 /// the effects is offered, or when a name of `prefix` is missing or twice
 /// in the chain.
 pub(crate) fn compose(
@@ -129,6 +153,7 @@ pub(crate) fn compose(
     prefix: &[String],
     base_theta: &[f64],
     offsets: Option<(f64, f64)>,
+    forms: &BTreeMap<Effect, usize>,
 ) -> Option<Composite> {
     if effects.is_empty() {
         return None;
@@ -149,7 +174,7 @@ pub(crate) fn compose(
         );
     }
     for order in orders {
-        let Some((inner, specs, theta)) = chain(base, &order, base_theta) else {
+        let Some((inner, specs, theta)) = chain(base, &order, base_theta, forms) else {
             continue;
         };
         let names: Vec<&str> = specs.iter().map(|s| s.name.as_str()).collect();

@@ -6,7 +6,7 @@
 
 use super::assess::{assess, Assessed, Context};
 use super::base::fit_base;
-use super::compose::Composite;
+use super::compose::{enrich_form, Composite};
 use super::crossval::Folds;
 use super::memo::Memo;
 use super::noise::{difference_noise_sd, path_noise_sd};
@@ -19,10 +19,15 @@ use super::structure::{default_window, discrepancy_band, significant_windows, wh
 use super::undetectable::undetectable;
 use super::verdict::decide;
 use super::{GapError, GapOptions};
-use palpate_core::enrichable::{effects_of, embed, enrich};
+use palpate_core::enrichable::{effects_of, embed, enrich_forms};
 use palpate_core::{Effect, ForwardError, ForwardModel, Loading};
 use rayon::prelude::*;
+use std::collections::BTreeMap;
 use std::sync::Arc;
+
+/// One form of a candidate: the effect, the form's index and name, the
+/// enriched model and its predictions at "off".
+type Form = (Effect, usize, String, Arc<dyn ForwardModel>, Vec<f64>);
 
 /// Fewest samples the diagnosis works with: the noise estimate from second
 /// differences needs them.
@@ -147,19 +152,33 @@ pub fn diagnose(
             .collect(),
         None => effects_of(base),
     };
-    // Each enrichment's predictions at "off": enrichments that cannot run
-    // on this history (e.g. no time for QLV) are skipped, the others reuse
-    // them in their score test.
-    let enriched: Vec<(Effect, Arc<dyn ForwardModel>, Vec<f64>)> = effects
+    // Each enrichment's predictions at "off", for every form of the
+    // effect (the richer laws of `material_form`): enrichments that cannot
+    // run on this history (e.g. no time for QLV) are skipped, the others
+    // reuse them in their score test.
+    let enriched: Vec<Form> = effects
         .into_par_iter()
-        .filter_map(|e| {
-            let rich: Arc<dyn ForwardModel> = Arc::from(enrich(base, e).ok()?);
-            let f_off = rich
-                .predict(&embed(rich.as_ref(), &base_theta), loading)
-                .ok()?;
-            Some((e, rich, f_off))
+        .flat_map_iter(|e| {
+            let forms = enrich_forms(base, e).unwrap_or_default();
+            forms
+                .into_iter()
+                .enumerate()
+                .filter_map(|(k, form)| {
+                    let rich: Arc<dyn ForwardModel> = Arc::from(form.model);
+                    let f_off = rich
+                        .predict(&embed(rich.as_ref(), &base_theta), loading)
+                        .ok()?;
+                    Some((e, k, form.name, rich, f_off))
+                })
+                .collect::<Vec<_>>()
         })
         .collect();
+    let mut distinct: Vec<Effect> = enriched.iter().map(|x| x.0).collect();
+    distinct.dedup();
+    // The default forms first; the others only where the default earns its
+    // place, or where no candidate does (see `search_forms`).
+    let (enriched, mut other_forms): (Vec<_>, Vec<_>) =
+        enriched.into_iter().partition(|x| x.1 == 0);
     let ctx = Context {
         loading,
         observed,
@@ -172,7 +191,7 @@ pub fn diagnose(
         base_cv: base_fit.cv.clone(),
         base_residual: base_residual.clone(),
         base_jac: base_fit.jac.as_ref(),
-        candidates: enriched.len(),
+        candidates: distinct.len(),
         alpha: options.alpha,
         rel_var_sd2: noise.rel_var_sd2,
         materiality: options.materiality,
@@ -184,15 +203,16 @@ pub fn diagnose(
     // A zero offset fitted where the record carries load is refitted within
     // what the record permits.
     let offsets = offset_range(loading, observed, sigma);
-    let outcomes: Vec<(Effect, Result<Assessed, GapError>)> = enriched
+    let assess_all = |enriched: Vec<Form>| {
+        enriched
         .into_par_iter()
-        .map(|(e, rich, f_off)| {
+        .map(|(e, k, name, rich, f_off)| {
             let outcome = assess(e, rich, &f_off, &ctx);
             let implausible = outcome.as_ref().is_ok_and(|a| offset_outside(a, offsets));
             if !implausible {
-                return (e, outcome);
+                return (e, k, name, outcome);
             }
-            let bounded = enrich(base, e).ok().and_then(|inner| {
+            let bounded = enrich_form(base, e, &BTreeMap::from([(e, k)])).and_then(|inner| {
                 let off = embed(inner.as_ref(), &base_theta);
                 Composite::bounded(inner, &off, p, offsets)
             });
@@ -206,12 +226,21 @@ pub fn diagnose(
                         ));
                         a
                     });
-                    (e, again)
+                    (e, k, name, again)
                 }
-                None => (e, outcome),
+                None => (e, k, name, outcome),
             }
         })
-        .collect();
+        .collect::<Vec<(Effect, usize, String, Result<Assessed, GapError>)>>()
+    };
+    let mut outcomes = assess_all(enriched);
+    other_forms.retain(|x| search_forms(x.0, &outcomes, gap_significant));
+    if !other_forms.is_empty() {
+        outcomes.extend(assess_all(other_forms));
+    }
+    // An effect of several forms: the form with the best held-out misfit,
+    // each parameter charged.
+    let (outcomes, forms) = choose_forms(outcomes, options.alpha);
     let mut assessed = Vec::new();
     let mut failed = Vec::new();
     for (effect, outcome) in outcomes {
@@ -282,6 +311,7 @@ pub fn diagnose(
             .iter()
             .map(|a| (a.ranked.effect, a.ranked.all_params.clone()))
             .collect(),
+        forms,
     };
     let offered: Vec<Effect> = assessed.iter().map(|a| a.ranked.effect).collect();
     let first = decision
@@ -396,6 +426,135 @@ fn short_record_caveat(
     )
 }
 
+/// Whether the other forms of `effect` are tried: when its default form
+/// leads the candidates (earns its parameters, matters, and has the best
+/// held-out gain, as the ranking orders them: a richer law than the
+/// simplest may explain more), or when the gap is significant and no
+/// candidate earns its place (it would be left unexplained). Otherwise the
+/// default form stands: a family of flexible laws tried beside a leading
+/// effect of another kind would shape the misfit that effect leaves (a
+/// relaxation, a series compliance) rather than the law's, and cost a fit
+/// per form.
+fn search_forms(
+    effect: Effect,
+    outcomes: &[(Effect, usize, String, Result<Assessed, GapError>)],
+    gap_significant: bool,
+) -> bool {
+    let counts = |a: &Assessed| a.ranked.earns && a.ranked.practical.material;
+    let leader = outcomes
+        .iter()
+        .filter_map(|(e, _, _, o)| o.as_ref().ok().filter(|a| counts(a)).map(|a| (*e, a)))
+        .max_by(|x, y| x.1.ranked.heldout_gain.total_cmp(&y.1.ranked.heldout_gain));
+    match leader {
+        Some((e, _)) => e == effect,
+        None => gap_significant,
+    }
+}
+
+/// The assessments of the candidates, one per effect, and the form chosen
+/// for each effect of several forms (index and name). Among the forms of
+/// one effect, as the ranking orders effects: those that earn their
+/// parameters and matter first, then by the held-out gain, here charged
+/// the chi2(1) quantile at `alpha` per parameter of the form (the gain one
+/// parameter must exceed to earn it), so that a form of more parameters
+/// must predict the held-out samples better by that much per parameter; a
+/// tie keeps the first (default) form. The chosen form's evidence lists
+/// the others.
+#[allow(clippy::type_complexity)]
+fn choose_forms(
+    outcomes: Vec<(Effect, usize, String, Result<Assessed, GapError>)>,
+    alpha: f64,
+) -> (
+    Vec<(Effect, Result<Assessed, GapError>)>,
+    BTreeMap<Effect, (usize, String)>,
+) {
+    let charge = super::structure::chi2_isf(alpha, 1.0);
+    let mut order: Vec<Effect> = Vec::new();
+    let mut groups: BTreeMap<Effect, Vec<(usize, String, Result<Assessed, GapError>)>> =
+        BTreeMap::new();
+    for (e, k, name, outcome) in outcomes {
+        if !order.contains(&e) {
+            order.push(e);
+        }
+        groups.entry(e).or_default().push((k, name, outcome));
+    }
+    let mut out = Vec::new();
+    let mut forms = BTreeMap::new();
+    for e in order {
+        let mut group = groups.remove(&e).unwrap_or_default();
+        group.sort_by_key(|g| g.0);
+        if group.len() == 1 && group[0].0 == 0 {
+            let (_, _, outcome) = group.remove(0);
+            out.push((e, outcome));
+            continue;
+        }
+        let score = |a: &Assessed| {
+            (
+                a.ranked.earns && a.ranked.practical.material,
+                a.ranked.earns,
+                a.ranked.heldout_gain - charge * a.ranked.params.len() as f64,
+            )
+        };
+        let mut best: Option<usize> = None;
+        for (i, g) in group.iter().enumerate() {
+            let Ok(a) = &g.2 else { continue };
+            let better = match best {
+                None => true,
+                Some(b) => {
+                    let (x, y) = (score(a), score(group[b].2.as_ref().expect("ok")));
+                    (x.0, x.1)
+                        .cmp(&(y.0, y.1))
+                        .then(x.2.total_cmp(&y.2))
+                        .is_gt()
+                }
+            };
+            if better {
+                best = Some(i);
+            }
+        }
+        let Some(b) = best else {
+            // every form failed: the default form's error
+            let (_, _, outcome) = group.remove(0);
+            out.push((e, outcome));
+            continue;
+        };
+        let others: Vec<String> = group
+            .iter()
+            .enumerate()
+            .filter(|(i, _)| *i != b)
+            .map(|(_, g)| match &g.2 {
+                Ok(a) => format!(
+                    "{} (held-out gain {:.1} on {} parameter(s){})",
+                    g.1,
+                    a.ranked.heldout_gain,
+                    a.ranked.params.len(),
+                    if a.ranked.earns {
+                        ""
+                    } else {
+                        ", does not earn them"
+                    }
+                ),
+                Err(err) => format!("{} (failed: {err})", g.1),
+            })
+            .collect();
+        let (k, name, outcome) = group.swap_remove(b);
+        let chosen = outcome.map(|mut a| {
+            a.ranked.evidence.push_str(&format!(
+                "; form {name} (held-out gain {:.1} on {} parameter(s)), chosen among the forms by held-out gain less \
+                 {charge:.1} per parameter; the others: {}",
+                a.ranked.heldout_gain,
+                a.ranked.params.len(),
+                others.join(", ")
+            ));
+            a.ranked.form = Some(name.clone());
+            a
+        });
+        forms.insert(e, (k, name));
+        out.push((e, chosen));
+    }
+    (out, forms)
+}
+
 /// Whether a candidate's fitted zero offset lies outside what the record
 /// permits.
 fn offset_outside(a: &Assessed, offsets: Option<(f64, f64)>) -> bool {
@@ -417,8 +576,9 @@ fn set_sentence(members: &[super::SetMember], dropped: &[Effect]) -> String {
         .map(|m| {
             let pct = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{:.0} %", 100.0 * v));
             format!(
-                "`{}` ({} of the excess misfit in the order of selection, {} dropped one out)",
+                "`{}`{} ({} of the excess misfit in the order of selection, {} dropped one out)",
                 m.effect,
+                m.form.as_ref().map_or(String::new(), |f| format!(" ({f})")),
                 pct(m.share_marginal),
                 pct(m.share_dropped)
             )

@@ -51,6 +51,11 @@ pub struct RankedEffect {
     pub practical: PracticalSize,
     /// Enriched model name.
     pub model: String,
+    /// The form of the effect, when it has several (the richer law of
+    /// `material_form`, e.g. `ogden:1`), chosen by held-out misfit with a
+    /// charge per parameter.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub form: Option<String>,
     /// Every parameter of the enriched fit.
     pub all_params: BTreeMap<String, f64>,
     /// Standard errors of the effect's parameters (absent where undefined).

@@ -24,14 +24,14 @@
 //! be 100 %.
 
 use super::assess::{assess, canonical_prony, Assessed, Context};
-use super::compose::compose;
+use super::compose::{compose, enrich_form};
 use super::crossval::{cross_validate_by, Folds};
 use super::fit::{fit_from_starts, Fitted};
 use super::rank::rank;
 use super::residual::{residuals, rms, sse};
 use super::structure::WhitenessTests;
 use super::structure::{chi2_isf, chi2_sf, significant_windows, whiteness, GapWindow};
-use palpate_core::enrichable::{embed, enrich};
+use palpate_core::enrichable::embed;
 use palpate_core::{Effect, ForwardModel, Loading};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -45,6 +45,10 @@ pub(crate) const MAX_SET: usize = 4;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct SetMember {
     pub effect: Effect,
+    /// Its form, when the effect has several (the richer law of
+    /// `material_form`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub form: Option<String>,
     /// Its own parameters in the fit of the whole set (physical units).
     pub params: BTreeMap<String, f64>,
     /// Their standard errors in that fit (absent where undefined).
@@ -141,6 +145,9 @@ pub(crate) struct Stage<'a> {
     /// Each candidate's parameters fitted alone (the first step): starts
     /// for its parameters when it joins a set.
     pub solo: BTreeMap<Effect, BTreeMap<String, f64>>,
+    /// The form of each effect that has several, chosen in the first step
+    /// (index among `enrich_forms`), and its name.
+    pub forms: BTreeMap<Effect, (usize, String)>,
 }
 
 /// A set of effects fitted to the record.
@@ -198,11 +205,16 @@ impl Stage<'_> {
             .is_empty()
     }
 
+    /// The chosen forms by index, as [`compose`] takes them.
+    fn form_index(&self) -> BTreeMap<Effect, usize> {
+        self.forms.iter().map(|(e, (k, _))| (*e, *k)).collect()
+    }
+
     /// The effects' own parameter names: those the effect adds to the base
     /// alone.
     fn own_names(&self, effect: Effect) -> Vec<String> {
         let base_names = self.base.space().names();
-        enrich(self.base, effect)
+        enrich_form(self.base, effect, &self.form_index())
             .map(|m| {
                 m.space()
                     .names()
@@ -223,6 +235,7 @@ impl Stage<'_> {
             &prefix,
             self.base_theta,
             self.offsets,
+            &self.form_index(),
         )?);
         let names = model.space().names();
         let donor_names = &donor.names;
@@ -272,6 +285,7 @@ impl Stage<'_> {
     fn forward_step(&self, current: &SetFit, remaining: &[Effect]) -> Option<(Assessed, SetFit)> {
         let prefix = current.names.clone();
         let theta = &current.fitted.theta;
+        let forms = self.form_index();
         let built: Vec<(Effect, Arc<dyn ForwardModel>, Vec<f64>)> = remaining
             .par_iter()
             .filter_map(|&e| {
@@ -283,6 +297,7 @@ impl Stage<'_> {
                     &prefix,
                     self.base_theta,
                     self.offsets,
+                    &forms,
                 )?);
                 let f_off = rich
                     .predict(&embed(rich.as_ref(), theta), self.loading)
@@ -535,6 +550,7 @@ pub(crate) fn explain(
         let j = joined.iter().find(|j| j.effect == effect);
         members.push(SetMember {
             effect,
+            form: stage.forms.get(&effect).map(|(_, n)| n.clone()),
             params: own
                 .iter()
                 .filter_map(|n| all.get(n).map(|v| (n.clone(), *v)))

@@ -165,9 +165,12 @@ pub(crate) fn decide(
         );
     };
     let mut text = format!(
-        "The base model misses the data ({reason}). Adding `{}` brings the misfit from {:.3e} to {:.3e} \
+        "The base model misses the data ({reason}). Adding `{}`{} brings the misfit from {:.3e} to {:.3e} \
          (noise {:.3e}; {:.2} -> {:.2} x noise) and the held-out misfit from {:.3e} to {:.3e}.",
         best.effect,
+        best.form
+            .as_ref()
+            .map_or(String::new(), |f| format!(" (as {f})")),
         best.misfit_before,
         best.misfit_after,
         sigma,
