@@ -26,6 +26,12 @@ OUT = os.environ.get("GAP_REAL_OUT", os.path.join(REPO, "target", "gap_real"))
 LAW = sys.argv[sys.argv.index("--law") + 1] if "--law" in sys.argv else "neo-hookean"
 
 
+def named(entry):
+    """An effect's name, with the law `material_form` chose (`form`)."""
+    form = entry.get("form")
+    return f"{entry['effect']} ({form})" if form else entry["effect"]
+
+
 def kind(folder, name):
     """The --data TEST[options] of a file."""
     if "simple_shear" in name:
@@ -66,7 +72,7 @@ def set_row(folder, name, r):
     noise = r["noise_sd"]
     members = r.get("explanation") or []
     text = "; ".join(
-        f"{m['effect']} ({pct(m.get('share_marginal'))} / {pct(m.get('share_dropped'))})"
+        f"{named(m)} ({pct(m.get('share_marginal'))} / {pct(m.get('share_dropped'))})"
         for m in members) or "none"
     rem = r.get("remainder") or {}
     over = rem.get("misfit_over_noise")
@@ -115,7 +121,7 @@ for folder, name, path in records():
     if r["failed"]:
         other.append("failed: " + ", ".join(str(f.get("effect", f)) if isinstance(f, dict) else str(f) for f in r["failed"]))
     print(f"| {folder} | {name} | {test} | **{r['verdict']}** | {noise:.2e} | {g(before)} | "
-          f"{best['effect'] if best else '-'} | {g(after)} | {excess*100:.0f} % | {'; '.join(other)} | {cpu:.1f} |")
+          f"{named(best) if best else '-'} | {g(after)} | {excess*100:.0f} % | {'; '.join(other)} | {cpu:.1f} |")
     if r.get("caveat"):
         sets[-1] = sets[-1][:-1] + f" caveat: {r['caveat']} |"
 
