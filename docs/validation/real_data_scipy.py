@@ -100,9 +100,9 @@ def law_spec(law):
     if law == "neo_hookean":
         return ["C10"], [0], [INF]
     if law == "mooney_rivlin":
-        # Fitted as (C10, S = C10 + C01), both >= 0: palpate's admissible domain
-        # (C10 > 0 and initial shear modulus 2 (C10 + C01) > 0), as treloar_scipy.py.
-        return ["C10", "S"], [0, 0], [INF, INF]
+        # Fitted as (C10, S = C10 + C01) with S >= 0: palpate's admissible domain
+        # (initial shear modulus 2 (C10 + C01) > 0, either term of either sign).
+        return ["C10", "S"], [-INF, 0], [INF, INF]
     if law == "yeoh":
         return ["C10", "C20", "C30"], [0, -INF, -INF], [INF, INF, INF]
     if law.startswith("ogden"):
