@@ -52,16 +52,16 @@
 //! * zero residual, evaluation budget, iteration budget (argmin's `max_iters`).
 
 use crate::problem::EvaluationCount;
-
-/// Gain ratio above which the next trial is expected to be accepted (and is
-/// evaluated with its Jacobian where that is cheaper together).
-const TRUSTED_GAIN: f64 = 0.25;
 use crate::Termination;
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, TerminationReason, TerminationStatus, KV,
 };
 use nalgebra::{DMatrix, DVector};
 use serde::{Deserialize, Serialize};
+
+/// Gain ratio above which the next trial is expected to be accepted (and is
+/// evaluated with its Jacobian where that is cheaper together).
+const TRUSTED_GAIN: f64 = 0.25;
 
 /// The argmin state the solver works on: parameters `z`, gradient `J^T r`,
 /// residuals `r`, cost SSE.
