@@ -7,8 +7,6 @@
 //! description holds are refused by name.
 
 use crate::common::{refused, Scratch};
-use palpate_core::{Drive, Loading};
-use palpate_fe::experiment::Experiment;
 
 const GEL: &str = include_str!("../../experiments/gel-disc.toml");
 const MESH: &str = "\n[mesh]\nlevel = 1\nelement = \"quad4\"\n";
@@ -19,17 +17,8 @@ const TRUTH: f64 = 5.0e-3;
 /// times the largest force (alternating signs, deterministic).
 fn record(noise: f64) -> String {
     let text = format!("{GEL}{MESH}\n[protocol]\nsegments = [{{ ramp_to = 0.5 }}]\n");
-    let e: Experiment = toml::from_str(&text).unwrap();
     let depths: Vec<f64> = (1..=10).map(|k| 0.05 * k as f64).collect();
-    let f = e
-        .model()
-        .unwrap()
-        .as_forward()
-        .predict(
-            &[TRUTH],
-            &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
-        )
-        .unwrap();
+    let f = crate::common::experiment_forces(&text, &[TRUTH], &depths);
     let top = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
     let mut csv = String::from("displacement_mm,force_N\n");
     for (k, (d, f)) in depths.iter().zip(&f).enumerate() {

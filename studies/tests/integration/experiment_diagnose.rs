@@ -14,11 +14,6 @@
 use std::path::Path;
 use std::process::{Command, Output};
 
-use palpate_core::{Drive, Loading};
-use palpate_fe::experiment::Experiment;
-use rand::SeedableRng;
-use rand_distr::{Distribution, Normal};
-
 fn palpate(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_palpate"))
         .args(args)
@@ -45,27 +40,10 @@ const SAMPLES: usize = 20;
 /// Gaussian noise of `noise` times the largest force (seeded).
 fn record(text: &str, theta: &[f64], noise: f64, seed: u64) -> String {
     let text = format!("{text}\n[protocol]\nsegments = [{{ ramp_to = {DEPTH} }}]\n");
-    let e: Experiment = toml::from_str(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
     let depths: Vec<f64> = (1..=SAMPLES)
         .map(|k| DEPTH * k as f64 / SAMPLES as f64)
         .collect();
-    let f = e
-        .model()
-        .unwrap()
-        .as_forward()
-        .predict(
-            theta,
-            &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
-        )
-        .unwrap();
-    let top = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
-    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
-    let normal = Normal::new(0.0, noise * top).unwrap();
-    let mut csv = String::from("displacement_mm,force_N\n");
-    for (d, f) in depths.iter().zip(&f) {
-        csv += &format!("{d},{:.12e}\n", f + normal.sample(&mut rng));
-    }
-    csv
+    crate::common::experiment_record(&text, theta, &depths, noise, seed)
 }
 
 /// `palpate diagnose --experiment` on `description` and `record` in

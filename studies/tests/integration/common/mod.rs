@@ -77,3 +77,44 @@ pub fn accepted(o: &Output) {
     let e = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{e}");
 }
+
+/// The forces of the experiment description `text` at `theta` on the
+/// displacements `depths` (mm).
+pub fn experiment_forces(text: &str, theta: &[f64], depths: &[f64]) -> Vec<f64> {
+    let e: palpate_fe::experiment::Experiment =
+        toml::from_str(text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+    e.model()
+        .unwrap()
+        .as_forward()
+        .predict(
+            theta,
+            &palpate_core::Loading::quasi_static(
+                palpate_core::Drive::DisplacementMm,
+                depths.to_vec(),
+            ),
+        )
+        .unwrap()
+}
+
+/// A record `displacement_mm,force_N` of the description `text` at
+/// `theta` on the depths, with Gaussian noise of `noise` times the largest
+/// force (seeded).
+pub fn experiment_record(
+    text: &str,
+    theta: &[f64],
+    depths: &[f64],
+    noise: f64,
+    seed: u64,
+) -> String {
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, Normal};
+    let f = experiment_forces(text, theta, depths);
+    let top = f.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(seed);
+    let normal = Normal::new(0.0, noise * top).unwrap();
+    let mut csv = String::from("displacement_mm,force_N\n");
+    for (d, f) in depths.iter().zip(&f) {
+        csv += &format!("{d},{:.12e}\n", f + normal.sample(&mut rng));
+    }
+    csv
+}
