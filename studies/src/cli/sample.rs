@@ -125,7 +125,7 @@ pub struct Args {
     /// Infer an AR(1) correlation of successive residuals per data set (uniform prior on (-1, 1)).
     #[arg(long)]
     pub ar1: bool,
-    /// Prior of a parameter: NAME=flat|uniform:L,U|normal:M,S|lognormal:MU,SIGMA|halfnormal:S. Repeatable.
+    /// Prior of a parameter: NAME=flat|uniform:L,U|normal:M,S|lognormal:MU,SIGMA|halfnormal:S|loguniform:L,U. Repeatable.
     #[arg(long = "prior", value_name = "NAME=SPEC")]
     pub prior: Vec<String>,
     /// Write the summary as JSON (params by name: mean, sd, hdi_3, hdi_97, rhat, ess_bulk, ess_tail, mcse_mean).
@@ -440,7 +440,7 @@ pub fn draw(
             crate::cli::calibrate::split_pair(p, "NAME=SPEC, e.g. C10=lognormal:-7,1")
                 .map_err(|_| {
                     anyhow::anyhow!(
-                        "--prior {p}: expected NAME=SPEC, e.g. C10=lognormal:-7,1 (SPEC: flat, uniform:L,U, normal:M,S, lognormal:MU,SIGMA or halfnormal:S)"
+                        "--prior {p}: expected NAME=SPEC, e.g. C10=lognormal:-7,1 (SPEC: flat, uniform:L,U, normal:M,S, lognormal:MU,SIGMA, halfnormal:S or loguniform:L,U)"
                     )
                 })?;
         if args

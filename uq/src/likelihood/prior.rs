@@ -13,9 +13,12 @@ const LN_SQRT_2PI: f64 = 0.918_938_533_204_672_8;
 /// * `Normal { mean, sd }`: N(mean, sd^2).
 /// * `LogNormal { mu, sigma }`: ln x ~ N(mu, sigma^2), x > 0.
 /// * `HalfNormal { sd }`: 2 N(x; 0, sd^2) for x >= 0.
+/// * `LogUniform { lower, upper }`: 1 / (x ln(upper / lower)) on
+///   [lower, upper], 0 < lower < upper (uniform in ln x: a scale known
+///   only to its order of magnitude).
 ///
 /// Spelled in the CLI and manifests as `flat`, `uniform:L,U`, `normal:M,S`,
-/// `lognormal:MU,SIGMA`, `halfnormal:S`.
+/// `lognormal:MU,SIGMA`, `halfnormal:S`, `loguniform:L,U`.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Prior {
@@ -24,6 +27,7 @@ pub enum Prior {
     Normal { mean: f64, sd: f64 },
     LogNormal { mu: f64, sigma: f64 },
     HalfNormal { sd: f64 },
+    LogUniform { lower: f64, upper: f64 },
 }
 
 impl Prior {
@@ -56,16 +60,24 @@ impl Prior {
                 let u = x / sd;
                 -0.5 * u * u - sd.ln() - LN_SQRT_2PI + std::f64::consts::LN_2
             }
+            Prior::LogUniform { lower, upper } => {
+                if x >= lower && x <= upper {
+                    -x.ln() - (upper / lower).ln().ln()
+                } else {
+                    f64::NEG_INFINITY
+                }
+            }
         }
     }
 
-    /// d log p / dx (0 for `Flat` and `Uniform` inside their support).
+    /// d log p / dx inside the support (0 for `Flat` and `Uniform`).
     pub fn d_log_density(&self, x: f64) -> f64 {
         match *self {
             Prior::Flat | Prior::Uniform { .. } => 0.0,
             Prior::Normal { mean, sd } => -(x - mean) / (sd * sd),
             Prior::LogNormal { mu, sigma } => -(x.ln() - mu) / (sigma * sigma * x) - 1.0 / x,
             Prior::HalfNormal { sd } => -x / (sd * sd),
+            Prior::LogUniform { .. } => -1.0 / x,
         }
     }
 
@@ -78,7 +90,9 @@ impl Prior {
     pub fn support(&self) -> (f64, f64) {
         match *self {
             Prior::Flat | Prior::Normal { .. } => (f64::NEG_INFINITY, f64::INFINITY),
-            Prior::Uniform { lower, upper } => (lower, upper),
+            Prior::Uniform { lower, upper } | Prior::LogUniform { lower, upper } => {
+                (lower, upper)
+            }
             Prior::LogNormal { .. } | Prior::HalfNormal { .. } => (0.0, f64::INFINITY),
         }
     }
@@ -147,6 +161,17 @@ impl Prior {
                 width("log-standard deviation sigma", sigma)
             }
             Prior::HalfNormal { sd } => width("scale", sd),
+            Prior::LogUniform { lower, upper } => {
+                width("lower end", lower)?;
+                finite("upper end", upper)?;
+                if upper > lower {
+                    Ok(())
+                } else {
+                    Err(format!(
+                        "invalid prior {self}: the upper end must exceed the lower end (loguniform:L,U with 0 < L < U)"
+                    ))
+                }
+            }
         }
     }
 }
@@ -159,6 +184,7 @@ impl fmt::Display for Prior {
             Prior::Normal { mean, sd } => write!(f, "normal:{mean},{sd}"),
             Prior::LogNormal { mu, sigma } => write!(f, "lognormal:{mu},{sigma}"),
             Prior::HalfNormal { sd } => write!(f, "halfnormal:{sd}"),
+            Prior::LogUniform { lower, upper } => write!(f, "loguniform:{lower},{upper}"),
         }
     }
 }
@@ -210,9 +236,13 @@ impl FromStr for Prior {
                 need(1)?;
                 Prior::HalfNormal { sd: nums[0] }
             }
+            "loguniform" | "log-uniform" => {
+                need(2)?;
+                Prior::LogUniform { lower: nums[0], upper: nums[1] }
+            }
             other => {
                 return Err(format!(
-                    "unknown prior `{other}`; expected flat, uniform:L,U, normal:M,S, lognormal:MU,SIGMA or halfnormal:S"
+                    "unknown prior `{other}`; expected flat, uniform:L,U, normal:M,S, lognormal:MU,SIGMA, halfnormal:S or loguniform:L,U"
                 ))
             }
         };
@@ -259,6 +289,14 @@ mod tests {
                 20.0,
             ),
             (Prior::HalfNormal { sd: 2.0 }, 0.0, 30.0),
+            (
+                Prior::LogUniform {
+                    lower: 0.5,
+                    upper: 2.0,
+                },
+                0.0,
+                3.0,
+            ),
         ] {
             let i = integral(p, a, b);
             assert!((i - 1.0).abs() < 2e-4, "{p}: {i}");
@@ -277,6 +315,13 @@ mod tests {
                 1.7,
             ),
             (Prior::HalfNormal { sd: 2.0 }, 0.9),
+            (
+                Prior::LogUniform {
+                    lower: 1e-4,
+                    upper: 0.2,
+                },
+                0.03,
+            ),
             (
                 Prior::Uniform {
                     lower: 0.0,
@@ -302,6 +347,7 @@ mod tests {
             "normal:1e-3,2e-4",
             "lognormal:-7,0.5",
             "halfnormal:0.1",
+            "loguniform:1e-4,0.2",
         ] {
             let p: Prior = s.parse().unwrap();
             assert_eq!(p.to_string().parse::<Prior>().unwrap(), p);
@@ -311,6 +357,14 @@ mod tests {
             .unwrap_err()
             .contains("2 numbers"));
         assert!("normal:1,-1".parse::<Prior>().is_err());
+        assert!("loguniform:0,1"
+            .parse::<Prior>()
+            .unwrap_err()
+            .contains("lower end must be positive"));
+        assert!("loguniform:2,1"
+            .parse::<Prior>()
+            .unwrap_err()
+            .contains("0 < L < U"));
         assert!("gamma:1,1"
             .parse::<Prior>()
             .unwrap_err()

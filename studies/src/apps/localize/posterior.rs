@@ -21,8 +21,8 @@
 //! The posterior is palpate-uq's
 //! [`ModelErrorPosterior`] of the model as a `ForwardModel`
 //! ([`super::forward::LocForward`], which states that error variance): its
-//! priors, the ordering constraint and the log-uniform densities of s and
-//! sigma as a joint prior term ([`log_prior_terms`]), the bound transforms
+//! priors (uniform on x_n and d_n, `Prior::LogUniform` on s and sigma),
+//! the ordering constraint as a joint prior term ([`log_prior_terms`]), the bound transforms
 //! (logit of every parameter's box) and their Jacobian those of
 //! palpate-core's `ParamSpace`.
 //!
@@ -149,16 +149,15 @@ pub struct LocRun {
 }
 
 /// The joint prior term of the localisation (module docs): `-inf` unless
-/// x_1 < x_2 - [`MIN_SEPARATION`] < ..., plus the log-uniform densities of
-/// the scale and the noise SD (`-ln s - ln sigma`; their boxes are in the
-/// parameters' bounds). `x` holds x_1, d_1, ..., x_N, d_N, s, sigma.
+/// x_1 < x_2 - [`MIN_SEPARATION`] < ..., 0 otherwise. `x` holds x_1, d_1,
+/// ..., x_N, d_N, s, sigma.
 pub fn log_prior_terms(x: &[f64], n: usize) -> f64 {
     for k in 1..n {
         if x[2 * k] - x[2 * (k - 1)] < MIN_SEPARATION {
             return f64::NEG_INFINITY;
         }
     }
-    -x[2 * n].ln() - x[2 * n + 1].ln()
+    0.0
 }
 
 /// Sum of squared residuals of nodules `nod` and scale `s` (infinite when
@@ -314,16 +313,23 @@ pub fn localize(
             upper: dhi,
         });
     }
-    // log-uniform on the scale's box: the density is in log_prior_terms
-    model_priors.push(Prior::Flat);
-    let noise = ParamSpec::new("noise_sd_N", "N", 1e-4 * mean_f, 0.2 * mean_f, rms);
+    let (s_lo, s_hi) = super::forward::SCALE_BOUNDS;
+    model_priors.push(Prior::LogUniform {
+        lower: s_lo,
+        upper: s_hi,
+    });
+    let (sd_lo, sd_hi) = (1e-4 * mean_f, 0.2 * mean_f);
+    let noise = ParamSpec::new("noise_sd_N", "N", sd_lo, sd_hi, rms);
     let posterior = ModelErrorPosterior::new(
         &fwd,
         LocForward::loading(x),
         y.to_vec(),
         model_priors,
         noise,
-        Prior::Flat,
+        Prior::LogUniform {
+            lower: sd_lo,
+            upper: sd_hi,
+        },
     )
     .map_err(|e| anyhow::anyhow!("the localisation posterior: {e}"))?
     .with_joint_prior(Box::new(move |t: &[f64]| log_prior_terms(t, n)));
