@@ -90,9 +90,7 @@ impl Prior {
     pub fn support(&self) -> (f64, f64) {
         match *self {
             Prior::Flat | Prior::Normal { .. } => (f64::NEG_INFINITY, f64::INFINITY),
-            Prior::Uniform { lower, upper } | Prior::LogUniform { lower, upper } => {
-                (lower, upper)
-            }
+            Prior::Uniform { lower, upper } | Prior::LogUniform { lower, upper } => (lower, upper),
             Prior::LogNormal { .. } | Prior::HalfNormal { .. } => (0.0, f64::INFINITY),
         }
     }
