@@ -22,7 +22,7 @@ use crate::apps::localize::posterior::{localize as sample_localisation, LocOptio
 use crate::apps::localize::record::Record;
 use crate::apps::localize::{LocModel, LocSetup};
 use crate::model::calibration::{calibrate as fit_law, Request};
-use crate::model::Viscous;
+use crate::model::{ExperimentSpec, ModelSpec, Viscous};
 use crate::records::TestData;
 use crate::study::runner::{run_study_counted, RunObserver, RunOptions, RunSummary};
 use palpate_inverse::{Method, ResidualKind};
@@ -118,6 +118,172 @@ pub fn calibrate(data: &[TestData], options: &CalibrateOptions) -> anyhow::Resul
         fixed: options.fixed.clone(),
         observer: None,
         viscous: options.viscous,
+    })
+}
+
+impl CalibrateOptions {
+    /// The options as the command line and the Python package give them
+    /// (names of the law, residual, estimator and viscoelastic form); the
+    /// errors name the option (`--law`, `--residual`, `--estimator`,
+    /// `--fix`, `--viscoelastic`) as `palpate calibrate` does.
+    pub fn parse(
+        law: &str,
+        residual: &str,
+        estimator: &str,
+        fixed: Vec<(String, f64)>,
+        viscoelastic: Option<&str>,
+    ) -> anyhow::Result<Self> {
+        let law: Law = law
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
+        let residual: ResidualKind = residual
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
+        let estimator: Estimator = anyhow::Context::context(estimator.parse(), "--estimator")?;
+        crate::run::checks::check_fixed(&law, &fixed, "--fix")?;
+        let viscous = viscoelastic
+            .map(Viscous::parse)
+            .transpose()
+            .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
+        Ok(CalibrateOptions {
+            law,
+            residual,
+            estimator,
+            fixed,
+            viscous,
+        })
+    }
+}
+
+/// The experiment a calibration fits: the description `experiment` (a
+/// file, a preset's name or JSON text), or the preset named `benchmark`
+/// (N1, N3) with its law replaced by `law` when given; `None` for the other
+/// calibrations (homogeneous tests, C1, Q1).
+pub fn experiment_spec(
+    experiment: Option<&str>,
+    benchmark: Option<&str>,
+    law: Option<&str>,
+) -> anyhow::Result<Option<ExperimentSpec>> {
+    if let Some(e) = experiment {
+        return ExperimentSpec::from_option(e).map(Some);
+    }
+    let Some(b) = benchmark else {
+        return Ok(None);
+    };
+    if b.eq_ignore_ascii_case("c1") || b.eq_ignore_ascii_case("q1") {
+        return Ok(None);
+    }
+    let Some(preset) = crate::model::experiment::preset(b) else {
+        anyhow::bail!(
+            "--benchmark {b}: calibrate takes C1, Q1 or a preset of the experiment descriptions ({})",
+            crate::model::experiment::preset_names().join(", ")
+        );
+    };
+    let mut spec = ExperimentSpec {
+        source: crate::model::ExperimentSource::Preset(b.to_ascii_uppercase()),
+        experiment: Box::new(preset),
+    };
+    if let Some(law) = law {
+        law.parse::<Law>()
+            .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
+        let materials = &mut spec.experiment.materials;
+        anyhow::ensure!(
+            materials.len() == 1,
+            "--law {law}: preset {b} has {} materials; give the laws in an experiment file (palpate experiment show {b})",
+            materials.len()
+        );
+        for m in materials.values_mut() {
+            if m.law != *law {
+                m.law = law.to_string();
+                m.params.clear();
+            }
+        }
+    }
+    spec.check()?;
+    Ok(Some(spec))
+}
+
+/// How to fit an experiment's parameters ([`calibrate_experiment`]).
+#[derive(Debug, Clone, Default)]
+pub struct ExperimentFitOptions {
+    pub residual: ResidualKind,
+    pub estimator: Estimator,
+    /// Parameters held, by name, beside the description's fixed ones.
+    pub fixed: Vec<(String, f64)>,
+}
+
+impl ExperimentFitOptions {
+    /// The residual and estimator by name, errors naming the option as
+    /// `palpate calibrate` does.
+    pub fn parse(
+        residual: &str,
+        estimator: &str,
+        fixed: Vec<(String, f64)>,
+    ) -> anyhow::Result<Self> {
+        Ok(ExperimentFitOptions {
+            residual: residual
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--residual: {e}"))?,
+            estimator: anyhow::Context::context(estimator.parse(), "--estimator")?,
+            fixed,
+        })
+    }
+}
+
+/// Fits the fitted parameters of the experiment `spec` to the force
+/// records `data` by finite elements, its fixed parameters and
+/// `options.fixed` held. The mesh is sized for the deepest displacement of
+/// the records when the description's protocol is the record's.
+pub fn calibrate_experiment(
+    spec: ExperimentSpec,
+    data: &[TestData],
+    options: &ExperimentFitOptions,
+) -> anyhow::Result<Calibration> {
+    let space = spec
+        .experiment
+        .param_space()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let names = space.names();
+    for (k, (name, value)) in options.fixed.iter().enumerate() {
+        anyhow::ensure!(
+            names.iter().any(|n| n == name),
+            "--fix {name}={value}: the experiment has no parameter `{name}`; its parameters: {}",
+            names.join(", ")
+        );
+        anyhow::ensure!(
+            value.is_finite(),
+            "--fix {name}={value}: `{value}` is not a finite number"
+        );
+        anyhow::ensure!(
+            !options.fixed[..k].iter().any(|(n, _)| n == name),
+            "--fix {name}={value}: {name} is fixed twice; give each parameter once"
+        );
+    }
+    let law: Law = spec
+        .law_text()
+        .parse()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let deepest = data
+        .iter()
+        .flat_map(|d| d.loading.drive.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut spec = spec;
+    spec.experiment.size_for_depth(deepest);
+    spec.check()?;
+    let model = ModelSpec::Experiment(spec);
+    model
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}", e.expected))?;
+    fit_law(Request {
+        law,
+        model: Some(&model),
+        fitted: data,
+        predict: &[],
+        residual: options.residual,
+        method: options.estimator.method(),
+        fixed: options.fixed.clone(),
+        observer: None,
+        viscous: None,
     })
 }
 
