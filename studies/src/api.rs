@@ -5,8 +5,18 @@
 //!
 //! * [`calibrate`]: fit a law to records ([`CalibrateOptions`] -> [`Calibration`]);
 //! * [`localize`]: nodules from an R2 rolled record ([`LocalizeOptions`] -> [`Localized`]);
+//! * [`calibrate_experiment`]: fit an experiment description's parameters
+//!   to force records by finite elements ([`experiment_spec`] reads the
+//!   description, [`ExperimentFitOptions`]);
+//! * [`simulate::simulate`]: an FE benchmark's or experiment's force curve
+//!   ([`simulate::SimulateOptions`] -> [`simulate::Simulated`]);
 //! * [`run_study`] and [`check_study`]: a study manifest into its run folder,
 //!   or only checked.
+//!
+//! Records are read with [`crate::records::data_option`] (files, or
+//! columns in memory). What a long run says (summaries, progress bars) goes
+//! to an [`Observer`]: [`Silent`] shows nothing, [`Stderr`] what the command
+//! line shows.
 //!
 //! ```no_run
 //! use palpate_studies::api::{calibrate, CalibrateOptions};
@@ -28,6 +38,34 @@ use crate::study::runner::{run_study_counted, RunObserver, RunOptions, RunSummar
 use palpate_inverse::{Method, ResidualKind};
 use palpate_material::Law;
 use std::path::{Path, PathBuf};
+
+mod estimate;
+pub mod simulate;
+
+/// Where a long run's lines (summaries, warnings, the error estimate) and
+/// progress bars go.
+pub trait Observer {
+    /// A line the command line prints on standard error.
+    fn message(&self, text: &str);
+    /// Whether to draw progress bars (on standard error, when it is a
+    /// terminal).
+    fn bars(&self) -> bool {
+        false
+    }
+}
+
+/// Lines and progress bars on standard error, as the command line shows
+/// them.
+pub struct Stderr;
+
+impl Observer for Stderr {
+    fn message(&self, text: &str) {
+        eprintln!("{text}");
+    }
+    fn bars(&self) -> bool {
+        true
+    }
+}
 
 pub use crate::apps::localize::posterior::LocSampler;
 pub use crate::model::calibration::Calibration;
@@ -405,6 +443,10 @@ pub fn localize(data: &Path, options: &LocalizeOptions) -> anyhow::Result<Locali
 pub struct Silent;
 
 impl RunObserver for Silent {
+    fn message(&self, _: &str) {}
+}
+
+impl Observer for Silent {
     fn message(&self, _: &str) {}
 }
 
