@@ -4,6 +4,8 @@
 //! their option names are theirs, not this API's.
 //!
 //! * [`calibrate`]: fit a law to records ([`CalibrateOptions`] -> [`Calibration`]);
+//! * [`diagnose::diagnose`]: the sim-to-real gap of a record
+//!   ([`diagnose::gap_options`] -> `GapReport`);
 //! * [`localize`]: nodules from an R2 rolled record ([`LocalizeOptions`] -> [`Localized`]);
 //! * [`calibrate_experiment`]: fit an experiment description's parameters
 //!   to force records by finite elements ([`experiment_spec`] reads the
@@ -39,6 +41,7 @@ use palpate_inverse::{Method, ResidualKind};
 use palpate_material::Law;
 use std::path::{Path, PathBuf};
 
+pub mod diagnose;
 mod estimate;
 pub mod simulate;
 

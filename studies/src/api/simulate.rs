@@ -137,6 +137,9 @@ impl std::error::Error for NotConverged {}
 /// refused with the command to use.
 pub fn simulate(options: &SimulateOptions, observer: &dyn Observer) -> anyhow::Result<Simulated> {
     if let Some(e) = &options.experiment {
+        if let Some(name) = held_by_experiment(options).next() {
+            bail!("{name}: not an option with --experiment {e}; the description holds the specimen, materials, tool, supports, protocol and mesh (edit it, or palpate experiment show NAME for a preset)");
+        }
         let (curve, system) = experiment(options, e, observer)?;
         return Ok(Simulated { curve, system });
     }
@@ -151,6 +154,34 @@ pub fn simulate(options: &SimulateOptions, observer: &dyn Observer) -> anyhow::R
         curve,
         system: Some(system),
     })
+}
+
+/// The options given that an experiment description holds itself (its
+/// specimen, materials, tool, supports, protocol and mesh).
+fn held_by_experiment(o: &SimulateOptions) -> impl Iterator<Item = &'static str> {
+    [
+        (o.benchmark.is_some(), "--benchmark"),
+        (o.law.is_some(), "--law"),
+        (o.friction.is_some(), "--friction"),
+        (o.rd.is_some(), "--rd"),
+        (o.nodules.is_some(), "--nodules"),
+        (o.nodule_law.is_some(), "--nodule-law"),
+        (!o.nodule_params.is_empty(), "--nodule-param"),
+        (o.bonded, "--bonded"),
+        (o.sliding_base, "--sliding-base"),
+        (o.tool.is_some(), "--tool"),
+        (o.element.is_some(), "--element"),
+        (o.edge_radius.is_some(), "--edge-radius"),
+        (o.depth.is_some(), "--depth"),
+        (o.step.is_some(), "--step"),
+        (o.mesh.is_some(), "--mesh"),
+        (o.bulk.is_some(), "--bulk"),
+        (o.prony.is_some(), "--prony"),
+        (o.ramp.is_some(), "--ramp"),
+        (o.hold.is_some(), "--hold"),
+    ]
+    .into_iter()
+    .filter_map(|(given, name)| given.then_some(name))
 }
 
 /// The law's parameter vector from `given` (name, value) pairs: each
