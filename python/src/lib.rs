@@ -148,8 +148,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_cli, m)?)?;
     m.add_function(wrap_pyfunction!(run_study, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
-    m.add_function(wrap_pyfunction!(arrays::simulate_arrays, m)?)?;
-    m.add_function(wrap_pyfunction!(arrays::calibrate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::sample_arrays, m)?)?;
     Ok(())
 }
