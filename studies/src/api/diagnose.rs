@@ -224,4 +224,3 @@ pub fn explanation_summary(r: &GapReport) -> String {
     let _ = write!(s, "remainder: {}", r.remainder.note);
     s
 }
-
