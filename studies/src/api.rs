@@ -1,7 +1,9 @@
 //! The typed library API of palpate: typed options in, typed results out,
 //! nothing printed (progress goes to an observer the caller gives, or
-//! nowhere). The `palpate` command line and the Python package call it;
-//! their option names are theirs, not this API's.
+//! nowhere). The `palpate` command line reads its options into these types
+//! and calls it, and so does the Python package, so the two check and
+//! compute the same; the errors name the command line's options (`--law`,
+//! `--param`, ...), which the Python keywords mirror.
 //!
 //! * [`calibrate`]: fit a law to records ([`CalibrateOptions`] -> [`Calibration`]);
 //! * [`diagnose::diagnose`]: the sim-to-real gap of a record
