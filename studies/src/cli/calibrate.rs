@@ -98,7 +98,8 @@ pub struct Args {
     #[arg(long, default_value = "absolute")]
     pub residual: String,
     /// Estimator: lm (Levenberg-Marquardt, default), bfgs or lbfgs (argmin).
-    #[arg(long, default_value = "lm")]
+    /// `--method` is the same option.
+    #[arg(long, visible_alias = "method", default_value = "lm")]
     pub estimator: String,
     /// Hold a parameter fixed, e.g. --fix C01=0 (MPa or dimensionless). Repeatable.
     #[arg(long = "fix", value_name = "NAME=VALUE")]
