@@ -1,28 +1,33 @@
-//! The functions of `palpate._native` that pass numpy arrays in memory
-//! (rust-numpy) instead of through files: `simulate_arrays` (the force
-//! curve out), `calibrate_arrays` (the data in), `sample_arrays` (the data
-//! in, the draws out).
+//! The functions of `palpate._native` that call palpate's typed library
+//! API ([`palpate_studies::api`]) with numpy arrays in memory: `simulate`
+//! ([`palpate_studies::api::simulate::simulate`], the force curve out),
+//! `calibrate` ([`palpate_studies::api::calibrate`] and
+//! [`palpate_studies::api::calibrate_experiment`], the data in), `diagnose`
+//! ([`palpate_studies::api::diagnose`], the record in), and
+//! `sample_arrays` (the data in, the draws out; still the command line's
+//! options, [`palpate_studies::cli::sample::draw`]). The GIL is released
+//! while they run.
 //!
-//! They take the command line's options as `args` (parsed by the same clap
-//! definitions as `run_cli`, so the options, defaults and messages are those
-//! of `palpate --help`) and call palpate's library functions behind the
-//! subcommands ([`palpate_studies::cli::simulate::curve`],
-//! [`palpate_studies::cli::calibrate::fit`],
-//! [`palpate_studies::cli::sample::draw`]), the GIL released while they run.
+//! The options are typed keywords; the texts among them (law, residual,
+//! estimator, a record's `TEST[key=value]` form) are read by the same
+//! functions the command line uses, so the messages are the same.
 //!
 //! No copy at the boundary:
 //! * in: a record's columns are read as borrowed slices of the numpy
 //!   arrays (`PyReadonlyArray1::as_slice`; a non-contiguous array, e.g. a
 //!   strided view, is copied once into a Vec instead) and named in the
-//!   options as `--data TEST=<array:K>` ([`palpate_studies::records::arrays`]);
+//!   record's text as `TEST=<array:K>` ([`palpate_studies::records::arrays`]);
 //! * out: a Vec palpate filled is moved into numpy (`PyArray1::from_vec`:
 //!   the array's memory is the Vec's, owned by a Rust container object that
 //!   is the array's `base`).
 
-use crate::{parse_cli, to_py};
+use crate::{parse_cli, to_py, PalpateError};
 use numpy::{PyArray1, PyReadonlyArray1};
-use palpate_studies::cli::{calibrate, sample, simulate, Command};
+use palpate_studies::api::{self, simulate::SimulateOptions, Observer, Silent, Stderr};
+use palpate_studies::cli::{sample, Command};
 use palpate_studies::records::arrays::ArrayRecord;
+use palpate_studies::records::data_option::{read_data_with, read_force_records};
+use palpate_studies::records::ReadOptions;
 use pyo3::prelude::*;
 use pyo3::types::PyDict;
 use std::borrow::Cow;
@@ -72,16 +77,125 @@ fn array_records<'a>(cols: &'a [Columns<'a>]) -> Vec<ArrayRecord<'a>> {
         .collect()
 }
 
-/// `palpate simulate ARGS` (N1, N3, C1, Q1) with the curve returned as
-/// arrays moved out of palpate's Vecs: a dict of `displacement_mm`,
-/// `force_N` and, when present, `time_s`, `error_estimate_N`, with
-/// `comments` (the CSV's comment lines) and `title`.
+/// Lines and bars on standard error when `verbose`, else nothing.
+fn observer(verbose: bool) -> &'static (dyn Observer + Sync) {
+    if verbose {
+        &Stderr
+    } else {
+        &Silent
+    }
+}
+
+/// A JSON value as Python data (dicts keep the serialiser's order).
+fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py, PyAny>> {
+    use pyo3::types::{PyBool, PyList, PyString};
+    use serde_json::Value as V;
+    Ok(match v {
+        V::Null => py.None().into_bound(py),
+        V::Bool(b) => PyBool::new(py, *b).to_owned().into_any(),
+        V::Number(n) => match (n.as_i64(), n.as_u64()) {
+            (Some(i), _) => i.into_pyobject(py)?.into_any(),
+            (None, Some(u)) => u.into_pyobject(py)?.into_any(),
+            _ => n.as_f64().unwrap_or(f64::NAN).into_pyobject(py)?.into_any(),
+        },
+        V::String(s) => PyString::new(py, s).into_any(),
+        V::Array(a) => {
+            let l = PyList::empty(py);
+            for x in a {
+                l.append(json_to_py(py, x)?)?;
+            }
+            l.into_any()
+        }
+        V::Object(m) => {
+            let d = PyDict::new(py);
+            for (k, x) in m {
+                d.set_item(k, json_to_py(py, x)?)?;
+            }
+            d.into_any()
+        }
+    })
+}
+
+/// An FE benchmark's (N1, N3, C1, Q1) or an experiment's force curve
+/// ([`palpate_studies::api::simulate::simulate`]) with the arrays moved
+/// out of palpate's Vecs: a dict of `displacement_mm`, `force_N` and, when
+/// present, `time_s`, `error_estimate_N`, with `comments` (the CSV's
+/// comment lines) and `title`.
 #[pyfunction]
-pub fn simulate_arrays<'py>(py: Python<'py>, args: Vec<String>) -> PyResult<Bound<'py, PyDict>> {
-    let Command::Simulate(a) = parse("simulate", args)? else {
-        return Err(other("simulate"));
+#[pyo3(signature = (
+    benchmark=None, experiment=None, law=None, params=Vec::new(), *, friction=None, rd=None,
+    nodules=None, nodule_law=None, nodule_params=Vec::new(), bonded=false, sliding_base=false,
+    tool=None, element=None, edge_radius=None, depth=None, step=None, mesh=None, accuracy=None,
+    bulk=None, error_estimate="on", order=None, prony=None, ramp=None, hold=None, verbose=false
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn simulate<'py>(
+    py: Python<'py>,
+    benchmark: Option<String>,
+    experiment: Option<String>,
+    law: Option<String>,
+    params: Vec<(String, f64)>,
+    friction: Option<f64>,
+    rd: Option<f64>,
+    nodules: Option<String>,
+    nodule_law: Option<String>,
+    nodule_params: Vec<(String, f64)>,
+    bonded: bool,
+    sliding_base: bool,
+    tool: Option<String>,
+    element: Option<String>,
+    edge_radius: Option<f64>,
+    depth: Option<f64>,
+    step: Option<f64>,
+    mesh: Option<String>,
+    accuracy: Option<f64>,
+    bulk: Option<String>,
+    error_estimate: &str,
+    order: Option<f64>,
+    prony: Option<String>,
+    ramp: Option<f64>,
+    hold: Option<f64>,
+    verbose: bool,
+) -> PyResult<Bound<'py, PyDict>> {
+    let error_estimate = match error_estimate {
+        "on" => true,
+        "off" => false,
+        other => {
+            return Err(PalpateError::new_err(format!(
+                "--error-estimate {other}: expected on or off"
+            )))
+        }
     };
-    let c = py.detach(|| simulate::curve(&a)).map_err(to_py)?;
+    let options = SimulateOptions {
+        benchmark,
+        experiment,
+        law,
+        params,
+        friction,
+        rd,
+        nodules,
+        nodule_law,
+        nodule_params,
+        bonded,
+        sliding_base,
+        tool,
+        element,
+        edge_radius,
+        depth,
+        step,
+        mesh,
+        accuracy,
+        bulk,
+        error_estimate,
+        order,
+        prony,
+        ramp,
+        hold,
+    };
+    let show = observer(verbose);
+    let c = py
+        .detach(|| api::simulate::simulate(&options, show).map(|s| s.curve))
+        .map_err(to_py)?;
     let d = PyDict::new(py);
     if let Some(t) = c.time_s {
         d.set_item("time_s", PyArray1::from_vec(py, t))?;
@@ -96,22 +210,109 @@ pub fn simulate_arrays<'py>(py: Python<'py>, args: Vec<String>) -> PyResult<Boun
     Ok(d)
 }
 
-/// `palpate calibrate ARGS` with `--data TEST=<array:K>` taking the K-th of
-/// `records` (column names, float64 columns). Returns the JSON of `--json`
-/// as text.
+/// A fit ([`palpate_studies::api::calibrate`], or
+/// [`palpate_studies::api::calibrate_experiment`] for an experiment
+/// description or a preset benchmark such as N1) of the records `data`
+/// (`TEST=FILE`, `TEST[key=value,...]=FILE`, a C1 or force record's
+/// `FILE`, with `<array:K>` for the K-th of `records`). Returns the
+/// calibration as Python data (the report of `palpate calibrate --json`);
+/// `verbose` prints its table as the command line does.
 #[pyfunction]
-pub fn calibrate_arrays(
-    py: Python<'_>,
-    args: Vec<String>,
+#[pyo3(signature = (
+    law, data, records, *, experiment=None, benchmark=None, residual="absolute", estimator="lm",
+    fix=Vec::new(), viscoelastic=None, verbose=false
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn calibrate<'py>(
+    py: Python<'py>,
+    law: Option<String>,
+    data: Vec<String>,
     records: Vec<PyRecord<'_>>,
-) -> PyResult<String> {
-    let Command::Calibrate(a) = parse("calibrate", args)? else {
-        return Err(other("calibrate"));
-    };
+    experiment: Option<String>,
+    benchmark: Option<String>,
+    residual: &str,
+    estimator: &str,
+    fix: Vec<(String, f64)>,
+    viscoelastic: Option<String>,
+    verbose: bool,
+) -> PyResult<Bound<'py, PyAny>> {
     let cols = columns(&records);
     let recs = array_records(&cols);
-    let fit = py.detach(|| calibrate::fit(&a, &recs)).map_err(to_py)?;
-    serde_json::to_string(&fit).map_err(|e| to_py(e.into()))
+    let fit = py
+        .detach(|| {
+            let spec = api::experiment_spec(
+                experiment.as_deref(),
+                benchmark.as_deref(),
+                law.as_deref(),
+            )?;
+            if let Some(spec) = spec {
+                anyhow::ensure!(
+                    viscoelastic.is_none(),
+                    "--viscoelastic: not an option of an experiment's calibration (its description holds the model)"
+                );
+                let options = api::ExperimentFitOptions::parse(residual, estimator, fix)?;
+                let data = read_force_records(&data, &recs, &ReadOptions::default())?;
+                return api::calibrate_experiment(spec, &data, &options);
+            }
+            let law = law.as_deref().ok_or_else(|| {
+                anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)")
+            })?;
+            let options = api::CalibrateOptions::parse(
+                law,
+                residual,
+                estimator,
+                fix,
+                viscoelastic.as_deref(),
+            )?;
+            let data = read_data_with(&data, benchmark.as_deref(), &recs)?;
+            api::calibrate(&data, &options)
+        })
+        .map_err(to_py)?;
+    if verbose {
+        print!("{}", palpate_studies::report::calibration_table(&fit));
+    }
+    let value = serde_json::to_value(&fit).map_err(|e| to_py(e.into()))?;
+    json_to_py(py, &value)
+}
+
+/// The gap diagnosis of one record ([`palpate_studies::api::diagnose`]):
+/// `data` is `TEST=FILE` (a homogeneous record), a force record's `FILE`
+/// with `benchmark` C1 or N1, with `<array:K>` for the K-th of `records`.
+/// Returns the report (the `--json` of `palpate diagnose`) as Python data;
+/// `verbose` prints the command line's summary.
+#[pyfunction]
+#[pyo3(signature = (
+    data, records, *, benchmark=None, base=None, effects=Vec::new(), alpha=None, folds=None,
+    verbose=false
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn diagnose<'py>(
+    py: Python<'py>,
+    data: String,
+    records: Vec<PyRecord<'_>>,
+    benchmark: Option<String>,
+    base: Option<String>,
+    effects: Vec<String>,
+    alpha: Option<f64>,
+    folds: Option<usize>,
+    verbose: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    use palpate_studies::api::diagnose::{diagnose, explanation_summary, gap_options, read_record};
+    let cols = columns(&records);
+    let recs = array_records(&cols);
+    let report = py
+        .detach(|| {
+            let options = gap_options(alpha, folds, &effects)?;
+            let record = read_record(benchmark.as_deref(), &data, &recs)?;
+            diagnose(&record, None, base.as_deref(), &options)
+        })
+        .map_err(to_py)?;
+    if verbose {
+        println!("{}", palpate_studies::report::gap_summary(&report));
+        println!("{}", explanation_summary(&report));
+    }
+    let value = serde_json::to_value(&report).map_err(|e| to_py(e.into()))?;
+    json_to_py(py, &value)
 }
 
 /// `palpate sample ARGS` with `--data TEST=<array:K>` taking the K-th of

@@ -1,17 +1,19 @@
 //! `palpate._native`: the Rust side of the Python package (docs/python.md).
 //!
-//! It runs palpate's own implementations in this process: a subcommand of
-//! the command line (`run_cli`, parsed by the same clap definitions, so the
-//! options, defaults and error messages are those of `palpate --help`), a
-//! study ([`palpate_studies::study::runner::run_study_counted`]) or the merge of
+//! It runs palpate's own implementations in this process: the typed
+//! library API ([`palpate_studies::api`]) for `simulate`, `calibrate` and
+//! `diagnose` ([`arrays`], numpy arrays in memory), `sample_arrays` (the
+//! command line's options parsed by its clap definitions), a subcommand of
+//! the command line (`run_cli`, so the options, defaults and error messages
+//! are those of `palpate --help`), a study
+//! ([`palpate_studies::study::runner::run_study_counted`]) or the merge of
 //! its shards ([`palpate_studies::study::merge::merge`]). The GIL is released for
 //! the whole run (`Python::detach`), so Python threads (a Dask worker's
 //! other tasks) go on meanwhile. An error is raised as `PalpateError` with
 //! the message the command line prints (`error: ...` and each
-//! `caused by: ...`). `simulate_arrays`, `calibrate_arrays` and
-//! `sample_arrays` ([`arrays`]) pass numpy arrays in memory; for the rest
-//! the Python wrappers in `pysrc/palpate` turn numpy arrays into the files
-//! the commands read and their outputs into arrays.
+//! `caused by: ...`). The Q1 identification of `calibrate` and the R2 scan
+//! of `simulate` run the command line through `run_cli`, their records and
+//! outputs as temporary files.
 
 mod arrays;
 
@@ -148,8 +150,9 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(run_cli, m)?)?;
     m.add_function(wrap_pyfunction!(run_study, m)?)?;
     m.add_function(wrap_pyfunction!(merge, m)?)?;
-    m.add_function(wrap_pyfunction!(arrays::simulate_arrays, m)?)?;
-    m.add_function(wrap_pyfunction!(arrays::calibrate_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::simulate, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::calibrate, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::diagnose, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::sample_arrays, m)?)?;
     Ok(())
 }

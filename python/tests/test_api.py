@@ -109,7 +109,7 @@ def quiet_calls():
         # the sampler's progress and summary
         "sample": lambda v: palpate.sample("neo-hookean", {"uniaxial": (stretch, stress)}, sampler="demc",
                                            draws=20, max_draws=20, tune=20, parallel=1, arviz=False, verbose=v),
-        # the Q1 path writes a temporary JSON (a `wrote` line on the command line)
+        # the diagnosis summary and explanation
         "diagnose": lambda v: palpate.diagnose({"uniaxial": (stretch, stress)}, folds=2, verbose=v),
     }
 

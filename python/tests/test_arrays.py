@@ -75,13 +75,13 @@ def test_simulate_moves_the_curve_out_and_equals_the_csv(tmp_path):
 def test_calibrate_hands_the_callers_arrays_to_palpate_and_fits_as_from_the_file(monkeypatch):
     stretch, stress = treloar()
     seen = []
-    real = _native.calibrate_arrays
+    real = _native.calibrate
 
-    def spy(args, records):
+    def spy(law, data, records, **options):
         seen.append(records)
-        return real(args, records)
+        return real(law, data, records, **options)
 
-    monkeypatch.setattr(_native, "calibrate_arrays", spy)
+    monkeypatch.setattr(_native, "calibrate", spy)
     fit = palpate.calibrate("yeoh", {"uniaxial": (stretch, stress)})
     (names, cols), = seen[0]
     assert names == ["stretch", "stress_MPa"]
@@ -159,3 +159,11 @@ def test_a_c1_force_record_as_arrays_fits_and_samples_as_the_file():
     y = palpate.sample("neo-hookean", path, **kw)
     assert np.array_equal(x.draws["C10"], y.draws["C10"])
     assert_moved_from_rust(x.draws["C10"])
+
+
+def test_diagnose_reads_arrays_in_memory_as_the_file():
+    """No temporary file: the arrays are the record, diagnosed as the CSV is."""
+    stretch, stress = treloar()
+    a = palpate.diagnose({"uniaxial": (stretch, stress)}, folds=2)
+    b = palpate.diagnose({"uniaxial": TRELOAR}, folds=2)
+    assert a.verdict == b.verdict and a.ranking == b.ranking and a.ranking

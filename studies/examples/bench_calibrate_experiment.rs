@@ -106,27 +106,37 @@ fn main() {
         if !chosen.is_empty() && !chosen.iter().any(|c| *c == case.name) {
             continue;
         }
-        // the record, on a finer mesh
-        let t0 = cpu_seconds(false);
-        let fine: Experiment = toml::from_str(&format!(
+        // the record, on a finer mesh (noiseless forces cached under
+        // target/: a rerun reads them instead of recomputing them)
+        let fine_text = format!(
             "{}\n[protocol]\nsegments = [{{ ramp_to = {} }}]\n\n[mesh]\nlevel = {}\n",
             case.description,
             case.depth,
             level + 1
-        ))
-        .expect("the record's description");
+        );
+        let fine: Experiment = toml::from_str(&fine_text).expect("the record's description");
         let model = fine.model().expect("the record's model");
         let depths: Vec<f64> = (1..=case.samples)
             .map(|k| case.depth * k as f64 / case.samples as f64)
             .collect();
         let theta: Vec<f64> = case.truth.iter().map(|t| t.1).collect();
-        let forces = model
-            .as_forward()
-            .predict(
-                &theta,
-                &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
-            )
-            .expect("the record's run");
+        let cache = record_cache(&fine_text, &theta, &depths);
+        let (forces, record_cpu, cached) = match read_cached(&cache, depths.len()) {
+            Some((f, cpu)) => (f, cpu, true),
+            None => {
+                let t0 = cpu_seconds(false);
+                let f = model
+                    .as_forward()
+                    .predict(
+                        &theta,
+                        &Loading::quasi_static(Drive::DisplacementMm, depths.clone()),
+                    )
+                    .expect("the record's run");
+                let cpu = cpu_seconds(false) - t0;
+                write_cached(&cache, &depths, &f, cpu);
+                (f, cpu, false)
+            }
+        };
         let top = forces.iter().fold(0.0f64, |m, f| m.max(f.abs()));
         let mut rng = rand_xoshiro::Xoshiro256PlusPlus::seed_from_u64(11);
         let normal = Normal::new(0.0, noise * top).expect("noise");
@@ -143,13 +153,17 @@ fn main() {
             format!("{}\n[mesh]\nlevel = {level}\n", case.description),
         )
         .expect("write the description");
-        let record_cpu = cpu_seconds(false) - t0;
         println!(
-            "\n== {}: record to {} mm, {} samples, F max {top:.4e} N, on {} ({record_cpu:.1} s CPU)",
+            "\n== {}: record to {} mm, {} samples, F max {top:.4e} N, on {} ({record_cpu:.1} s CPU{})",
             case.name,
             case.depth,
             case.samples,
-            model.name()
+            model.name(),
+            if cached {
+                format!(" when made; read from {}", cache.display())
+            } else {
+                String::new()
+            }
         );
         // the fit, as the command line makes it
         let line = [
@@ -174,8 +188,13 @@ fn main() {
             serde_json::from_str(&std::fs::read_to_string(&json).expect("the fit's JSON"))
                 .expect("JSON");
         println!(
-            "{}: {} FE runs, {} iterations, converged {}, {cpu:.1} s CPU ({wall:.1} s wall)",
-            case.name, fit["evaluations"], fit["iterations"], fit["converged"]
+            "{}: {} FE runs in the fit ({} Jacobians, each from one of them run with sensitivities) + 1 for the fitted curve, {} iterations, converged {} ({}), {cpu:.1} s CPU ({wall:.1} s wall)",
+            case.name,
+            fit["evaluations"],
+            fit["fit"]["jacobians"],
+            fit["iterations"],
+            fit["converged"],
+            fit["fit"]["termination"],
         );
         for (name, t) in &case.truth {
             let p = &fit["params"][name];
@@ -187,5 +206,47 @@ fn main() {
                 (v - t) / se
             );
         }
+    }
+}
+
+/// The file of a record's noiseless forces: under the workspace's
+/// `target/`, named by a hash of the description, the parameters and the
+/// depths (so that any change makes a new record).
+fn record_cache(description: &str, theta: &[f64], depths: &[f64]) -> std::path::PathBuf {
+    use std::hash::{Hash, Hasher};
+    let mut h = std::collections::hash_map::DefaultHasher::new();
+    description.hash(&mut h);
+    for x in theta.iter().chain(depths) {
+        x.to_bits().hash(&mut h);
+    }
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../target/bench_calibrate_experiment")
+        .join(format!("record-{:016x}.csv", h.finish()))
+}
+
+/// The cached forces and the CPU seconds their run took, when the file
+/// holds `n` of them.
+fn read_cached(path: &std::path::Path, n: usize) -> Option<(Vec<f64>, f64)> {
+    let text = std::fs::read_to_string(path).ok()?;
+    let mut lines = text.lines();
+    let cpu: f64 = lines.next()?.strip_prefix("# cpu_s ")?.parse().ok()?;
+    lines.next()?; // the column names
+    let forces: Vec<f64> = lines
+        .map(|l| l.split(',').nth(1).and_then(|f| f.parse().ok()))
+        .collect::<Option<_>>()?;
+    (forces.len() == n).then_some((forces, cpu))
+}
+
+fn write_cached(path: &std::path::Path, depths: &[f64], forces: &[f64], cpu: f64) {
+    let mut text = format!("# cpu_s {cpu}\ndisplacement_mm,force_N\n");
+    for (d, f) in depths.iter().zip(forces) {
+        text += &format!("{d},{f:e}\n");
+    }
+    let written = path
+        .parent()
+        .map_or(Ok(()), std::fs::create_dir_all)
+        .and_then(|()| std::fs::write(path, text));
+    if let Err(e) = written {
+        println!("(the record is not cached: {}: {e})", path.display());
     }
 }

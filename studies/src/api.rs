@@ -1,12 +1,26 @@
 //! The typed library API of palpate: typed options in, typed results out,
 //! nothing printed (progress goes to an observer the caller gives, or
-//! nowhere). The `palpate` command line and the Python package call it;
-//! their option names are theirs, not this API's.
+//! nowhere). The `palpate` command line reads its options into these types
+//! and calls it, and so does the Python package, so the two check and
+//! compute the same; the errors name the command line's options (`--law`,
+//! `--param`, ...), which the Python keywords mirror.
 //!
 //! * [`calibrate`]: fit a law to records ([`CalibrateOptions`] -> [`Calibration`]);
+//! * [`diagnose::diagnose`]: the sim-to-real gap of a record
+//!   ([`diagnose::gap_options`] -> `GapReport`);
 //! * [`localize`]: nodules from an R2 rolled record ([`LocalizeOptions`] -> [`Localized`]);
+//! * [`calibrate_experiment`]: fit an experiment description's parameters
+//!   to force records by finite elements ([`experiment_spec`] reads the
+//!   description, [`ExperimentFitOptions`]);
+//! * [`simulate::simulate`]: an FE benchmark's or experiment's force curve
+//!   ([`simulate::SimulateOptions`] -> [`simulate::Simulated`]);
 //! * [`run_study`] and [`check_study`]: a study manifest into its run folder,
 //!   or only checked.
+//!
+//! Records are read with [`crate::records::data_option`] (files, or
+//! columns in memory). What a long run says (summaries, progress bars) goes
+//! to an [`Observer`]: [`Silent`] shows nothing, [`Stderr`] what the command
+//! line shows.
 //!
 //! ```no_run
 //! use palpate_studies::api::{calibrate, CalibrateOptions};
@@ -22,12 +36,41 @@ use crate::apps::localize::posterior::{localize as sample_localisation, LocOptio
 use crate::apps::localize::record::Record;
 use crate::apps::localize::{LocModel, LocSetup};
 use crate::model::calibration::{calibrate as fit_law, Request};
-use crate::model::Viscous;
+use crate::model::{ExperimentSpec, ModelSpec, Viscous};
 use crate::records::TestData;
 use crate::study::runner::{run_study_counted, RunObserver, RunOptions, RunSummary};
 use palpate_inverse::{Method, ResidualKind};
 use palpate_material::Law;
 use std::path::{Path, PathBuf};
+
+pub mod diagnose;
+mod estimate;
+pub mod simulate;
+
+/// Where a long run's lines (summaries, warnings, the error estimate) and
+/// progress bars go.
+pub trait Observer {
+    /// A line the command line prints on standard error.
+    fn message(&self, text: &str);
+    /// Whether to draw progress bars (on standard error, when it is a
+    /// terminal).
+    fn bars(&self) -> bool {
+        false
+    }
+}
+
+/// Lines and progress bars on standard error, as the command line shows
+/// them.
+pub struct Stderr;
+
+impl Observer for Stderr {
+    fn message(&self, text: &str) {
+        eprintln!("{text}");
+    }
+    fn bars(&self) -> bool {
+        true
+    }
+}
 
 pub use crate::apps::localize::posterior::LocSampler;
 pub use crate::model::calibration::Calibration;
@@ -118,6 +161,172 @@ pub fn calibrate(data: &[TestData], options: &CalibrateOptions) -> anyhow::Resul
         fixed: options.fixed.clone(),
         observer: None,
         viscous: options.viscous,
+    })
+}
+
+impl CalibrateOptions {
+    /// The options as the command line and the Python package give them
+    /// (names of the law, residual, estimator and viscoelastic form); the
+    /// errors name the option (`--law`, `--residual`, `--estimator`,
+    /// `--fix`, `--viscoelastic`) as `palpate calibrate` does.
+    pub fn parse(
+        law: &str,
+        residual: &str,
+        estimator: &str,
+        fixed: Vec<(String, f64)>,
+        viscoelastic: Option<&str>,
+    ) -> anyhow::Result<Self> {
+        let law: Law = law
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
+        let residual: ResidualKind = residual
+            .parse()
+            .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
+        let estimator: Estimator = anyhow::Context::context(estimator.parse(), "--estimator")?;
+        crate::run::checks::check_fixed(&law, &fixed, "--fix")?;
+        let viscous = viscoelastic
+            .map(Viscous::parse)
+            .transpose()
+            .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
+        Ok(CalibrateOptions {
+            law,
+            residual,
+            estimator,
+            fixed,
+            viscous,
+        })
+    }
+}
+
+/// The experiment a calibration fits: the description `experiment` (a
+/// file, a preset's name or JSON text), or the preset named `benchmark`
+/// (N1, N3) with its law replaced by `law` when given; `None` for the other
+/// calibrations (homogeneous tests, C1, Q1).
+pub fn experiment_spec(
+    experiment: Option<&str>,
+    benchmark: Option<&str>,
+    law: Option<&str>,
+) -> anyhow::Result<Option<ExperimentSpec>> {
+    if let Some(e) = experiment {
+        return ExperimentSpec::from_option(e).map(Some);
+    }
+    let Some(b) = benchmark else {
+        return Ok(None);
+    };
+    if b.eq_ignore_ascii_case("c1") || b.eq_ignore_ascii_case("q1") {
+        return Ok(None);
+    }
+    let Some(preset) = crate::model::experiment::preset(b) else {
+        anyhow::bail!(
+            "--benchmark {b}: calibrate takes C1, Q1 or a preset of the experiment descriptions ({})",
+            crate::model::experiment::preset_names().join(", ")
+        );
+    };
+    let mut spec = ExperimentSpec {
+        source: crate::model::ExperimentSource::Preset(b.to_ascii_uppercase()),
+        experiment: Box::new(preset),
+    };
+    if let Some(law) = law {
+        law.parse::<Law>()
+            .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
+        let materials = &mut spec.experiment.materials;
+        anyhow::ensure!(
+            materials.len() == 1,
+            "--law {law}: preset {b} has {} materials; give the laws in an experiment file (palpate experiment show {b})",
+            materials.len()
+        );
+        for m in materials.values_mut() {
+            if m.law != *law {
+                m.law = law.to_string();
+                m.params.clear();
+            }
+        }
+    }
+    spec.check()?;
+    Ok(Some(spec))
+}
+
+/// How to fit an experiment's parameters ([`calibrate_experiment`]).
+#[derive(Debug, Clone, Default)]
+pub struct ExperimentFitOptions {
+    pub residual: ResidualKind,
+    pub estimator: Estimator,
+    /// Parameters held, by name, beside the description's fixed ones.
+    pub fixed: Vec<(String, f64)>,
+}
+
+impl ExperimentFitOptions {
+    /// The residual and estimator by name, errors naming the option as
+    /// `palpate calibrate` does.
+    pub fn parse(
+        residual: &str,
+        estimator: &str,
+        fixed: Vec<(String, f64)>,
+    ) -> anyhow::Result<Self> {
+        Ok(ExperimentFitOptions {
+            residual: residual
+                .parse()
+                .map_err(|e| anyhow::anyhow!("--residual: {e}"))?,
+            estimator: anyhow::Context::context(estimator.parse(), "--estimator")?,
+            fixed,
+        })
+    }
+}
+
+/// Fits the fitted parameters of the experiment `spec` to the force
+/// records `data` by finite elements, its fixed parameters and
+/// `options.fixed` held. The mesh is sized for the deepest displacement of
+/// the records when the description's protocol is the record's.
+pub fn calibrate_experiment(
+    spec: ExperimentSpec,
+    data: &[TestData],
+    options: &ExperimentFitOptions,
+) -> anyhow::Result<Calibration> {
+    let space = spec
+        .experiment
+        .param_space()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let names = space.names();
+    for (k, (name, value)) in options.fixed.iter().enumerate() {
+        anyhow::ensure!(
+            names.iter().any(|n| n == name),
+            "--fix {name}={value}: the experiment has no parameter `{name}`; its parameters: {}",
+            names.join(", ")
+        );
+        anyhow::ensure!(
+            value.is_finite(),
+            "--fix {name}={value}: `{value}` is not a finite number"
+        );
+        anyhow::ensure!(
+            !options.fixed[..k].iter().any(|(n, _)| n == name),
+            "--fix {name}={value}: {name} is fixed twice; give each parameter once"
+        );
+    }
+    let law: Law = spec
+        .law_text()
+        .parse()
+        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let deepest = data
+        .iter()
+        .flat_map(|d| d.loading.drive.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()));
+    let mut spec = spec;
+    spec.experiment.size_for_depth(deepest);
+    spec.check()?;
+    let model = ModelSpec::Experiment(spec);
+    model
+        .validate()
+        .map_err(|e| anyhow::anyhow!("{}", e.expected))?;
+    fit_law(Request {
+        law,
+        model: Some(&model),
+        fitted: data,
+        predict: &[],
+        residual: options.residual,
+        method: options.estimator.method(),
+        fixed: options.fixed.clone(),
+        observer: None,
+        viscous: None,
     })
 }
 
@@ -239,6 +448,10 @@ pub fn localize(data: &Path, options: &LocalizeOptions) -> anyhow::Result<Locali
 pub struct Silent;
 
 impl RunObserver for Silent {
+    fn message(&self, _: &str) {}
+}
+
+impl Observer for Silent {
     fn message(&self, _: &str) {}
 }
 

@@ -8,9 +8,10 @@ Arrays go in as numpy arrays (or file paths) and come out as numpy arrays
 in result objects (:class:`Calibration`, :class:`Curve`,
 :class:`Posterior`, :class:`Diagnosis`, :class:`StudyRun`; ``to_dict()``
 gives JSON-like data). The functions print nothing unless ``verbose=True``.
-``calibrate``, ``simulate`` and ``sample`` pass arrays in memory (no copy
-at the boundary, docs/python.md says where); ``diagnose`` goes through
-temporary files.
+``calibrate``, ``simulate`` and ``diagnose`` call palpate's typed library
+API (the functions the command line calls after reading its options);
+``calibrate``, ``simulate``, ``sample`` and ``diagnose`` pass arrays in
+memory (no copy at the boundary, docs/python.md says where).
 
 See docs/python.md for a worked example.
 """
@@ -245,8 +246,9 @@ def calibrate(
     ``converged``, ``predictions`` with numpy arrays, ``report``).
 
     Records given as float64 arrays go to palpate in memory (read there as
-    borrowed slices); ``benchmark="Q1"`` reads files, so its record is
-    written to a temporary CSV.
+    borrowed slices). ``benchmark="Q1"`` (and its options) runs the
+    command line's staged identification, which reads files, so its record
+    is written to a temporary CSV.
     """
     if data is None:
         raise TypeError("calibrate() missing required argument: 'data'")
@@ -258,11 +260,18 @@ def calibrate(
                    fit_edge_radius=fit_edge_radius, mesh_check=mesh_check, compare=compare, profile=profile)
     flags = _flags(options)
     model_args = (["--law", law] if law is not None else []) + _experiment_option(experiment)
-    if (benchmark or "").lower() != "q1":
+    q1_options = dict(stages=stages, prony_terms=prony_terms, fit_mesh=fit_mesh, correct_mesh=correct_mesh,
+                      time_step=time_step, edge_radius=edge_radius, fit_edge_radius=fit_edge_radius,
+                      mesh_check=mesh_check, compare=compare, profile=profile)
+    if (benchmark or "").lower() != "q1" and not any(v not in (None, False) for v in q1_options.values()):
         one_record = benchmark if experiment is None else "experiment"
         data_args, records = _data_in_memory(data, one_record)
-        with _quiet(not verbose):
-            report = json.loads(_native.calibrate_arrays([*model_args, *data_args, *flags], records))
+        specs = data_args[1::2]  # the values of the --data options
+        experiment_text = _experiment_option(experiment)[1:] or [None]
+        report = _native.calibrate(
+            law, specs, records, experiment=experiment_text[0], benchmark=benchmark, residual=residual,
+            estimator=estimator, fix=[(k, float(v)) for k, v in (fix or {}).items()],
+            viscoelastic=viscoelastic, verbose=verbose)
         return Calibration.from_report(report)
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "fit.json")
@@ -328,7 +337,17 @@ def simulate(
     """
     if (benchmark is None) == (experiment is None):
         raise TypeError("simulate() needs exactly one of 'benchmark' and 'experiment'")
-    args = ["--benchmark", benchmark] if benchmark is not None else _experiment_option(experiment)
+    if (benchmark or "").lower() != "r2":
+        curve = _native.simulate(
+            benchmark, (_experiment_option(experiment)[1:] or [None])[0], law,
+            [(k, float(v)) for k, v in (params or {}).items()],
+            friction=friction, rd=rd, nodules=nodules, nodule_law=nodule_law,
+            nodule_params=[(k, float(v)) for k, v in (nodule_params or {}).items()],
+            bonded=bonded, sliding_base=sliding_base, tool=tool, element=element, edge_radius=edge_radius,
+            depth=depth, step=step, mesh=None if mesh is None else str(mesh), bulk=_text(bulk),
+            error_estimate=error_estimate, order=order, prony=prony, ramp=ramp, hold=hold, verbose=verbose)
+        return Curve(**curve)
+    args = ["--benchmark", benchmark]
     if law is not None:
         args += ["--law", law]
     for k, v in (params or {}).items():
@@ -339,15 +358,19 @@ def simulate(
                         bulk=bulk, bonded=bonded, sliding_base=sliding_base, edge_radius=edge_radius,
                         prony=prony, ramp=ramp, hold=hold, error_estimate=error_estimate, order=order,
                         rd=rd, nodules=nodules, nodule_law=nodule_law))
-    if (benchmark or "").lower() != "r2":
-        with _quiet(not verbose):
-            curve = _native.simulate_arrays(args)
-        return Curve(**curve)
     with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
         out = os.path.join(tmp, "curve.csv")
         with _quiet(not verbose):
             _run_cli(["simulate", *args, "--csv", out])
         return Curve(**_read_curve(out))
+
+
+def _text(value: Any) -> str | None:
+    """An option that is a number or a name (``bulk=1000.0`` or ``"exact"``)
+    as palpate reads it."""
+    if value is None:
+        return None
+    return repr(value) if isinstance(value, float) else str(value)
 
 
 def _read_curve(path: str) -> dict:
@@ -455,23 +478,17 @@ def diagnose(
     test, or a force record with ``benchmark="C1"`` / ``"N1"``. ``base``:
     the base law; ``effects``: the candidate effects (all by default);
     ``alpha`` and ``folds`` as ``palpate diagnose --help``. ``verbose``:
-    print the report.
+    print the report. Records given as float64 arrays go to palpate in
+    memory.
 
     Returns a :class:`Diagnosis`: ``verdict``, ``ranking`` and ``report``
     (the GAP.md contract as a dict).
     """
-    with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
-        out = os.path.join(tmp, "gap.json")
-        data_args = _data_options(data, benchmark, tmp)
-        if len(data_args) != 2:
-            raise PalpateError("diagnose: give one record (a mapping with one test, or one benchmark record)")
-        args = ["diagnose", *data_args, "--base", base, "--json", out]
-        if effects:
-            args += ["--effects", ",".join(effects)]
-        args += _flags(dict(benchmark=benchmark, alpha=alpha, folds=folds))
-        with _quiet(not verbose):
-            _run_cli(args)
-        report = json.loads(Path(out).read_text())
+    data_args, records = _data_in_memory(data, benchmark)
+    if len(data_args) != 2:
+        raise PalpateError("diagnose: give one record (a mapping with one test, or one benchmark record)")
+    report = _native.diagnose(data_args[1], records, benchmark=benchmark, base=base, effects=list(effects or []),
+                              alpha=alpha, folds=folds, verbose=verbose)
     return Diagnosis(report.get("verdict"), report.get("ranking") or [], report)
 
 

@@ -1,14 +1,16 @@
 //! `palpate calibrate`: fit a hyperelastic law to homogeneous-test data or a
 //! C1 force record, print a table, optionally write JSON and an SVG plot.
 
-use crate::model::calibration::{calibrate, parse_method, Calibration, Request};
-use crate::model::{ExperimentSpec, ModelSpec, Viscous};
-use crate::records::arrays::{record_for, ArrayRecord};
-use crate::records::{ReadOptions, TestData, TestKind};
+use crate::model::calibration::Calibration;
+use crate::model::ExperimentSpec;
+use crate::records::arrays::ArrayRecord;
+pub use crate::records::data_option::{
+    read_data, read_data_opts, read_data_with, read_force_records, split_data, split_data_with,
+    split_pair,
+};
+use crate::records::TestData;
 use crate::report::{calibration_table, fit_plot};
 use crate::run::output::{write_atomic, write_json};
-use anyhow::Context;
-use palpate_inverse::ResidualKind;
 use palpate_material::Law;
 use std::path::Path;
 use std::path::PathBuf;
@@ -96,7 +98,8 @@ pub struct Args {
     #[arg(long, default_value = "absolute")]
     pub residual: String,
     /// Estimator: lm (Levenberg-Marquardt, default), bfgs or lbfgs (argmin).
-    #[arg(long, default_value = "lm")]
+    /// `--method` is the same option.
+    #[arg(long, visible_alias = "method", default_value = "lm")]
     pub estimator: String,
     /// Hold a parameter fixed, e.g. --fix C01=0 (MPa or dimensionless). Repeatable.
     #[arg(long = "fix", value_name = "NAME=VALUE")]
@@ -150,141 +153,6 @@ pub struct Args {
     /// --benchmark Q1: profile-likelihood intervals of the polished parameters.
     #[arg(long)]
     pub profile: bool,
-}
-
-/// Splits `NAME=VALUE` (or `NAME=PATH`).
-pub fn split_pair<'a>(s: &'a str, what: &str) -> anyhow::Result<(&'a str, &'a str)> {
-    s.split_once('=')
-        .filter(|(a, b)| !a.is_empty() && !b.is_empty())
-        .ok_or_else(|| anyhow::anyhow!("`{s}`: expected {what}"))
-}
-
-/// Splits `TEST=FILE` or `TEST[key=value,...]=FILE` into the test, its
-/// reading options and the file.
-pub fn split_data(d: &str) -> anyhow::Result<(&str, ReadOptions, &str)> {
-    split_data_with(d, &ReadOptions::default())
-}
-
-/// [`split_data`] starting from `defaults` (the options of `--column`,
-/// `--compression`, `--skip-rows`), which the options in brackets override.
-pub fn split_data_with<'a>(
-    d: &'a str,
-    defaults: &ReadOptions,
-) -> anyhow::Result<(&'a str, ReadOptions, &'a str)> {
-    let mut options = defaults.clone();
-    let mut chosen = Vec::new();
-    if let Some(open) = d.find('[').filter(|&i| !d[..i].contains('=')) {
-        let close = d[open..]
-            .find(']')
-            .map(|c| open + c)
-            .ok_or_else(|| anyhow::anyhow!("--data {d}: `[` without `]`"))?;
-        let path = d[close + 1..]
-            .strip_prefix('=')
-            .filter(|p| !p.is_empty())
-            .ok_or_else(|| anyhow::anyhow!("--data {d}: expected `=FILE` after `]`"))?;
-        for kv in d[open + 1..close]
-            .split(',')
-            .filter(|s| !s.trim().is_empty())
-        {
-            let (k, v) = split_pair(kv, "key=value inside [...], e.g. weight=0.5")
-                .with_context(|| format!("--data {d}"))?;
-            // A column chosen here replaces the one --column chose.
-            if let Some(role) = crate::records::Role::parse(k) {
-                if !chosen.contains(&role) {
-                    options.columns.retain(|(r, _)| *r != role);
-                    chosen.push(role);
-                }
-            }
-            options.set(k, v).with_context(|| format!("--data {d}"))?;
-        }
-        return Ok((&d[..open], options, path));
-    }
-    let (test, path) = split_pair(
-        d,
-        "TEST=FILE, e.g. uniaxial=data.csv (or use --benchmark C1 --data FILE)",
-    )
-    .map_err(|e| anyhow::anyhow!("--data {e}"))?;
-    Ok((test, options, path))
-}
-
-/// Reads the `--data` options.
-pub fn read_data(data: &[String], benchmark: Option<&str>) -> anyhow::Result<Vec<TestData>> {
-    read_data_with(data, benchmark, &[])
-}
-
-/// Reads the `--data` options, a file part `<array:K>` taking the columns of
-/// `arrays[K]` instead of a file ([`crate::records::arrays`]).
-pub fn read_data_with(
-    data: &[String],
-    benchmark: Option<&str>,
-    arrays: &[ArrayRecord],
-) -> anyhow::Result<Vec<TestData>> {
-    read_data_opts(data, benchmark, arrays, &ReadOptions::default())
-}
-
-/// [`read_data_with`] with the reading options every file starts from
-/// ([`crate::cli::reading::ReadingArgs`]).
-pub fn read_data_opts(
-    data: &[String],
-    benchmark: Option<&str>,
-    arrays: &[ArrayRecord],
-    defaults: &ReadOptions,
-) -> anyhow::Result<Vec<TestData>> {
-    let read = |name: &str, kind: TestKind, path: &str, options: ReadOptions| match record_for(
-        path, arrays,
-    )
-    .with_context(|| format!("--data {path}"))?
-    {
-        Some(r) => TestData::from_table(name, kind, r.table(&format!("{name} arrays"))?, options),
-        None => TestData::read_with(name, kind, std::path::Path::new(path), options),
-    };
-    let mut out = Vec::new();
-    match benchmark {
-        Some(b) if b.eq_ignore_ascii_case("c1") => {
-            for d in data {
-                let path = d
-                    .strip_prefix("C1=")
-                    .or_else(|| d.strip_prefix("c1="))
-                    .unwrap_or(d);
-                if let Some((test, _)) = path.split_once('=') {
-                    if !std::path::Path::new(path).exists() {
-                        anyhow::bail!(
-                            "--data {d}: with --benchmark C1 every record is a C1 force record; give FILE or C1=FILE, not {test}=FILE"
-                        );
-                    }
-                }
-                out.push(read("C1", TestKind::C1, path, defaults.clone())?);
-            }
-        }
-        Some(b) => anyhow::bail!(
-            "--benchmark {b}: calibrate takes C1, Q1 or a preset of the experiment descriptions (palpate experiment list)"
-        ),
-        None => {
-            for d in data {
-                let (test, options, pattern) = split_data_with(d, defaults)?;
-                let kind = TestKind::parse(test).with_context(|| format!("--data {d}"))?;
-                // A FILE with wildcards: every file it matches.
-                let files = if record_for(pattern, arrays)?.is_some() {
-                    vec![pattern.to_string()]
-                } else {
-                    crate::records::replicates::expand(pattern)
-                        .with_context(|| format!("--data {d}"))?
-                        .iter()
-                        .map(|p| p.display().to_string())
-                        .collect()
-                };
-                for path in &files {
-                    let name = if out.iter().any(|o: &TestData| o.name == test) {
-                        format!("{test}#{}", out.len() + 1)
-                    } else {
-                        test.to_string()
-                    };
-                    out.push(read(&name, kind, path, options.clone())?);
-                }
-            }
-        }
-    }
-    Ok(out)
 }
 
 /// Runs `palpate calibrate`.
@@ -356,45 +224,13 @@ fn law_of(args: &Args) -> anyhow::Result<Law> {
 
 /// The experiment of `--experiment`, or of `--benchmark N1` (a preset of
 /// the descriptions, its law replaced by `--law` when given); `None` for the
-/// other calibrations.
+/// other calibrations ([`crate::api::experiment_spec`]).
 pub fn experiment_of(args: &Args) -> anyhow::Result<Option<ExperimentSpec>> {
-    if let Some(e) = &args.experiment {
-        return ExperimentSpec::from_option(e).map(Some);
-    }
-    let Some(b) = args.benchmark.as_deref() else {
-        return Ok(None);
-    };
-    if b.eq_ignore_ascii_case("c1") || b.eq_ignore_ascii_case("q1") {
-        return Ok(None);
-    }
-    let Some(preset) = crate::model::experiment::preset(b) else {
-        anyhow::bail!(
-            "--benchmark {b}: calibrate takes C1, Q1 or a preset of the experiment descriptions ({})",
-            crate::model::experiment::preset_names().join(", ")
-        );
-    };
-    let mut spec = ExperimentSpec {
-        source: crate::model::ExperimentSource::Preset(b.to_ascii_uppercase()),
-        experiment: Box::new(preset),
-    };
-    if let Some(law) = &args.law {
-        law.parse::<Law>()
-            .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
-        let materials = &mut spec.experiment.materials;
-        anyhow::ensure!(
-            materials.len() == 1,
-            "--law {law}: preset {b} has {} materials; give the laws in an experiment file (palpate experiment show {b})",
-            materials.len()
-        );
-        for m in materials.values_mut() {
-            if m.law != *law {
-                m.law = law.clone();
-                m.params.clear();
-            }
-        }
-    }
-    spec.check()?;
-    Ok(Some(spec))
+    crate::api::experiment_spec(
+        args.experiment.as_deref(),
+        args.benchmark.as_deref(),
+        args.law.as_deref(),
+    )
 }
 
 /// The options of the staged Q1 identification that were given.
@@ -415,8 +251,30 @@ fn q1_options_given(args: &Args) -> impl Iterator<Item = &'static str> {
     .filter_map(|(given, name)| given.then_some(name))
 }
 
+/// `--fix NAME=VALUE` options as pairs; `example` completes the message
+/// of one without `=`.
+fn fixed_of(args: &Args, example: &str) -> anyhow::Result<Vec<(String, f64)>> {
+    let mut fixed: Vec<(String, f64)> = Vec::new();
+    for f in &args.fix {
+        let (name, value) = split_pair(f, &format!("NAME=VALUE, e.g. {example}"))
+            .map_err(|e| anyhow::anyhow!("--fix {e}"))?;
+        let v: f64 = value
+            .parse()
+            .ok()
+            .filter(|v: &f64| v.is_finite())
+            .ok_or_else(|| anyhow::anyhow!("--fix {f}: `{value}` is not a finite number"))?;
+        anyhow::ensure!(
+            !fixed.iter().any(|(n, _)| n == name),
+            "--fix {f}: {name} is fixed twice; give each parameter once"
+        );
+        fixed.push((name.to_string(), v));
+    }
+    Ok(fixed)
+}
+
 /// `palpate calibrate --experiment`: the description's fitted parameters
-/// from force records, its fixed ones (and `--fix`) held.
+/// from force records, its fixed ones (and `--fix`) held
+/// ([`crate::api::calibrate_experiment`]).
 fn fit_experiment(
     args: &Args,
     arrays: &[ArrayRecord],
@@ -429,105 +287,23 @@ fn fit_experiment(
         args.viscoelastic.is_none(),
         "--viscoelastic: not an option of an experiment's calibration (its description holds the model)"
     );
-    let residual: ResidualKind = args
-        .residual
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
-    let method = parse_method(&args.estimator).context("--estimator")?;
-    let space = spec
-        .experiment
-        .param_space()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
-    let mut fixed: Vec<(String, f64)> = Vec::new();
-    for f in &args.fix {
-        let (name, value) = split_pair(f, "NAME=VALUE, e.g. C10=0.002")
-            .map_err(|e| anyhow::anyhow!("--fix {e}"))?;
-        anyhow::ensure!(
-            space.names().iter().any(|n| n == name),
-            "--fix {f}: the experiment has no parameter `{name}`; its parameters: {}",
-            space.names().join(", ")
-        );
-        let v: f64 = value
-            .parse()
-            .ok()
-            .filter(|v: &f64| v.is_finite())
-            .ok_or_else(|| anyhow::anyhow!("--fix {f}: `{value}` is not a finite number"))?;
-        anyhow::ensure!(
-            !fixed.iter().any(|(n, _)| n == name),
-            "--fix {f}: {name} is fixed twice; give each parameter once"
-        );
-        fixed.push((name.to_string(), v));
-    }
-    let law: Law = spec
-        .law_text()
-        .parse()
-        .map_err(|e| anyhow::anyhow!("{}: {e}", spec.source))?;
+    let options = crate::api::ExperimentFitOptions::parse(
+        &args.residual,
+        &args.estimator,
+        fixed_of(args, "C10=0.002")?,
+    )?;
     let data = read_experiment_data(args, arrays)?;
-    // The mesh is sized for the deepest displacement of the records when
-    // the description's protocol is the record's (no segments of its own).
-    let deepest = data
-        .iter()
-        .flat_map(|d| d.loading.drive.iter())
-        .fold(0.0f64, |m, x| m.max(x.abs()));
-    let mut spec = spec;
-    spec.experiment.size_for_depth(deepest);
-    spec.check()?;
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
     crate::run::output::check_outputs(&inputs, &outputs)?;
-    let model = ModelSpec::Experiment(spec);
-    model
-        .validate()
-        .map_err(|e| anyhow::anyhow!("{}", e.expected))?;
-    calibrate(Request {
-        law,
-        model: Some(&model),
-        fitted: &data,
-        predict: &[],
-        residual,
-        method,
-        fixed,
-        observer: None,
-        viscous: None,
-    })
+    crate::api::calibrate_experiment(spec, &data, &options)
 }
 
-/// The force records of an experiment's calibration: each `--data` is
-/// `FILE`, `force=FILE` or `force[key=value,...]=FILE` (columns
-/// `displacement_mm, force_N`, optionally `time_s`; the reading options of
-/// `--column`, `--compression`, `--skip-rows` and the brackets apply), or
-/// `<array:K>` for records given as arrays.
+/// The force records of an experiment's calibration
+/// ([`read_force_records`] with the reading options of `--column`,
+/// `--compression`, `--skip-rows`).
 pub fn read_experiment_data(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Vec<TestData>> {
-    let defaults = args.reading.defaults()?;
-    let mut data = Vec::new();
-    for d in &args.data {
-        let (path, options) = if d.contains('=') && !Path::new(d).is_file() {
-            let (test, options, path) = split_data_with(d, &defaults)?;
-            anyhow::ensure!(
-                test.eq_ignore_ascii_case("force") || test.eq_ignore_ascii_case("n1"),
-                "--data {d}: an experiment is fitted to force records: FILE or force=FILE (columns displacement_mm, force_N), not {test}=FILE"
-            );
-            (path, options)
-        } else {
-            (d.as_str(), defaults.clone())
-        };
-        let name = if args.data.len() == 1 {
-            "force".to_string()
-        } else {
-            format!("force#{}", data.len() + 1)
-        };
-        let record = match record_for(path, arrays).with_context(|| format!("--data {path}"))? {
-            Some(r) => TestData::from_table(
-                &name,
-                TestKind::N1,
-                r.table(&format!("{name} arrays"))?,
-                options,
-            )?,
-            None => TestData::read_with(&name, TestKind::N1, Path::new(path), options)?,
-        };
-        data.push(record);
-    }
-    Ok(data)
+    read_force_records(&args.data, arrays, &args.reading.defaults()?)
 }
 
 /// Whether `--benchmark Q1` (the staged identification, files only).
@@ -539,13 +315,18 @@ pub fn is_q1(args: &Args) -> bool {
 
 /// The fit of `palpate calibrate` (not Q1) without its outputs: what
 /// [`run`] prints and writes, for callers that hold the data in memory
-/// (`--data TEST=<array:K>` takes `arrays[K]`, [`crate::records::arrays`]). The
-/// checks and messages are those of the command line.
+/// (`--data TEST=<array:K>` takes `arrays[K]`, [`crate::records::arrays`]):
+/// the options read, then [`crate::api::calibrate`].
 pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
     if let Some(spec) = experiment_of(args)? {
         return fit_experiment(args, arrays, spec);
     }
-    let law = law_of(args)?;
+    let law = args
+        .law
+        .as_deref()
+        .ok_or_else(|| anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)"))?;
+    law.parse::<Law>()
+        .map_err(|e| anyhow::anyhow!("--law {law}: {e}"))?;
     anyhow::ensure!(
         !is_q1(args),
         "--benchmark Q1: the staged identification reads its record from a file (palpate calibrate --benchmark Q1 --data FILE)"
@@ -553,32 +334,13 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
     if let Some(name) = q1_options_given(args).next() {
         anyhow::bail!("{name}: an option of --benchmark Q1 (the staged inverse FE identification)");
     }
-    let residual: ResidualKind = args
-        .residual
-        .parse()
-        .map_err(|e| anyhow::anyhow!("--residual: {e}"))?;
-    let estimator: crate::api::Estimator = args.estimator.parse().context("--estimator")?;
-    let mut fixed = Vec::new();
-    for f in &args.fix {
-        let (name, value) =
-            split_pair(f, "NAME=VALUE, e.g. C01=0").map_err(|e| anyhow::anyhow!("--fix {e}"))?;
-        let v: f64 = value
-            .parse()
-            .ok()
-            .filter(|v: &f64| v.is_finite())
-            .ok_or_else(|| anyhow::anyhow!("--fix {f}: `{value}` is not a finite number"))?;
-        if fixed.iter().any(|(n, _)| n == name) {
-            anyhow::bail!("--fix {f}: {name} is fixed twice; give each parameter once");
-        }
-        fixed.push((name.to_string(), v));
-    }
-    crate::run::checks::check_fixed(&law, &fixed, "--fix")?;
-    let viscous = args
-        .viscoelastic
-        .as_deref()
-        .map(Viscous::parse)
-        .transpose()
-        .map_err(|e| anyhow::anyhow!("--viscoelastic {e}"))?;
+    let options = crate::api::CalibrateOptions::parse(
+        law,
+        &args.residual,
+        &args.estimator,
+        fixed_of(args, "C01=0")?,
+        args.viscoelastic.as_deref(),
+    )?;
     let data = read_data_opts(
         &args.data,
         args.benchmark.as_deref(),
@@ -588,16 +350,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
     let inputs: Vec<&Path> = data.iter().map(|d| Path::new(&d.file)).collect();
     let outputs = crate::run::output::given(&[("--json", &args.json), ("--plot", &args.plot)]);
     crate::run::output::check_outputs(&inputs, &outputs)?;
-    crate::api::calibrate(
-        &data,
-        &crate::api::CalibrateOptions {
-            law,
-            residual,
-            estimator,
-            fixed,
-            viscous,
-        },
-    )
+    crate::api::calibrate(&data, &options)
 }
 
 /// `palpate calibrate --benchmark Q1`: the staged inverse FE identification

@@ -17,8 +17,6 @@ pub mod run;
 pub mod sample;
 pub mod sample_fe;
 pub mod simulate;
-mod simulate_estimate;
-mod simulate_experiment;
 pub mod simulate_r2;
 
 /// palpate: calibrate soft-tissue material laws from force curves, quantify

@@ -3,12 +3,14 @@
 //! ([`ReadOptions`], [`DataSpec`] in manifests) and the columns of each kind
 //! ([`columns`]); files as testing machines write them, with metadata lines,
 //! column names with units and other separators ([`machine`]); sign
-//! conventions ([`sign`]); records given as arrays ([`arrays`]). It depends
+//! conventions ([`sign`]); records given as arrays ([`arrays`]); a record
+//! given as text, `TEST[options]=FILE` ([`data_option`]). It depends
 //! on nothing else in the crate, so that models, calibration and the steps
 //! all build on it.
 
 pub mod arrays;
 pub mod columns;
+pub mod data_option;
 pub mod machine;
 pub mod published;
 pub mod replicates;

@@ -86,3 +86,27 @@ fn the_modulus_of_a_gel_disc_from_a_sphere_record() {
     let fit = calibrate(dir.path(), &format!("{GEL}{FIT_MESH}"), &rec);
     assert_recovered(&fit, &[("C10", truth)]);
 }
+
+/// `--method` is `--estimator` under another name (lm, bfgs, lbfgs).
+#[test]
+fn method_names_the_estimator() {
+    use clap::Parser;
+    use palpate_studies::cli::{Cli, Command};
+    for (option, value) in [("--method", "bfgs"), ("--estimator", "lbfgs")] {
+        let cli = Cli::try_parse_from([
+            "palpate",
+            "calibrate",
+            "--experiment",
+            "gel-disc.toml",
+            "--data",
+            "force=record.csv",
+            option,
+            value,
+        ])
+        .unwrap();
+        match cli.command {
+            Command::Calibrate(a) => assert_eq!(a.estimator, value, "{option}"),
+            other => panic!("{other:?}"),
+        }
+    }
+}

@@ -1,4 +1,4 @@
-//! The discretisation error estimate of `palpate simulate`: the model's
+//! The discretisation error estimate of a simulation ([`super::simulate`]): the model's
 //! coarser companion solved once more and Richardson extrapolation with
 //! the model's documented order of convergence
 //! (`palpate_fe::discretisation`), as one line for the user and, when the
@@ -19,7 +19,7 @@ pub(crate) struct Estimate {
 }
 
 /// Solves the model's coarser companion and extrapolates (Richardson).
-/// A coarse solve that fails is reported in the line, not as an error: the
+/// Progress bars when `show`. A coarse solve that fails is reported in the line, not as an error: the
 /// fine curve stands on its own.
 pub(crate) fn estimate(
     model: &Model,
@@ -27,8 +27,9 @@ pub(crate) fn estimate(
     loading: &Loading,
     order: Option<f64>,
     fine: &[f64],
+    show: bool,
 ) -> anyhow::Result<Estimate> {
-    let (bar, mut cb) = progress_bar(loading.len(), "coarse mesh for the error estimate: ");
+    let (bar, mut cb) = progress_bar(loading.len(), "coarse mesh for the error estimate: ", show);
     // (element-size ratio, coarse mesh, documented order, coarse result)
     let (ratio, mesh, documented, result) = match model {
         Model::N1Needle(m) => {
