@@ -473,11 +473,13 @@ fn main() -> anyhow::Result<()> {
                 page,
                 "The fit with the platen friction fitted is **not an optimum**: it ended at \
                  friction {:.4} with an RMS of {:.3} N, above the {fixed_rms:.3} N of a fit with \
-                 the friction held. Just past that point the FE run at this mesh fails (an \
-                 element at the platen's edge inverts at about 6.6 mm of compression); every \
-                 trial step there is rejected, so the fit does not abort, but it stops on the \
-                 edge of that region, and its standard errors there mean nothing. Until the \
-                 run holds there, fit C10 at a few fixed frictions (the rows above).\n",
+                 the friction held. At this mesh level the force is not monotone in the friction: \
+                 it drops as the friction passes about 0.28, where the bulging side starts to roll \
+                 onto the platen's edge, a jump that the next level does not have (no FE run \
+                 fails; docs/notes/2026-11-29-platen-friction-level1.md). Levenberg-Marquardt \
+                 stops below the jump, and its standard errors there mean nothing. At level 1, \
+                 fit C10 at a few fixed frictions (the rows above), or fit the friction at the \
+                 description's default level.\n",
                 f.friction.map_or(f64::NAN, |x| x.0),
                 f.rms
             )?;
