@@ -181,7 +181,12 @@ const VISIBLE_SD: f64 = 2.5;
 
 /// RMS of what `model` (started at `start`) leaves of the noiseless `clean`
 /// once fitted to it by least squares.
-fn left_after_fit(model: Box<dyn ForwardModel>, start: Vec<f64>, loading: &Loading, clean: &[f64]) -> f64 {
+fn left_after_fit(
+    model: Box<dyn ForwardModel>,
+    start: Vec<f64>,
+    loading: &Loading,
+    clean: &[f64],
+) -> f64 {
     use palpate_inverse::{fit, DataSet, FitOptions, Objective, ResidualKind};
     let set = DataSet::new("record", Arc::from(model), loading.clone(), clean.to_vec());
     let objective = Objective::new(vec![set], ResidualKind::Absolute, &[]).expect("objective");
@@ -189,7 +194,9 @@ fn left_after_fit(model: Box<dyn ForwardModel>, start: Vec<f64>, loading: &Loadi
         start: Some(start),
         ..FitOptions::default()
     };
-    fit(&objective, &options).map(|r| r.rms).unwrap_or(f64::INFINITY)
+    fit(&objective, &options)
+        .map(|r| r.rms)
+        .unwrap_or(f64::INFINITY)
 }
 
 /// The C1 pair records: every pair of the five effects, two variants each.
@@ -241,12 +248,7 @@ fn c1_records() -> Vec<Record> {
                         .names()
                         .iter()
                         .zip(&truth)
-                        .map(|(n, t)| {
-                            names
-                                .iter()
-                                .position(|m| m == n)
-                                .map_or(*t, |i| theta[i])
-                        })
+                        .map(|(n, t)| names.iter().position(|m| m == n).map_or(*t, |i| theta[i]))
                         .collect();
                     visible[j] = left_after_fit(alone, start, &loading, &clean) / sd;
                 }
@@ -450,7 +452,10 @@ fn main() {
     let dir = palpate_tools::repo("studies/data/gap-dev2");
     std::fs::create_dir_all(&dir).expect("create studies/data/gap-dev2");
     // records of an earlier suite (a pair no longer written) go
-    for entry in std::fs::read_dir(&dir).expect("read studies/data/gap-dev2").flatten() {
+    for entry in std::fs::read_dir(&dir)
+        .expect("read studies/data/gap-dev2")
+        .flatten()
+    {
         let path = entry.path();
         if path.extension().is_some_and(|e| e == "csv") {
             std::fs::remove_file(&path).expect("remove an old record");
