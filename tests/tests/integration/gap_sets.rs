@@ -3,8 +3,9 @@
 //! `tools/src/bin/make_gap_two.rs`):
 //!
 //! * C1 compression and homogeneous uniaxial records with two planted
-//!   effects, each of which alone leaves the misfit well above the noise:
-//!   the explanation is the planted pair on at least 90 % of them;
+//!   effects, each of which leaves the misfit well above the noise beside
+//!   the other (`visible_sd` in the truth): the explanation is the planted
+//!   pair on at least 90 % of them;
 //! * twenty noise-only records: verdict `none`, an empty explanation, a
 //!   remainder consistent with the noise;
 //! * one-effect records (`studies/data/gap-dev/c1`): a set of one, the
@@ -84,9 +85,14 @@ fn found(r: &GapReport) -> BTreeSet<Effect> {
 /// on at least 90 %, every planted effect alone leaving the misfit well
 /// above the noise, shares and remainders consistent.
 fn pairs(prefix: &str, least: usize) {
-    let t = truth();
     let cases = names(prefix);
     assert!(cases.len() >= least, "{prefix}: {} records", cases.len());
+    pairs_in(&cases);
+}
+
+/// [`pairs`] on the records `cases`.
+fn pairs_in(cases: &[String]) {
+    let t = truth();
     let reports: Vec<(String, GapReport)> = cases.par_iter().map(|n| (n.clone(), run(n))).collect();
     let mut right = 0;
     let mut wrong = Vec::new();
@@ -168,10 +174,23 @@ fn pairs(prefix: &str, least: usize) {
     );
 }
 
+/// One record of each kind of C1 pair (relaxation beside an offset, a
+/// compressible specimen or a compliant tool; an offset beside a stiffening
+/// law): the fast part of the suite below.
 #[test]
-#[ignore = "20 diagnoses, about 20 s of CPU (bench_gap_sets), and the records do not yet all plant a visible pair: with compressibility beside an offset or a compliance, or a compliance beside a stiffening law, the partner alone leaves 1.0-1.1 x noise (13 of 20 right): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
+#[ignore = "four diagnoses, about 3 min of CPU under load; c1-08 fails the check that each planted effect alone leaves over 2 x noise (material_form alone 1.67 x: the family of laws absorbs the offset the generator measured against reduced polynomial 2 only): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
+fn c1_pairs_of_each_kind_get_the_pair() {
+    let cases: Vec<String> = ["c1-00", "c1-05", "c1-07", "c1-08"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    pairs_in(&cases);
+}
+
+#[test]
+#[ignore = "14 diagnoses, over 20 s of CPU in the dev profile (bench_gap_sets prints each one's cost): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn c1_records_with_two_planted_effects_get_the_pair() {
-    pairs("c1-", 20);
+    pairs("c1-", 14);
 }
 
 #[test]

@@ -11,10 +11,16 @@
 //!   tension-compression asymmetry (records that cross stretch 1);
 //! * `null-*`: twenty records of the base models with noise only.
 //!
-//! Each effect is planted strong enough that alone it leaves a misfit well
-//! above the noise (the test checks this on the diagnosis: the first
-//! member alone leaves the gap partly explained). `expected` is the set a
-//! correct diagnosis answers (`[]` for the nulls).
+//! Each effect is planted strong enough that, with its partner fitted, it
+//! leaves a misfit well above the noise: for the C1 pairs this is measured
+//! on the noiseless record (the model with the partner alone, fitted by
+//! least squares; `visible_sd` in the truth, in noise SDs), and an effect
+//! below 2.5 SD is planted twice as strong (up to three times). A pair
+//! whose effects still hide behind one another (in C1, a stiffening law
+//! beside compressibility or a compliant tool: their sensitivities nearly
+//! coincide) is not a two-effect record and is not written; its name is
+//! skipped, so the others keep theirs. `expected` is the set a correct
+//! diagnosis answers (the planted pair; `[]` for the nulls).
 //!
 //! `cargo run -p palpate-tools --bin make_gap_two` (seconds). The records
 //! are committed; rerun only to change them.
@@ -114,15 +120,92 @@ fn compressible_nh() -> Box<dyn ForwardModel> {
     Box::new(Compressible::new(Law::NeoHookean))
 }
 
-/// The C1 pair records: every pair of the five effects, two variants each.
-fn c1_records() -> Vec<Record> {
-    // Parameters of each effect (variant 0, variant 1).
+/// The C1 model with `effects` planted (names of GAP.md), variant `v`, each
+/// effect's strength multiplied by its entry of `scale` (in the order of
+/// [`C1_EFFECTS`]): the model and its parameters.
+fn c1_model(effects: &[&str], v: usize, scale: &[f64; 5]) -> (Box<dyn ForwardModel>, Vec<f64>) {
     let c10 = [1.2e-3, 1.0e-3];
     let prony = [(0.3, 1.5, 0.15, 12.0), (0.25, 0.8, 0.2, 8.0)];
     let d0 = [0.15, 0.1];
     let c20 = [2.0e-3, 1.5e-3];
     let d1 = [600.0, 450.0];
     let comp = [0.15, 0.2];
+    let has = |e: &str| effects.contains(&e);
+    let (g1, tau1, g2, tau2) = prony[v];
+    // relaxation weights scaled together, their sum held below 0.8
+    let gs = scale[0].min(0.8 / (g1 + g2));
+    // The elastic core: the law and compressibility.
+    let (c20v, d1v) = (c20[v] * scale[2], d1[v] * scale[3]);
+    let (core, mut theta): (Box<dyn ForwardModel>, Vec<f64>) =
+        match (has("material_form"), has("compressibility")) {
+            (true, true) => (
+                Box::new(Compressible::new(Law::ReducedPolynomial(2))),
+                vec![c10[v], c20v, d1v],
+            ),
+            (true, false) => (c1_rp2(), vec![c10[v], c20v]),
+            (false, true) => (compressible_nh(), vec![c10[v], d1v]),
+            (false, false) => (nh_c1(), vec![c10[v]]),
+        };
+    let mut model = core;
+    if has("zero_offset") {
+        model = Box::new(ZeroOffset::new(model));
+        theta.push((d0[v] * scale[1]).min(0.6));
+    }
+    if has("viscoelasticity") {
+        model = Box::new(Viscoelastic::new(model, 2));
+        theta.extend([gs * g1, tau1, gs * g2, tau2]);
+    }
+    if has("tool_compliance") {
+        model = Box::new(ToolCompliance::new(model));
+        theta.push((comp[v] * scale[4]).min(0.8));
+    }
+    (model, theta)
+}
+
+/// The effects of the C1 pairs, in the order of the strength scales.
+const C1_EFFECTS: [&str; 5] = [
+    "viscoelasticity",
+    "zero_offset",
+    "material_form",
+    "compressibility",
+    "tool_compliance",
+];
+
+/// Relative noise of the pair records (of the peak force).
+const PAIR_NOISE: f64 = 0.005;
+
+/// An effect is planted visibly beside its partner when the noiseless
+/// record, fitted by the model with the partner alone, leaves an RMS of at
+/// least this many noise SDs.
+const VISIBLE_SD: f64 = 2.5;
+
+/// RMS of what `model` (started at `start`) leaves of the noiseless `clean`
+/// once fitted to it by least squares.
+fn left_after_fit(
+    model: Box<dyn ForwardModel>,
+    start: Vec<f64>,
+    loading: &Loading,
+    clean: &[f64],
+) -> f64 {
+    use palpate_inverse::{fit, DataSet, FitOptions, Objective, ResidualKind};
+    let set = DataSet::new("record", Arc::from(model), loading.clone(), clean.to_vec());
+    let objective = Objective::new(vec![set], ResidualKind::Absolute, &[]).expect("objective");
+    let options = FitOptions {
+        start: Some(start),
+        ..FitOptions::default()
+    };
+    fit(&objective, &options)
+        .map(|r| r.rms)
+        .unwrap_or(f64::INFINITY)
+}
+
+/// The C1 pair records: every pair of the five effects, two variants each.
+/// Each effect's visible size beside its partner is measured on the
+/// noiseless record (the model with the partner alone fitted to it, from
+/// the partner's planted values); an effect below [`VISIBLE_SD`] is planted
+/// twice as strong, up to three times; `expected` holds the effects that
+/// end up visible.
+fn c1_records() -> Vec<Record> {
     let pairs: [(&str, &str); 10] = [
         ("viscoelasticity", "zero_offset"),
         ("viscoelasticity", "material_form"),
@@ -138,57 +221,84 @@ fn c1_records() -> Vec<Record> {
     let mut out = Vec::new();
     for (k, &(a, b)) in pairs.iter().enumerate() {
         for v in 0..2 {
-            let has = |e: &str| a == e || b == e;
-            let (g1, tau1, g2, tau2) = prony[v];
-            // The elastic core: the law and compressibility.
-            let (core, mut theta): (Box<dyn ForwardModel>, Vec<f64>) =
-                match (has("material_form"), has("compressibility")) {
-                    (true, true) => (
-                        Box::new(Compressible::new(Law::ReducedPolynomial(2))),
-                        vec![c10[v], c20[v], d1[v]],
-                    ),
-                    (true, false) => (c1_rp2(), vec![c10[v], c20[v]]),
-                    (false, true) => (compressible_nh(), vec![c10[v], d1[v]]),
-                    (false, false) => (nh_c1(), vec![c10[v]]),
-                };
-            let mut model = core;
-            if has("zero_offset") {
-                model = Box::new(ZeroOffset::new(model));
-                theta.push(d0[v]);
-            }
-            if has("viscoelasticity") {
-                model = Box::new(Viscoelastic::new(model, 2));
-                theta.extend([g1, tau1, g2, tau2]);
-            }
-            if has("tool_compliance") {
-                model = Box::new(ToolCompliance::new(model));
-                theta.push(comp[v]);
-            }
             let (rate, depth, hold) = if v == 0 {
                 (0.2, 2.0, 20.0)
             } else {
                 (0.25, 2.2, 25.0)
             };
             let loading = c1_history(rate, depth, hold, 0.1);
-            let clean = model.predict(&theta, &loading).expect("C1 pair record");
+            let index = |e: &str| C1_EFFECTS.iter().position(|x| *x == e).expect("effect");
+            let mut scale = [1.0; 5];
+            let mut visible = [0.0, 0.0];
+            let (mut model, mut theta, mut clean);
+            let mut round = 0;
+            loop {
+                (model, theta) = c1_model(&[a, b], v, &scale);
+                clean = model.predict(&theta, &loading).expect("C1 pair record");
+                let peak = clean.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+                let sd = PAIR_NOISE * peak;
+                // visible size of `hidden`: what the partner alone leaves
+                for (j, partner) in [b, a].into_iter().enumerate() {
+                    let (alone, truth) = c1_model(&[partner], v, &scale);
+                    // the partner's planted values as the start (the law's
+                    // C10 and the partner's own)
+                    let names = model.space().names();
+                    let start: Vec<f64> = alone
+                        .space()
+                        .names()
+                        .iter()
+                        .zip(&truth)
+                        .map(|(n, t)| names.iter().position(|m| m == n).map_or(*t, |i| theta[i]))
+                        .collect();
+                    visible[j] = left_after_fit(alone, start, &loading, &clean) / sd;
+                }
+                if round == 3 || visible.iter().all(|s| *s >= VISIBLE_SD) {
+                    break;
+                }
+                for (j, hidden) in [a, b].into_iter().enumerate() {
+                    if visible[j] < VISIBLE_SD {
+                        scale[index(hidden)] *= 2.0;
+                    }
+                }
+                round += 1;
+            }
+            if visible.iter().any(|s| *s < VISIBLE_SD) {
+                eprintln!(
+                    "c1-{:02} not written: {a} visible {:.2} SD, {b} {:.2} SD beside each other at scales {scale:?}",
+                    2 * k + v,
+                    visible[0],
+                    visible[1]
+                );
+                continue;
+            }
+            let expected = [format!("\"{a}\""), format!("\"{b}\"")];
             let names: Vec<String> = model.space().names();
             let params: Vec<String> = names
                 .iter()
                 .zip(&theta)
                 .map(|(n, v)| format!("\"{n}\": {v}"))
                 .collect();
+            eprintln!(
+                "c1-{:02}: {a} visible {:.2} SD, {b} {:.2} SD (scales {scale:?})",
+                2 * k + v,
+                visible[0],
+                visible[1]
+            );
             out.push(Record {
                 name: format!("c1-{:02}", 2 * k + v),
                 loading,
                 clean,
-                relative_noise: 0.005,
+                relative_noise: PAIR_NOISE,
                 seed: 1000 + (2 * k + v) as u64,
                 truth: format!(
                     "\"base\": \"C1\", \"law\": \"neo-hookean\", \"model\": \"{}\", \"protocol\": \"ramp_hold_unload\", \
                      \"rate_mm_s\": {rate}, \"depth_mm\": {depth}, \"hold_s\": {hold}, \"params\": {{{}}}, \
-                     \"expected\": [\"{a}\", \"{b}\"]",
+                     \"visible_sd\": {{\"{a}\": {:.3}, \"{b}\": {:.3}}}, \"expected\": [{}]",
                     model.name(),
-                    params.join(", ")
+                    params.join(", "),
+                    visible[0],
+                    visible[1],
+                    expected.join(", ")
                 ),
             });
         }
@@ -341,6 +451,16 @@ fn null_records() -> Vec<Record> {
 fn main() {
     let dir = palpate_tools::repo("studies/data/gap-dev2");
     std::fs::create_dir_all(&dir).expect("create studies/data/gap-dev2");
+    // records of an earlier suite (a pair no longer written) go
+    for entry in std::fs::read_dir(&dir)
+        .expect("read studies/data/gap-dev2")
+        .flatten()
+    {
+        let path = entry.path();
+        if path.extension().is_some_and(|e| e == "csv") {
+            std::fs::remove_file(&path).expect("remove an old record");
+        }
+    }
     let mut records = c1_records();
     records.extend(uniaxial_records());
     records.extend(null_records());

@@ -4,6 +4,7 @@
 
 use super::crossval::{cross_validate_by, Folds};
 use super::fit::{fit_from_starts, fit_with_budget, Fitted};
+use super::plausible::degenerate;
 use super::report::{PracticalSize, RankedEffect};
 use super::residual::{ar1_deviance, residuals, rms, sse};
 use super::score::{projected_columns, score_test, sensitivities_at};
@@ -344,7 +345,10 @@ pub(crate) fn assess(
     let delta_bic = dev_rich - dev_base + lr_dof as f64 * nf.ln();
     let lr_level = ctx.alpha / ctx.candidates.max(1) as f64;
     let gain_threshold = chi2_isf(ctx.alpha, 1.0);
-    let earns = lr_p < lr_level && heldout_gain > gain_threshold;
+    // A degenerate member (Prony terms at total relaxation, or a time
+    // constant the record cannot resolve) is reported and earns nothing.
+    let degenerate_why = degenerate(&specs, &full.theta, p, ctx.loading);
+    let earns = lr_p < lr_level && heldout_gain > gain_threshold && degenerate_why.is_none();
 
     let names = rich.space().names();
     let own: Vec<String> = names[p..].to_vec();
@@ -420,6 +424,10 @@ pub(crate) fn assess(
         after.runs_p,
         ident.reason
     );
+    let evidence = match &degenerate_why {
+        Some(why) => format!("{evidence}; degenerate fit, not credited: {why}"),
+        None => evidence,
+    };
     let ranked = RankedEffect {
         effect,
         params,

@@ -17,6 +17,7 @@
 //! threshold for a while) and always holding d0 = 0, the base model.
 
 use palpate_core::{Drive, Loading, ParamRole, ParamSpec};
+use std::collections::BTreeMap;
 
 /// Share of the peak |response| below which a sample counts as unloaded.
 const UNLOADED_SHARE: f64 = 0.02;
@@ -76,6 +77,83 @@ pub(crate) fn bound_offsets(specs: &mut [ParamSpec], range: Option<(f64, f64)>) 
     moved
 }
 
+/// Relaxation weights summing to at least this leave no equilibrium
+/// stiffness: total relaxation, the simplex's bound.
+const TOTAL_RELAXATION: f64 = 1.0 - 1e-4;
+/// A Prony term whose time constant exceeds this many record durations
+/// relaxes nothing within the record (a copy of the modulus).
+const SLOWEST_RESOLVED: f64 = 100.0;
+/// A Prony term whose time constant is below this share of the shortest
+/// sample interval relaxes between two samples (a copy of the modulus).
+const FASTEST_RESOLVED: f64 = 0.1;
+/// A relaxation weight below this does nothing the record can show.
+const NEGLIGIBLE_WEIGHT: f64 = 1e-3;
+
+/// Why the fitted own parameters of an effect (`theta[p..]`, `specs[p..]`)
+/// are a degenerate member the record cannot support, or `None`: Prony
+/// terms with total relaxation (weights summing to 1, their bound), or a
+/// weighted term whose time constant the record cannot resolve (over
+/// [`SLOWEST_RESOLVED`] record durations, or under [`FASTEST_RESOLVED`] of
+/// the shortest sample interval). Such a fit buys its misfit reduction by
+/// trading the modulus for a relaxation that never shows in the record; it
+/// is reported and earns nothing.
+pub(crate) fn degenerate(
+    specs: &[ParamSpec],
+    theta: &[f64],
+    p: usize,
+    loading: &Loading,
+) -> Option<String> {
+    let mut weights: BTreeMap<usize, (String, f64)> = BTreeMap::new();
+    let mut taus: BTreeMap<usize, (String, f64)> = BTreeMap::new();
+    for (s, &v) in specs.iter().zip(theta).skip(p) {
+        match s.role {
+            ParamRole::RelaxationWeight { term } => {
+                weights.insert(term, (s.name.clone(), v));
+            }
+            ParamRole::TimeConstant { term } => {
+                taus.insert(term, (s.name.clone(), v));
+            }
+            _ => {}
+        }
+    }
+    if weights.is_empty() {
+        return None;
+    }
+    let mut why = Vec::new();
+    let total: f64 = weights.values().map(|(_, g)| g).sum();
+    if total >= TOTAL_RELAXATION {
+        why.push(format!(
+            "relaxation weights sum to {total:.4} (total relaxation, no equilibrium stiffness: their bound)"
+        ));
+    }
+    if let Some(t) = loading.time.as_ref().filter(|t| t.len() > 1) {
+        let duration = t[t.len() - 1] - t[0];
+        let dt_min = t
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|d| *d > 0.0)
+            .fold(f64::INFINITY, f64::min);
+        for (term, (g_name, g)) in &weights {
+            let Some((t_name, tau)) = taus.get(term) else {
+                continue;
+            };
+            if *g < NEGLIGIBLE_WEIGHT {
+                continue;
+            }
+            if duration > 0.0 && *tau > SLOWEST_RESOLVED * duration {
+                why.push(format!(
+                    "{g_name} = {g:.4} with {t_name} = {tau:.3e} s, over {SLOWEST_RESOLVED} record durations ({duration:.3e} s): it relaxes nothing within the record"
+                ));
+            } else if dt_min.is_finite() && *tau < FASTEST_RESOLVED * dt_min {
+                why.push(format!(
+                    "{g_name} = {g:.4} with {t_name} = {tau:.3e} s, under {FASTEST_RESOLVED} of the shortest sample interval ({dt_min:.3e} s): it relaxes between samples"
+                ));
+            }
+        }
+    }
+    (!why.is_empty()).then(|| why.join("; "))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -101,5 +179,45 @@ mod tests {
         // a record that is loaded everywhere permits anything
         let loaded = vec![1.0; 301];
         assert!(offset_range(&loading, &loaded, 1e-3).is_none());
+    }
+
+    fn prony_specs() -> Vec<ParamSpec> {
+        vec![
+            ParamSpec::new("C10", "MPa", 0.0, f64::INFINITY, 1.0).with_role(ParamRole::Modulus),
+            ParamSpec::new("g1", "1", 0.0, 1.0, 0.1)
+                .with_role(ParamRole::RelaxationWeight { term: 1 }),
+            ParamSpec::new("tau1_s", "s", 0.0, f64::INFINITY, 1.0)
+                .with_role(ParamRole::TimeConstant { term: 1 }),
+        ]
+    }
+
+    #[test]
+    fn a_prony_member_on_its_bound_or_unresolved_is_degenerate() {
+        // 100 s sampled every 0.1 s
+        let t: Vec<f64> = (0..=1000).map(|i| 0.1 * i as f64).collect();
+        let loading = Loading::timed(Drive::DisplacementMm, t.clone(), t);
+        let specs = prony_specs();
+        // a relaxation the record resolves
+        assert_eq!(degenerate(&specs, &[1.0, 0.3, 5.0], 1, &loading), None);
+        // the phantom's member: total relaxation with tau = 8.9e47 s
+        let why = degenerate(&specs, &[1.0, 1.0, 8.9e47], 1, &loading).unwrap();
+        assert!(
+            why.contains("total relaxation") && why.contains("relaxes nothing"),
+            "{why}"
+        );
+        // each condition alone
+        assert!(degenerate(&specs, &[1.0, 0.3, 2e4], 1, &loading)
+            .unwrap()
+            .contains("tau1_s"));
+        assert!(degenerate(&specs, &[1.0, 0.3, 1e-3], 1, &loading)
+            .unwrap()
+            .contains("between samples"));
+        assert!(degenerate(&specs, &[1.0, 1.0, 5.0], 1, &loading)
+            .unwrap()
+            .contains("total relaxation"));
+        // a negligible weight's time constant is not judged
+        assert_eq!(degenerate(&specs, &[1.0, 1e-5, 1e60], 1, &loading), None);
+        // the base's parameters are not the effect's
+        assert_eq!(degenerate(&specs, &[1.0, 1.0, 8.9e47], 3, &loading), None);
     }
 }
