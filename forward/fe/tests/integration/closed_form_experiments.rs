@@ -175,12 +175,12 @@ fn punch_forces(radius: f64, h: f64, edge_radius: f64, level: usize, depths: &[f
 /// rounding, short of the rim (docs/validation/sneddon_rounded_punch.py
 /// prints these).
 fn rounded_edge_factor(d: f64) -> f64 {
-    match d {
-        d if d == 0.01 => 0.991340,
-        d if d == 0.02 => 0.992105,
-        d if d == 0.04 => 0.993261,
-        _ => panic!("no factor for d = {d}"),
-    }
+    const FACTORS: [(f64, f64); 3] = [(0.01, 0.991340), (0.02, 0.992105), (0.04, 0.993261)];
+    FACTORS
+        .iter()
+        .find(|(depth, _)| (depth - d).abs() < 1e-12)
+        .map(|&(_, f)| f)
+        .unwrap_or_else(|| panic!("no factor for d = {d}"))
 }
 
 /// A bonded incompressible layer of thickness h under a punch whose contact
