@@ -306,8 +306,9 @@ fn a_series_spring_and_relaxation_on_a_single_ramp_are_reported_as_confounded() 
     };
     assert!(
         r.confounded.iter().any(|e| e == other),
-        "confounded: {:?}",
-        r.confounded
+        "confounded: {:?}\n{}",
+        r.confounded,
+        r.explanation
     );
     let best = entry(&r, r.verdict.as_str());
     assert!(!best.identifiable && best.confounded_with.iter().any(|e| e == other));
