@@ -214,12 +214,7 @@ fn replicates_declared(args: &Args) -> bool {
 
 /// The parsed `--law`.
 fn law_of(args: &Args) -> anyhow::Result<Law> {
-    let text = args
-        .law
-        .as_deref()
-        .ok_or_else(|| anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)"))?;
-    text.parse()
-        .map_err(|e| anyhow::anyhow!("--law {text}: {e}"))
+    super::parse_law(args.law.as_deref())
 }
 
 /// The experiment of `--experiment`, or of `--benchmark N1` (a preset of

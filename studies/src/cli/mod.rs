@@ -98,6 +98,15 @@ pub fn join_negative_values<I: IntoIterator<Item = std::ffi::OsString>>(
     out
 }
 
+/// The `--law` of `calibrate` and `sample`, parsed; missing or unknown is
+/// an error naming the option.
+fn parse_law(text: Option<&str>) -> anyhow::Result<palpate_material::Law> {
+    let text = text
+        .ok_or_else(|| anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)"))?;
+    text.parse()
+        .map_err(|e| anyhow::anyhow!("--law {text}: {e}"))
+}
+
 /// Runs the parsed command line.
 pub fn dispatch(cli: Cli) -> anyhow::Result<()> {
     match cli.command {

@@ -238,12 +238,7 @@ fn check_sizes(args: &Args, sampler: &Sampler, dim: usize) -> anyhow::Result<()>
 
 /// The parsed `--law`.
 fn law_of(args: &Args) -> anyhow::Result<Law> {
-    let text = args
-        .law
-        .as_deref()
-        .ok_or_else(|| anyhow::anyhow!("--law: give the material law (e.g. --law neo-hookean)"))?;
-    text.parse()
-        .map_err(|e| anyhow::anyhow!("--law {text}: {e}"))
+    super::parse_law(args.law.as_deref())
 }
 
 /// The cap of the draws per chain: --max-draws, else 16 x the first run's.
