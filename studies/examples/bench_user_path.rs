@@ -16,6 +16,11 @@
 //! cargo run --release -p palpate-studies --example bench_user_path -- [--recorded-ccx] [--no-n3] [--page docs/validation/fe.md] [--palpate PATH]
 //! ```
 //!
+//! Without `--release` it times the dev-profile binary (opt-level 2,
+//! dependencies at 3) and the table says so. CPU times grow with the
+//! machine's load (CalculiX's n6 run: 164 s quiet, 438 s at load 10-16), so
+//! run it on a quiet machine; the table prints the load average.
+//!
 //! `--recorded-ccx` quotes CalculiX's run recorded in docs/validation/fe.md
 //! instead of rerunning it (~5-10 min); `--page FILE` replaces the section
 //! between `<!-- bench_user_path begin -->` and `<!-- bench_user_path end -->`
@@ -186,9 +191,20 @@ fn main() {
     std::fs::remove_dir_all(&dir).ok();
 
     let mut out = String::new();
+    let bin = palpate();
+    let profile = if bin.components().any(|c| c.as_os_str() == "debug") {
+        "the dev-profile binary (opt-level 2, dependencies 3)"
+    } else {
+        "the release binary"
+    };
+    let load = std::fs::read_to_string("/proc/loadavg")
+        .ok()
+        .and_then(|l| l.split_whitespace().next().map(str::to_string))
+        .unwrap_or_else(|| "unknown".into());
     out.push_str(&format!(
-        "Machine: {cores} cores. `palpate simulate --benchmark N1|N3 --law neo-hookean --param {C10} --csv F` \
-         with default options (error estimate on), the release binary; CPU = user + system of the child process.\n\n"
+        "Machine: {cores} cores, load average {load} at the end of the run. \
+         `palpate simulate --benchmark N1|N3 --law neo-hookean --param {C10} --csv F` \
+         with default options (error estimate on), {profile}; CPU = user + system of the child process.\n\n"
     ));
     out.push_str("| run | mesh | wall (s) | CPU (s) | F(10) N | vs converged | palpate's estimate |\n|---|---|---|---|---|---|---|\n");
     let row = |name: &str, t: &Timed, conv: f64| {
