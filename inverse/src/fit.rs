@@ -243,10 +243,10 @@ fn statistics_with(
     // Jacobian (none when the solver kept them); otherwise the
     // predictions, then finite differences.
     let exact = objective.has_exact_sensitivities();
-    let (predictions, r, jz, evaluations) = match (kept, exact) {
-        (Some((p, r, j)), _) => (p, r, j, 0),
+    let ((predictions, r, jz), evaluations) = match (kept, exact) {
+        (Some(kept), _) => (kept, 0),
         (None, true) => match residuals_and_exact_jacobian(objective, z, "final point") {
-            Ok((p, r, j)) => (p, r, j, 1),
+            Ok(e) => (e, 1),
             // the run with sensitivities failed: a plain one and finite
             // differences (as `jacobian_unbounded` falls back)
             Err(InverseError::Forward { .. }) => plain_and_differences(objective, z, fd, 1)?,
@@ -375,7 +375,7 @@ fn plain_and_differences(
     z: &[f64],
     fd: &FdOptions,
     failed: usize,
-) -> Result<(Vec<Vec<f64>>, Vec<f64>, crate::JacobianEval, usize), InverseError> {
+) -> Result<(ExactEvaluation, usize), InverseError> {
     let theta = objective.theta_from_unbounded(z);
     let mut evs = objective.evaluators();
     let predictions = objective.predict(&mut evs, &theta, "final point")?;
@@ -383,5 +383,5 @@ fn plain_and_differences(
     objective.residuals_from_predictions(&predictions, &mut r);
     let jz = finite_difference_jacobian(objective, z, Some(&r), fd)?;
     let evaluations = failed + 1 + jz.evaluations;
-    Ok((predictions, r, jz, evaluations))
+    Ok(((predictions, r, jz), evaluations))
 }
