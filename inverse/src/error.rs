@@ -78,6 +78,17 @@ pub enum InverseError {
         option: &'static str,
         reason: String,
     },
+    /// Trial steps in a row from the point `from` (the physical parameters)
+    /// failed to evaluate, the shorter ones too; `last` is the last one's
+    /// failure (which names its point and cause).
+    #[error("{solver}: {failures} trial steps in a row from theta = {from:?} failed to evaluate, however short; the last: {last}")]
+    TrialsFailed {
+        solver: &'static str,
+        from: Vec<f64>,
+        failures: usize,
+        #[source]
+        last: Box<InverseError>,
+    },
     /// The optimiser library reported an error that is not a forward failure.
     #[error("optimiser `{solver}` failed: {reason}")]
     Solver {

@@ -7,8 +7,8 @@ use crate::observer::ArgminBridge;
 use crate::run::{run, RunOutcome};
 use crate::wall_slide::{limit_ahead, wall_slide};
 use crate::{
-    covariance, jacobian_unbounded, residuals_and_exact_jacobian, sum_of_squares, BoundSide,
-    FdOptions, FitReport, InverseError, Method, Objective, ParameterEstimate, SetReport,
+    covariance, finite_difference_jacobian, residuals_and_exact_jacobian, sum_of_squares,
+    BoundSide, FdOptions, FitReport, InverseError, Method, Objective, ParameterEstimate, SetReport,
     SharedObserver,
 };
 use nalgebra::DMatrix;
@@ -239,21 +239,20 @@ fn statistics_with(
     kept: Option<ExactEvaluation>,
 ) -> Result<FitReport, InverseError> {
     let theta = objective.theta_from_unbounded(z);
-    let reused = kept.is_some();
     // With exact sensitivities one run gives the predictions and the
     // Jacobian (none when the solver kept them); otherwise the
     // predictions, then finite differences.
-    let (predictions, r, jz) = if let Some(kept) = kept {
-        kept
-    } else if objective.has_exact_sensitivities() {
-        residuals_and_exact_jacobian(objective, z, "final point")?
-    } else {
-        let mut evs = objective.evaluators();
-        let predictions = objective.predict(&mut evs, &theta, "final point")?;
-        let mut r = vec![0.0; objective.n_residuals()];
-        objective.residuals_from_predictions(&predictions, &mut r);
-        let jz = jacobian_unbounded(objective, z, Some(&r), fd)?;
-        (predictions, r, jz)
+    let exact = objective.has_exact_sensitivities();
+    let ((predictions, r, jz), evaluations) = match (kept, exact) {
+        (Some(kept), _) => (kept, 0),
+        (None, true) => match residuals_and_exact_jacobian(objective, z, "final point") {
+            Ok(e) => (e, 1),
+            // the run with sensitivities failed: a plain one and finite
+            // differences (as `jacobian_unbounded` falls back)
+            Err(InverseError::Forward { .. }) => plain_and_differences(objective, z, fd, 1)?,
+            Err(e) => return Err(e),
+        },
+        (None, false) => plain_and_differences(objective, z, fd, 0)?,
     };
     let sse = sum_of_squares(&r);
     let dxdz = objective.dx_dz(z);
@@ -356,13 +355,7 @@ fn statistics_with(
         r_squared: 1.0 - ss_res_all / ss_tot_all,
         n_residuals: m,
         iterations: 0,
-        evaluations: if reused {
-            0
-        } else if objective.has_exact_sensitivities() {
-            1
-        } else {
-            1 + jz.evaluations
-        },
+        evaluations,
         jacobians: 1,
         termination: crate::Termination::MaxIterations,
         converged: false,
@@ -373,4 +366,22 @@ fn statistics_with(
         identifiability: cov.identifiability,
         on_limit: false,
     })
+}
+
+/// The predictions and residuals at `z` from a plain run and the Jacobian
+/// by finite differences, with the evaluations they cost plus `failed`.
+fn plain_and_differences(
+    objective: &Objective,
+    z: &[f64],
+    fd: &FdOptions,
+    failed: usize,
+) -> Result<(ExactEvaluation, usize), InverseError> {
+    let theta = objective.theta_from_unbounded(z);
+    let mut evs = objective.evaluators();
+    let predictions = objective.predict(&mut evs, &theta, "final point")?;
+    let mut r = vec![0.0; objective.n_residuals()];
+    objective.residuals_from_predictions(&predictions, &mut r);
+    let jz = finite_difference_jacobian(objective, z, Some(&r), fd)?;
+    let evaluations = failed + 1 + jz.evaluations;
+    Ok(((predictions, r, jz), evaluations))
 }

@@ -44,7 +44,10 @@ pub struct JacobianEval {
 }
 
 /// d r / d z at `z` (free unbounded parameters). `r0` (the residuals at `z`)
-/// is needed for forward differences only.
+/// is needed for forward differences only. With exact sensitivities, from
+/// them, or by finite differences where the run with sensitivities fails
+/// (an FE run that converges, but whose differentiation inverts an element
+/// at a perturbed state); the failed run counts as an evaluation.
 pub fn jacobian_unbounded(
     objective: &Objective,
     z: &[f64],
@@ -52,8 +55,26 @@ pub fn jacobian_unbounded(
     options: &FdOptions,
 ) -> Result<JacobianEval, InverseError> {
     if objective.has_exact_sensitivities() {
-        return exact_jacobian(objective, z);
+        return match exact_jacobian(objective, z) {
+            Err(InverseError::Forward { .. }) => {
+                let mut j = finite_difference_jacobian(objective, z, r0, options)?;
+                j.evaluations += 1;
+                Ok(j)
+            }
+            done => done,
+        };
     }
+    finite_difference_jacobian(objective, z, r0, options)
+}
+
+/// d r / d z at `z` by finite differences of the objective, whether or not
+/// the data sets have exact sensitivities.
+pub fn finite_difference_jacobian(
+    objective: &Objective,
+    z: &[f64],
+    r0: Option<&[f64]>,
+    options: &FdOptions,
+) -> Result<JacobianEval, InverseError> {
     if !(options.relative_step > 0.0 && options.relative_step < 1.0) {
         return Err(InverseError::InvalidOption {
             option: "relative_step",

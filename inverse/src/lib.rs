@@ -63,7 +63,10 @@ pub use dataset::DataSet;
 pub use error::InverseError;
 pub use fidelity_correction::{CorrectedModel, FidelityCorrection};
 pub use fit::{fit, start_points, statistics, FitOptions, MultiStart};
-pub use jacobian::{jacobian_unbounded, residuals_and_exact_jacobian, FdOptions, JacobianEval};
+pub use jacobian::{
+    finite_difference_jacobian, jacobian_unbounded, residuals_and_exact_jacobian, FdOptions,
+    JacobianEval,
+};
 pub use lm::{LevenbergMarquardt, LmOptions, LmState};
 pub use objective::{sum_of_squares, Evaluators, Objective, ParamMap};
 pub use observer::{shared_observer, FitObserver, Progress, SharedObserver};

@@ -27,7 +27,15 @@
 //! least squares problems", alg. 3.16): on acceptance
 //! `mu <- mu * max(1/3, 1 - (2 rho - 1)^3)`, `nu <- 2`; on rejection
 //! `mu <- mu * nu`, `nu <- 2 nu`. Initial `mu = tau` (relative to `D^2`).
-//! A failed forward evaluation at a trial point is a rejected step.
+//! A failed forward evaluation at a trial point is a rejected step, and so
+//! is an accepted trial whose Jacobian fails to evaluate (the residuals
+//! converged, the run with sensitivities or a finite-difference step did
+//! not). A failure that says the point is outside what the model describes
+//! ([`ForwardError::InvalidParameter`], [`ForwardError::Unphysical`]: an
+//! admissibility limit, [`LevenbergMarquardt::blocked`]) only shortens the
+//! step; after [`MAX_FAILED_TRIALS`] other failures in a row (a solver that
+//! does not converge however short the step) the fit stops with
+//! [`InverseError::TrialsFailed`], naming the point and the last cause.
 //!
 //! Where the Jacobian comes with the residuals at a price (exact
 //! sensitivities: a run with sensitivities costs a plain run and a
@@ -52,16 +60,25 @@
 //! * zero residual, evaluation budget, iteration budget (argmin's `max_iters`).
 
 use crate::problem::EvaluationCount;
-use crate::Termination;
+use crate::{InverseError, Termination};
 use argmin::core::{
     Error, IterState, Jacobian, Operator, Problem, Solver, TerminationReason, TerminationStatus, KV,
 };
 use nalgebra::{DMatrix, DVector};
+use palpate_core::ForwardError;
 use serde::{Deserialize, Serialize};
 
 /// Gain ratio above which the next trial is expected to be accepted (and is
 /// evaluated with its Jacobian where that is cheaper together).
 const TRUSTED_GAIN: f64 = 0.25;
+
+/// Trial steps in a row whose evaluation may fail (a forward failure other
+/// than an admissibility limit) before the fit stops with an error: the
+/// damping grows with each (`mu` by `2^(k (k + 1) / 2)` after `k`), so the
+/// last trials are some `1e-10` of the first step's length, where a model
+/// that converged at the accepted point and still fails is not going to
+/// converge by shorter steps.
+pub const MAX_FAILED_TRIALS: usize = 8;
 
 /// The argmin state the solver works on: parameters `z`, gradient `J^T r`,
 /// residuals `r`, cost SSE.
@@ -106,6 +123,10 @@ pub struct LevenbergMarquardt {
     blocked: bool,
     /// The last trial was accepted with a gain ratio above [`TRUSTED_GAIN`].
     trusted: bool,
+    /// Trials in a row whose evaluation failed (admissibility limits not
+    /// counted), and how many there were in all.
+    failed_in_a_row: usize,
+    failed_trials: usize,
 }
 
 impl LevenbergMarquardt {
@@ -120,7 +141,53 @@ impl LevenbergMarquardt {
             termination: None,
             blocked: false,
             trusted: false,
+            failed_in_a_row: 0,
+            failed_trials: 0,
         }
+    }
+
+    /// Trial steps whose evaluation (residuals or, once accepted, the
+    /// Jacobian) failed in the last run; each was rejected.
+    pub fn failed_trials(&self) -> usize {
+        self.failed_trials
+    }
+
+    /// Counts a trial whose evaluation failed with `error`; the error that
+    /// stops the fit when it is the [`MAX_FAILED_TRIALS`]-th in a row that
+    /// is not an admissibility limit.
+    fn trial_failed<O: EvaluationCount>(
+        &mut self,
+        problem: Option<&O>,
+        z: &[f64],
+        error: Error,
+    ) -> Result<(), Error> {
+        self.failed_trials += 1;
+        let cause = match error.downcast::<InverseError>() {
+            Ok(e) => e,
+            Err(other) => InverseError::Solver {
+                solver: "Levenberg-Marquardt",
+                reason: other.to_string(),
+            },
+        };
+        let limit = matches!(
+            &cause,
+            InverseError::Forward { source, .. }
+                if matches!(**source, ForwardError::InvalidParameter { .. } | ForwardError::Unphysical { .. })
+        );
+        if limit {
+            return Ok(());
+        }
+        self.failed_in_a_row += 1;
+        if self.failed_in_a_row < MAX_FAILED_TRIALS {
+            return Ok(());
+        }
+        Err(InverseError::TrialsFailed {
+            solver: "Levenberg-Marquardt",
+            from: problem.map_or_else(|| z.to_vec(), |p| p.point(z)),
+            failures: self.failed_in_a_row,
+            last: Box::new(cause),
+        }
+        .into())
     }
 
     /// Why the solver stopped, when it stopped by its own criteria.
@@ -245,6 +312,8 @@ where
         self.nu = 2.0;
         self.termination = None;
         self.trusted = false;
+        self.failed_in_a_row = 0;
+        self.failed_trials = 0;
         let sse: f64 = r.iter().map(|v| v * v).sum();
         self.check_converged(&r, sse);
         let g = gradient(&self.jacobian, &r);
@@ -297,22 +366,43 @@ where
             if let Some(p) = problem.problem.as_ref() {
                 p.jacobian_with_residuals(self.trusted);
             }
-            let trial = problem.apply(&z_new).ok().and_then(|r_new| {
-                let sse_new: f64 = r_new.iter().map(|v| v * v).sum();
-                sse_new.is_finite().then_some((r_new, sse_new))
-            });
+            let trial = match problem.apply(&z_new) {
+                Ok(r_new) => {
+                    let sse_new: f64 = r_new.iter().map(|v| v * v).sum();
+                    sse_new.is_finite().then_some((r_new, sse_new))
+                }
+                Err(e) => {
+                    self.trial_failed(problem.problem.as_ref(), &z, e)?;
+                    None
+                }
+            };
             self.blocked = trial.is_none();
-            let (rho, accepted) = match trial {
+            let (mut rho, accepted) = match trial {
                 Some((r_new, sse_new)) if pred > 0.0 => {
                     ((sse - sse_new) / pred, Some((r_new, sse_new)))
                 }
                 _ => (f64::NEG_INFINITY, None),
             };
+            // kept from the trial's run, or one run with sensitivities (or
+            // finite differences where that run fails)
+            let jacobian = match accepted {
+                Some(_) if rho > 1e-4 => match problem.jacobian(&z_new) {
+                    Ok(j) => Some(j),
+                    Err(e) => {
+                        self.trial_failed(problem.problem.as_ref(), &z, e)?;
+                        self.blocked = true;
+                        rho = f64::NEG_INFINITY;
+                        None
+                    }
+                },
+                _ => None,
+            };
+            if !self.blocked {
+                self.failed_in_a_row = 0;
+            }
             self.trusted = rho > TRUSTED_GAIN;
-            if rho > 1e-4 {
-                let (r_new, sse_new) = accepted.expect("accepted step has residuals");
-                // kept from the trial's run, or one run with sensitivities
-                self.jacobian = problem.jacobian(&z_new)?;
+            if let (Some((r_new, sse_new)), Some(jacobian)) = (accepted, jacobian) {
+                self.jacobian = jacobian;
                 self.update_scale();
                 self.mu *= (1.0 / 3.0f64).max(1.0 - (2.0 * rho - 1.0).powi(3));
                 self.nu = 2.0;

@@ -19,8 +19,9 @@
 //! evaluated plain. [`LeastSquaresProblem::evaluations`] counts runs of
 //! both kinds, [`LeastSquaresProblem::runs`] each kind.
 
+use crate::jacobian::finite_difference_jacobian;
 use crate::jacobian::{residuals_and_exact_jacobian, ExactEvaluation};
-use crate::{jacobian_unbounded, sum_of_squares, Evaluators, FdOptions, InverseError, Objective};
+use crate::{sum_of_squares, Evaluators, FdOptions, InverseError, Objective};
 use argmin::core::{CostFunction, Error, Gradient, Jacobian, Operator};
 use nalgebra::DMatrix;
 use std::cell::{Cell, RefCell};
@@ -35,6 +36,12 @@ pub trait EvaluationCount {
     /// compute the Jacobian there, where the two come cheaper together than
     /// apart (exact sensitivities). A hint: the default ignores it.
     fn jacobian_with_residuals(&self, _wanted: bool) {}
+
+    /// The model's parameters at the solver's unknowns `z`, for messages
+    /// (default: `z` itself).
+    fn point(&self, z: &[f64]) -> Vec<f64> {
+        z.to_vec()
+    }
 }
 
 /// Forward runs of an objective with exact sensitivities, by kind.
@@ -63,6 +70,10 @@ pub struct LeastSquaresProblem<'a> {
     /// Levenberg-Marquardt's last accepted point survives a rejected trial
     /// evaluated with sensitivities after it.
     last_exact: RefCell<Vec<(Vec<f64>, ExactEvaluation)>>,
+    /// The last point whose run with sensitivities failed, and how many
+    /// failed.
+    exact_failed: RefCell<Option<Vec<f64>>>,
+    failed_exact: Cell<usize>,
 }
 
 impl<'a> LeastSquaresProblem<'a> {
@@ -78,6 +89,8 @@ impl<'a> LeastSquaresProblem<'a> {
             with_jacobian: Cell::new(true),
             last: RefCell::new(None),
             last_exact: RefCell::new(Vec::new()),
+            exact_failed: RefCell::new(None),
+            failed_exact: Cell::new(0),
         }
     }
 
@@ -94,6 +107,18 @@ impl<'a> LeastSquaresProblem<'a> {
         let mut kept = self.last_exact.borrow_mut();
         let i = kept.iter().position(|(zl, _)| zl.as_slice() == z)?;
         Some(kept.remove(i).1)
+    }
+
+    /// Runs with sensitivities that failed (each then replaced by a plain
+    /// run, or by finite differences for a Jacobian).
+    pub fn failed_sensitivity_runs(&self) -> usize {
+        self.failed_exact.get()
+    }
+
+    /// Notes that the run with sensitivities at `z` failed.
+    fn exact_failed_at(&self, z: &[f64]) {
+        self.failed_exact.set(self.failed_exact.get() + 1);
+        *self.exact_failed.borrow_mut() = Some(z.to_vec());
     }
 
     /// One run with sensitivities at `z`, kept.
@@ -130,7 +155,12 @@ impl<'a> LeastSquaresProblem<'a> {
         }
         let exact = self.objective.has_exact_sensitivities();
         if exact && self.with_jacobian.get() {
-            return self.exact_run(z);
+            // a run with sensitivities may fail where a plain one converges
+            // (its differentiation inverts an element at a perturbed state)
+            match self.exact_run(z) {
+                Err(InverseError::Forward { .. }) => self.exact_failed_at(z),
+                done => return done,
+            }
         }
         self.evaluations.set(self.evaluations.get() + 1);
         if exact {
@@ -158,22 +188,31 @@ impl<'a> LeastSquaresProblem<'a> {
                     .map(|(_, (_, _, j))| j.matrix.clone())
             };
             let found = here(&self.last_exact.borrow());
+            let failed_here = self.exact_failed.borrow().as_deref() == Some(z);
             let j = match found {
-                Some(j) => j,
-                None => {
-                    self.exact_run(z)?;
-                    here(&self.last_exact.borrow()).expect("the run just kept")
-                }
+                Some(j) => Some(j),
+                None if failed_here => None,
+                None => match self.exact_run(z) {
+                    Ok(_) => here(&self.last_exact.borrow()),
+                    Err(InverseError::Forward { .. }) => {
+                        self.exact_failed_at(z);
+                        None
+                    }
+                    Err(e) => return Err(e),
+                },
             };
-            self.jacobians.set(self.jacobians.get() + 1);
-            return Ok(j);
+            if let Some(j) = j {
+                self.jacobians.set(self.jacobians.get() + 1);
+                return Ok(j);
+            }
+            // the run with sensitivities failed here: finite differences
         }
         let r0 = if self.fd.central {
             None
         } else {
             Some(self.residuals_at(z)?)
         };
-        let j = jacobian_unbounded(self.objective, z, r0.as_deref(), &self.fd)?;
+        let j = finite_difference_jacobian(self.objective, z, r0.as_deref(), &self.fd)?;
         self.evaluations.set(self.evaluations.get() + j.evaluations);
         self.jacobians.set(self.jacobians.get() + 1);
         Ok(j.matrix)
@@ -187,6 +226,10 @@ impl EvaluationCount for LeastSquaresProblem<'_> {
 
     fn jacobian_with_residuals(&self, wanted: bool) {
         self.with_jacobian.set(wanted);
+    }
+
+    fn point(&self, z: &[f64]) -> Vec<f64> {
+        self.objective.theta_from_unbounded(z)
     }
 }
 

@@ -597,6 +597,105 @@ fn a_failed_run_at_a_trial_point_is_a_rejected_step_with_exact_sensitivities() {
     assert!(r.converged);
 }
 
+/// The exact sensitivities of `y = a^3 x` that fail for `a > 1.5` where
+/// the plain model converges (an FE run whose differentiation inverts an
+/// element at a perturbed state).
+struct FragileCubeSensitivities;
+impl Sensitivities for FragileCubeSensitivities {
+    fn predict_with_jacobian(
+        &self,
+        t: &[f64],
+        loading: &Loading,
+    ) -> Result<(Vec<f64>, Vec<Vec<f64>>), ForwardError> {
+        if t[0] > 1.5 {
+            return fails_above(2.0, 0.0).map(|_| (vec![], vec![]));
+        }
+        CubeSensitivities.predict_with_jacobian(t, loading)
+    }
+}
+
+/// Where the run with sensitivities fails and a plain run converges, the
+/// residuals come from a plain run and the Jacobian from finite
+/// differences: the fit goes on through that part of the space to the
+/// optimum near the truth a = 2, with the standard error of a fit whose
+/// sensitivities never fail.
+#[test]
+fn a_failed_run_with_sensitivities_falls_back_to_finite_differences() {
+    let model: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "cube",
+        space: ParamSpace::new(vec![p("a", 0.0, INF, 0.3)]),
+        law: |t, x| Ok(t[0].powi(3) * x),
+    });
+    let s = noisy(set(model.clone(), times(10, 2.0), &[2.0]), 0.01, 3)
+        .with_sensitivities(Arc::new(FragileCubeSensitivities));
+    let obj = Objective::new(vec![s.clone()], ResidualKind::Absolute, &[]).unwrap();
+    let r = fit(&obj, &lm()).unwrap();
+    let reference = fit(
+        &Objective::new(
+            vec![s.with_sensitivities(Arc::new(CubeSensitivities))],
+            ResidualKind::Absolute,
+            &[],
+        )
+        .unwrap(),
+        &lm(),
+    )
+    .unwrap();
+    let (a, se) = (r.value("a").unwrap(), r.parameters[0].standard_error);
+    assert!(r.converged, "{r:?}");
+    assert!((a - reference.value("a").unwrap()).abs() < 1e-7, "{a}");
+    let se_ref = reference.parameters[0].standard_error.unwrap();
+    assert!(
+        (se.unwrap() / se_ref - 1.0).abs() < 1e-4,
+        "{se:?} vs {se_ref}"
+    );
+}
+
+/// A model that converges at the start and nowhere else the steps reach
+/// (`y = a x`, its solve failing for every a above 0.3): Levenberg-Marquardt
+/// rejects each failed trial with more damping, and after
+/// `MAX_FAILED_TRIALS` in a row stops with an error that names the point
+/// the steps started from and the last failure's point and cause.
+#[test]
+fn trial_steps_that_keep_failing_end_the_fit_with_the_point_and_the_cause() {
+    let model: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "stuck",
+        space: ParamSpace::new(vec![p("a", 0.0, INF, 0.3)]),
+        law: |t, x| {
+            if t[0] > 0.3 + 1e-9 {
+                fails_above(2.0, x)
+            } else {
+                Ok(t[0] * x)
+            }
+        },
+    });
+    let drive = times(10, 2.0);
+    let observed = drive.clone();
+    let s = DataSet::new(
+        "stuck",
+        model,
+        Loading::quasi_static(Drive::DisplacementMm, drive),
+        observed,
+    );
+    let obj = Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap();
+    let e = fit(&obj, &lm()).unwrap_err();
+    let InverseError::TrialsFailed {
+        from,
+        failures,
+        last,
+        ..
+    } = &e
+    else {
+        panic!("{e}");
+    };
+    assert_eq!(*failures, palpate_inverse::lm::MAX_FAILED_TRIALS);
+    assert!((from[0] - 0.3).abs() < 1e-12, "{from:?}");
+    assert!(
+        matches!(**last, InverseError::Forward { ref theta, .. } if theta[0] > 0.3),
+        "{last}"
+    );
+    assert!(e.to_string().contains("element 110 inverted"), "{e}");
+}
+
 #[test]
 fn multistart_escapes_a_local_minimum_and_the_observer_sees_progress() {
     // y = sin(w t): from w0 = 1 the nearest minimum is not the truth w = 3.

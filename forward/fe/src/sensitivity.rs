@@ -104,7 +104,10 @@ impl Differentiation {
     /// The derivatives at the converged state of the increment to `target`,
     /// before its commit; leaves the system as it found it (state,
     /// parameters, committed history and the trial state of an assembly at
-    /// the converged state).
+    /// the converged state). On an error (an element inverted at a
+    /// perturbed state) the parameters, the committed history and the state
+    /// are restored, so that the stepper can cut the increment and retry
+    /// it; the history's derivatives are those of the increment's start.
     pub(crate) fn increment(
         &mut self,
         sys: &mut System,
@@ -113,11 +116,31 @@ impl Differentiation {
         observe: &dyn Fn(&System) -> Vec<f64>,
     ) -> Result<(), FeError> {
         let h0 = sys.histories();
+        let u0 = sys.u.clone();
+        let done = self.differentiate(sys, target, set, observe, &h0, &u0);
+        if done.is_err() {
+            // the parameters were accepted at the run's start
+            let _ = set(sys, &self.theta);
+            sys.set_histories(&h0, &h0, 0.0);
+            sys.set_state(&u0, &vec![0.0; sys.equations()], 0.0);
+        }
+        done
+    }
+
+    /// [`Differentiation::increment`] without the restoring on an error.
+    fn differentiate(
+        &mut self,
+        sys: &mut System,
+        target: &Target,
+        set: &mut SetParameters,
+        observe: &dyn Fn(&System) -> Vec<f64>,
+        h0: &[Vec<f64>],
+        u0: &[f64],
+    ) -> Result<(), FeError> {
         if self.dh.is_empty() || self.drop_history {
             let zero: Vec<Vec<f64>> = h0.iter().map(|h| vec![0.0; h.len()]).collect();
             self.dh = vec![zero; self.theta.len()];
         }
-        let u0 = sys.u.clone();
         let zero = vec![0.0; sys.equations()];
         sys.assemble(target, true)?;
         sys.factorize_tangent()?;
@@ -129,8 +152,8 @@ impl Differentiation {
             let mut sides = Vec::with_capacity(2);
             for s in [a, b] {
                 self.at(sys, j, s, e, set)?;
-                sys.set_histories(&h0, dh, s * e);
-                sys.set_state(&u0, &zero, 0.0);
+                sys.set_histories(h0, dh, s * e);
+                sys.set_state(u0, &zero, 0.0);
                 sys.assemble(target, false)?;
                 sides.push(sys.residual().to_vec());
             }
@@ -146,8 +169,8 @@ impl Differentiation {
             let mut hists = Vec::with_capacity(2);
             for s in [a, b] {
                 self.at(sys, j, s, e, set)?;
-                sys.set_histories(&h0, dh, s * e);
-                sys.set_state(&u0, &du, s * e);
+                sys.set_histories(h0, dh, s * e);
+                sys.set_state(u0, &du, s * e);
                 sys.assemble(target, false)?;
                 outs.push(observe(sys));
                 sys.commit_contributions(target);
@@ -168,8 +191,8 @@ impl Differentiation {
         }
         self.dh = dh_new;
         set(sys, &self.theta)?;
-        sys.set_histories(&h0, &h0, 0.0);
-        sys.set_state(&u0, &zero, 0.0);
+        sys.set_histories(h0, h0, 0.0);
+        sys.set_state(u0, &zero, 0.0);
         sys.assemble(target, false)?;
         Ok(())
     }

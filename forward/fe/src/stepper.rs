@@ -226,7 +226,12 @@ pub fn run(
 /// What runs after every converged increment, before its commit, with the
 /// system at the converged state and the committed history of the
 /// increment's start ([`crate::sensitivity`]); it must leave the system as
-/// it found it, trial state included. An error stops the run.
+/// it found it, trial state included. An error fails the increment as
+/// Newton's would: a recoverable one ([`FeError::is_recoverable`]) cuts
+/// it and retries (the stepper restores the state vector and rolls the
+/// contributions back, so the hook must leave the parameters and the
+/// committed history as it found them on an error too), any other or one
+/// after the last cut stops the run.
 pub(crate) type IncrementHook<'a> = dyn FnMut(&mut System, &Target) -> Result<(), FeError> + 'a;
 
 /// [`run`] with a hook after every converged increment.
@@ -303,13 +308,11 @@ pub(crate) fn run_with_hook(
                 sys.predictor = Some(p);
             }
             let it0 = sys.stats.iterations;
-            let solved = sys.solve_increment(&target, opts);
-            if let (Ok(()), Some(h)) = (&solved, hook.as_deref_mut()) {
-                if let Err(e) = h(sys, &target) {
-                    let drive = sys.committed.channels.first().copied().unwrap_or(0.0);
-                    return Err(fail(k, drive, cuts, e, &outputs));
-                }
-            }
+            // the hook's failure is the increment's: a recoverable one (an
+            // element inverted at a perturbed state) is cut like Newton's
+            let solved = sys
+                .solve_increment(&target, opts)
+                .and_then(|()| hook.as_deref_mut().map_or(Ok(()), |h| h(sys, &target)));
             match solved {
                 Ok(()) => {
                     sys.commit(&target);

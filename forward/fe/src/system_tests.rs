@@ -525,6 +525,69 @@ fn rollback_restores_material_history_exactly() {
     );
 }
 
+/// A hook after the converged increment (the sensitivities' perturbed
+/// assemblies) that fails recoverably, as an element inverted at a
+/// perturbed state, on increments over 0.1 mm: the stepper cuts and
+/// retries as it does for Newton's failures, and reaches the force of a run
+/// without the hook; a hook that always fails stops the run after the
+/// cuts, with the outputs of the stations that converged.
+#[test]
+fn a_recoverable_failure_of_the_increment_hook_cuts_the_step() {
+    let opts = SolverOptions {
+        first_step: 0.3,
+        max_step: 0.3,
+        ..SolverOptions::default()
+    };
+    let path = LoadPath::from_drive(&[0.3, 0.6]);
+    let mut observe = |s: &System| vec![s.channel_reaction(0)];
+    let mut plain = hardening_block(0.0);
+    let without = stepper::run(&mut plain, &path, &opts, &mut observe, None).unwrap();
+    let mut sys = hardening_block(0.0);
+    let mut calls = 0;
+    let mut hook = |s: &mut System, t: &Target| {
+        calls += 1;
+        let increment = (t.channels[0] - s.committed.channels[0]).abs();
+        if increment > 0.1 {
+            Err(FeError::InvertedElement {
+                element: 0,
+                det_f: -0.5,
+            })
+        } else {
+            Ok(())
+        }
+    };
+    let with = stepper::run_with_hook(&mut sys, &path, &opts, &mut observe, None, Some(&mut hook))
+        .unwrap();
+    assert!(sys.stats.cuts >= 2, "{:?}", sys.stats);
+    assert!(calls > sys.stats.increments, "{calls} {:?}", sys.stats);
+    for (a, b) in with.iter().zip(&without) {
+        assert!((a[0] - b[0]).abs() < 1e-6 * b[0].abs(), "{a:?} vs {b:?}");
+    }
+    // a hook that always fails: the cuts, then the error and no station
+    let mut sys = hardening_block(0.0);
+    let mut always = |_: &mut System, _: &Target| -> Result<(), FeError> {
+        Err(FeError::InvertedElement {
+            element: 3,
+            det_f: -0.1,
+        })
+    };
+    let failed = stepper::run_with_hook(
+        &mut sys,
+        &path,
+        &opts,
+        &mut observe,
+        None,
+        Some(&mut always),
+    )
+    .unwrap_err();
+    assert_eq!(failed.cuts, opts.max_cuts);
+    assert!(matches!(
+        failed.error,
+        FeError::InvertedElement { element: 3, .. }
+    ));
+    assert!(failed.completed.is_empty() && failed.sample == 0);
+}
+
 /// A plane-strain block under a wheel pressed by channel 0 and moved along
 /// +x by channel 1, rolling without slip (`rolling`) or sliding; returns
 /// the (horizontal, vertical) force on the wheel at the end.
