@@ -194,7 +194,7 @@ fn c1_records_with_two_planted_effects_get_the_pair() {
 }
 
 #[test]
-#[ignore = "12 diagnoses, over 20 s of CPU in the dev profile: cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
+#[ignore = "12 diagnoses, over 20 s of CPU in the dev profile, and 10 of 12 right (uni-03 misses the offset, uni-04 adds an asymmetry: docs/validation/gap-sets.md), under the 90 % asserted: cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn uniaxial_records_with_two_planted_effects_get_the_pair() {
     pairs("uni-", 12);
 }
