@@ -8,7 +8,9 @@
 //!
 //! The output is the page `docs/validation/gap-sets.md`:
 //! `cargo run -p palpate-tests --example bench_gap_sets > docs/validation/gap-sets.md`
-//! (or `-- PREFIX` for a subset, PREFIX `c1-`, `uni-`, `null-`).
+//! (or `-- PREFIX` for a subset, PREFIX `c1-`, `uni-`, `null-`, or a record's
+//! name; `-- PREFIX --explain` also writes each report's explanation, its
+//! candidates and its dropped members to stderr).
 
 use palpate_analytic::{C1Compression, Homogeneous, Mode};
 use palpate_core::{Drive, ForwardModel, Loading, Table};
@@ -32,7 +34,13 @@ fn cpu_seconds() -> f64 {
 
 fn main() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../studies/data/gap-dev2");
-    let prefix = std::env::args().nth(1).unwrap_or_default();
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let explain = args.iter().any(|a| a == "--explain");
+    let prefix = args
+        .iter()
+        .find(|a| !a.starts_with("--"))
+        .cloned()
+        .unwrap_or_default();
     let truth: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).expect("truth"))
             .expect("truth.json");
@@ -78,6 +86,19 @@ fn main() {
         let (cpu0, wall0) = (cpu_seconds(), Instant::now());
         let r = diagnose(base.as_ref(), &loading, &y, &GapOptions::default()).expect("diagnosis");
         let (cpu, wall) = (cpu_seconds() - cpu0, wall0.elapsed().as_secs_f64());
+        if explain {
+            eprintln!("== {name}\n{}", r.explanation);
+            for c in &r.ranking {
+                eprintln!(
+                    "  candidate {} {:?}: misfit {:.3e} -> {:.3e}, held-out gain {:.1}, earns {}, {:?}",
+                    c.effect, c.form, c.misfit_before, c.misfit_after, c.heldout_gain, c.earns, c.params
+                );
+            }
+            for m in &r.explanation_set {
+                eprintln!("  member {}: {}", m.effect, m.evidence);
+            }
+            eprintln!("  dropped {:?}; failed {:?}", r.dropped, r.failed);
+        }
         let mut planted: Vec<String> = truth[name.as_str()]["expected"]
             .as_array()
             .expect("expected")

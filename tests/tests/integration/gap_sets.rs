@@ -174,13 +174,13 @@ fn pairs_in(cases: &[String]) {
     );
 }
 
-/// One record of each kind of C1 pair (relaxation beside an offset, a
-/// compressible specimen or a compliant tool; an offset beside a stiffening
-/// law): the fast part of the suite below.
+/// Three cheap C1 pairs (relaxation beside an offset, a compressible
+/// specimen, a compliant tool: a few seconds of CPU each); the whole suite,
+/// with the records whose relaxation refits cost a minute or more, is in
+/// the test below and in `bench_gap_sets`.
 #[test]
-#[ignore = "four diagnoses, about 3 min of CPU under load; c1-08 fails the check that each planted effect alone leaves over 2 x noise (material_form alone 1.67 x: the family of laws absorbs the offset the generator measured against reduced polynomial 2 only): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
-fn c1_pairs_of_each_kind_get_the_pair() {
-    let cases: Vec<String> = ["c1-00", "c1-05", "c1-07", "c1-08"]
+fn cheap_c1_pairs_get_the_pair() {
+    let cases: Vec<String> = ["c1-00", "c1-04", "c1-06"]
         .iter()
         .map(|s| s.to_string())
         .collect();
@@ -188,13 +188,13 @@ fn c1_pairs_of_each_kind_get_the_pair() {
 }
 
 #[test]
-#[ignore = "14 diagnoses, over 20 s of CPU in the dev profile (bench_gap_sets prints each one's cost): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
+#[ignore = "13 diagnoses, several minutes of CPU in the dev profile (c1-05 about 100 s; bench_gap_sets prints each one's cost): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn c1_records_with_two_planted_effects_get_the_pair() {
-    pairs("c1-", 14);
+    pairs("c1-", 13);
 }
 
 #[test]
-#[ignore = "not every record yet plants both effects above 2 x noise alone (uni-05: material form 1.9 x): cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
+#[ignore = "12 diagnoses, over 20 s of CPU in the dev profile, and 10 of 12 right (uni-03 misses the offset, uni-04 adds an asymmetry: docs/validation/gap-sets.md), under the 90 % asserted: cargo test -p palpate-tests --test integration -- --ignored gap_sets::"]
 fn uniaxial_records_with_two_planted_effects_get_the_pair() {
     pairs("uni-", 12);
 }

@@ -12,21 +12,25 @@
 //! * `null-*`: twenty records of the base models with noise only.
 //!
 //! Each effect is planted strong enough that, with its partner fitted, it
-//! leaves a misfit well above the noise: for the C1 pairs this is measured
-//! on the noiseless record (the model with the partner alone, fitted by
-//! least squares; `visible_sd` in the truth, in noise SDs), and an effect
-//! below 2.5 SD is planted twice as strong (up to three times). A pair
-//! whose effects still hide behind one another (in C1, a stiffening law
-//! beside compressibility or a compliant tool: their sensitivities nearly
-//! coincide) is not a two-effect record and is not written; its name is
-//! skipped, so the others keep theirs. `expected` is the set a correct
-//! diagnosis answers (the planted pair; `[]` for the nulls).
+//! leaves a misfit well above the noise. This is measured on the noiseless
+//! record (`visible_sd` in the truth, in noise SDs): the base model with the
+//! partner alone, in every form the diagnosis searches (for
+//! `material_form` the whole family of richer laws: a flexible law can take
+//! up a zero offset that reduced polynomial 2 leaves), fitted by least
+//! squares; an effect below 2.5 SD is planted twice as strong (up to three
+//! times). A pair whose effects still hide behind one another (in C1, a
+//! stiffening law beside compressibility or a compliant tool: their
+//! sensitivities nearly coincide; an offset beside a law the family
+//! absorbs it into) is not a two-effect record and is not written; its
+//! name is skipped, so the others keep theirs. `expected` is the set a
+//! correct diagnosis answers (the planted pair; `[]` for the nulls).
 //!
-//! `cargo run -p palpate-tools --bin make_gap_two` (seconds). The records
+//! `cargo run -p palpate-tools --bin make_gap_two` (about a minute). The records
 //! are committed; rerun only to change them.
 
 use palpate_analytic::{C1Compression, Compressible, Homogeneous, Mode};
-use palpate_core::{Drive, ForwardModel, Loading};
+use palpate_core::enrichable::{embed, enrich_forms};
+use palpate_core::{Drive, Effect, ForwardModel, Loading};
 use palpate_enrich::{TensionCompressionAsymmetry, ToolCompliance, Viscoelastic, ZeroOffset};
 use palpate_material::Law;
 use rand::SeedableRng;
@@ -123,7 +127,7 @@ fn compressible_nh() -> Box<dyn ForwardModel> {
 /// The C1 model with `effects` planted (names of GAP.md), variant `v`, each
 /// effect's strength multiplied by its entry of `scale` (in the order of
 /// [`C1_EFFECTS`]): the model and its parameters.
-fn c1_model(effects: &[&str], v: usize, scale: &[f64; 5]) -> (Box<dyn ForwardModel>, Vec<f64>) {
+fn c1_model(effects: &[&str], v: usize, scale: &[f64]) -> (Arc<dyn ForwardModel>, Vec<f64>) {
     let c10 = [1.2e-3, 1.0e-3];
     let prony = [(0.3, 1.5, 0.15, 12.0), (0.25, 0.8, 0.2, 8.0)];
     let d0 = [0.15, 0.1];
@@ -159,7 +163,7 @@ fn c1_model(effects: &[&str], v: usize, scale: &[f64; 5]) -> (Box<dyn ForwardMod
         model = Box::new(ToolCompliance::new(model));
         theta.push((comp[v] * scale[4]).min(0.8));
     }
-    (model, theta)
+    (Arc::from(model), theta)
 }
 
 /// The effects of the C1 pairs, in the order of the strength scales.
@@ -182,13 +186,13 @@ const VISIBLE_SD: f64 = 2.5;
 /// RMS of what `model` (started at `start`) leaves of the noiseless `clean`
 /// once fitted to it by least squares.
 fn left_after_fit(
-    model: Box<dyn ForwardModel>,
+    model: Arc<dyn ForwardModel>,
     start: Vec<f64>,
     loading: &Loading,
     clean: &[f64],
 ) -> f64 {
     use palpate_inverse::{fit, DataSet, FitOptions, Objective, ResidualKind};
-    let set = DataSet::new("record", Arc::from(model), loading.clone(), clean.to_vec());
+    let set = DataSet::new("record", model, loading.clone(), clean.to_vec());
     let objective = Objective::new(vec![set], ResidualKind::Absolute, &[]).expect("objective");
     let options = FitOptions {
         start: Some(start),
@@ -199,12 +203,118 @@ fn left_after_fit(
         .unwrap_or(f64::INFINITY)
 }
 
-/// The C1 pair records: every pair of the five effects, two variants each.
-/// Each effect's visible size beside its partner is measured on the
-/// noiseless record (the model with the partner alone fitted to it, from
-/// the partner's planted values); an effect below [`VISIBLE_SD`] is planted
-/// twice as strong, up to three times; `expected` holds the effects that
-/// end up visible.
+/// RMS of what the effect `partner` alone leaves of the noiseless `clean`:
+/// `base` enriched by `partner` in every form the diagnosis searches (the
+/// family of richer laws of `material_form`, one form for the others),
+/// each fitted from the planted values (`names`, `planted`, by name), from
+/// its "off" point at the planted base parameters and from its own initial
+/// values; the least of them. A form that another planted effect's misfit
+/// fits (a flexible law taking a zero offset) hides that effect as surely
+/// as the form planted would.
+fn left_by_partner(
+    base: &dyn ForwardModel,
+    partner: Effect,
+    names: &[String],
+    planted: &[f64],
+    loading: &Loading,
+    clean: &[f64],
+) -> f64 {
+    let value = |n: &String| names.iter().position(|m| m == n).map(|i| planted[i]);
+    let base_theta: Vec<f64> = base
+        .space()
+        .params
+        .iter()
+        .map(|p| value(&p.name).unwrap_or(p.initial))
+        .collect();
+    let forms = enrich_forms(base, partner).expect("the partner's forms");
+    forms
+        .into_iter()
+        .map(|form| {
+            let model: Arc<dyn ForwardModel> = Arc::from(form.model);
+            let off = embed(model.as_ref(), &base_theta);
+            let specs = &model.space().params;
+            let by_name: Vec<f64> = specs
+                .iter()
+                .zip(&off)
+                .map(|(p, o)| value(&p.name).unwrap_or(*o))
+                .collect();
+            let initial: Vec<f64> = specs
+                .iter()
+                .enumerate()
+                .map(|(j, p)| base_theta.get(j).copied().unwrap_or(p.initial))
+                .collect();
+            [by_name, off, initial]
+                .into_iter()
+                .map(|start| left_after_fit(model.clone(), start, loading, clean))
+                .fold(f64::INFINITY, f64::min)
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// A pair planted visibly: the model, its parameters, the noiseless record
+/// and each effect's visible size beside the other (in noise SDs), or
+/// `None` when one stays under [`VISIBLE_SD`] after three doublings.
+struct Planted {
+    model: Arc<dyn ForwardModel>,
+    theta: Vec<f64>,
+    clean: Vec<f64>,
+    visible: [f64; 2],
+    scale: Vec<f64>,
+}
+
+/// Plants the pair `(a, b)` with `build(effects, scale)` (strengths
+/// multiplied by `scale`, in the order of `order`) and measures each
+/// effect's visible size on the noiseless record: what the partner alone
+/// leaves ([`left_by_partner`], every form of it), against the noise
+/// [`PAIR_NOISE`] of the peak. An effect below [`VISIBLE_SD`] is planted
+/// twice as strong, up to three times.
+fn plant_visibly(
+    base: &dyn ForwardModel,
+    (a, b): (&str, &str),
+    order: &[&str],
+    loading: &Loading,
+    build: impl Fn(&[&str], &[f64]) -> (Arc<dyn ForwardModel>, Vec<f64>),
+) -> Result<Planted, Planted> {
+    let index = |e: &str| order.iter().position(|x| *x == e).expect("effect");
+    let mut scale = vec![1.0; order.len()];
+    let mut round = 0;
+    loop {
+        let (model, theta) = build(&[a, b], &scale);
+        let clean = model.predict(&theta, loading).expect("pair record");
+        let peak = clean.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let sd = PAIR_NOISE * peak;
+        let names = model.space().names();
+        let mut visible = [0.0, 0.0];
+        // visible size of each: what its partner alone leaves
+        for (j, partner) in [b, a].into_iter().enumerate() {
+            let partner: Effect = partner.parse().expect("effect name");
+            visible[j] = left_by_partner(base, partner, &names, &theta, loading, &clean) / sd;
+        }
+        let planted = Planted {
+            model,
+            theta,
+            clean,
+            visible,
+            scale: scale.clone(),
+        };
+        if visible.iter().all(|s| *s >= VISIBLE_SD) {
+            return Ok(planted);
+        }
+        if round == 3 {
+            return Err(planted);
+        }
+        for (j, hidden) in [a, b].into_iter().enumerate() {
+            if visible[j] < VISIBLE_SD {
+                scale[index(hidden)] *= 2.0;
+            }
+        }
+        round += 1;
+    }
+}
+
+/// The C1 pair records: every pair of the five effects, two variants each,
+/// planted visibly ([`plant_visibly`]); a pair whose effects still hide
+/// behind one another is not written.
 fn c1_records() -> Vec<Record> {
     let pairs: [(&str, &str); 10] = [
         ("viscoelasticity", "zero_offset"),
@@ -227,50 +337,26 @@ fn c1_records() -> Vec<Record> {
                 (0.25, 2.2, 25.0)
             };
             let loading = c1_history(rate, depth, hold, 0.1);
-            let index = |e: &str| C1_EFFECTS.iter().position(|x| *x == e).expect("effect");
-            let mut scale = [1.0; 5];
-            let mut visible = [0.0, 0.0];
-            let (mut model, mut theta, mut clean);
-            let mut round = 0;
-            loop {
-                (model, theta) = c1_model(&[a, b], v, &scale);
-                clean = model.predict(&theta, &loading).expect("C1 pair record");
-                let peak = clean.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-                let sd = PAIR_NOISE * peak;
-                // visible size of `hidden`: what the partner alone leaves
-                for (j, partner) in [b, a].into_iter().enumerate() {
-                    let (alone, truth) = c1_model(&[partner], v, &scale);
-                    // the partner's planted values as the start (the law's
-                    // C10 and the partner's own)
-                    let names = model.space().names();
-                    let start: Vec<f64> = alone
-                        .space()
-                        .names()
-                        .iter()
-                        .zip(&truth)
-                        .map(|(n, t)| names.iter().position(|m| m == n).map_or(*t, |i| theta[i]))
-                        .collect();
-                    visible[j] = left_after_fit(alone, start, &loading, &clean) / sd;
+            let name = format!("c1-{:02}", 2 * k + v);
+            let planted = plant_visibly(nh_c1().as_ref(), (a, b), &C1_EFFECTS, &loading, |e, s| {
+                c1_model(e, v, s)
+            });
+            let Planted {
+                model,
+                theta,
+                clean,
+                visible,
+                scale,
+            } = match planted {
+                Ok(p) => p,
+                Err(p) => {
+                    eprintln!(
+                        "{name} not written: {a} visible {:.2} SD, {b} {:.2} SD beside each other at scales {:?}",
+                        p.visible[0], p.visible[1], p.scale
+                    );
+                    continue;
                 }
-                if round == 3 || visible.iter().all(|s| *s >= VISIBLE_SD) {
-                    break;
-                }
-                for (j, hidden) in [a, b].into_iter().enumerate() {
-                    if visible[j] < VISIBLE_SD {
-                        scale[index(hidden)] *= 2.0;
-                    }
-                }
-                round += 1;
-            }
-            if visible.iter().any(|s| *s < VISIBLE_SD) {
-                eprintln!(
-                    "c1-{:02} not written: {a} visible {:.2} SD, {b} {:.2} SD beside each other at scales {scale:?}",
-                    2 * k + v,
-                    visible[0],
-                    visible[1]
-                );
-                continue;
-            }
+            };
             let expected = [format!("\"{a}\""), format!("\"{b}\"")];
             let names: Vec<String> = model.space().names();
             let params: Vec<String> = names
@@ -279,13 +365,11 @@ fn c1_records() -> Vec<Record> {
                 .map(|(n, v)| format!("\"{n}\": {v}"))
                 .collect();
             eprintln!(
-                "c1-{:02}: {a} visible {:.2} SD, {b} {:.2} SD (scales {scale:?})",
-                2 * k + v,
-                visible[0],
-                visible[1]
+                "{name}: {a} visible {:.2} SD, {b} {:.2} SD (scales {scale:?})",
+                visible[0], visible[1]
             );
             out.push(Record {
-                name: format!("c1-{:02}", 2 * k + v),
+                name,
                 loading,
                 clean,
                 relative_noise: PAIR_NOISE,
@@ -310,7 +394,52 @@ fn uniaxial(law: Law) -> Arc<dyn ForwardModel> {
     Arc::new(Homogeneous::new(law, Mode::Uniaxial))
 }
 
-/// The homogeneous uniaxial pair records.
+/// The effects of the uniaxial pairs, in the order of the strength scales.
+const UNI_EFFECTS: [&str; 4] = [
+    "viscoelasticity",
+    "zero_offset",
+    "material_form",
+    "tension_compression_asymmetry",
+];
+
+/// The uniaxial model with `effects` planted, variant `v`, strengths
+/// multiplied by `scale` (in the order of [`UNI_EFFECTS`]).
+fn uni_model(effects: &[&str], v: usize, scale: &[f64]) -> (Arc<dyn ForwardModel>, Vec<f64>) {
+    let c10 = [0.05, 0.08];
+    let c20 = [0.08, 0.1];
+    let prony = [(0.3, 1.0, 0.2, 10.0), (0.25, 2.0, 0.15, 15.0)];
+    let d0 = [0.03, -0.025];
+    let asym = [1.0, 1.5];
+    let has = |e: &str| effects.contains(&e);
+    let (mut model, mut theta): (Arc<dyn ForwardModel>, Vec<f64>) = if has("material_form") {
+        (
+            uniaxial(Law::ReducedPolynomial(2)),
+            vec![c10[v], c20[v] * scale[2]],
+        )
+    } else {
+        (uniaxial(Law::NeoHookean), vec![c10[v]])
+    };
+    if has("tension_compression_asymmetry") {
+        model = Arc::new(TensionCompressionAsymmetry::from_arc(model));
+        theta.push(asym[v] * scale[3]);
+    }
+    if has("zero_offset") {
+        model = Arc::new(ZeroOffset::on_stretch(model));
+        // an offset of the stretch held under 0.1
+        theta.push((d0[v] * scale[1]).clamp(-0.1, 0.1));
+    }
+    if has("viscoelasticity") {
+        let (g1, tau1, g2, tau2) = prony[v];
+        // relaxation weights scaled together, their sum held below 0.8
+        let gs = scale[0].min(0.8 / (g1 + g2));
+        model = Arc::new(Viscoelastic::from_arc(model, 2));
+        theta.extend([gs * g1, tau1, gs * g2, tau2]);
+    }
+    (model, theta)
+}
+
+/// The homogeneous uniaxial pair records, planted visibly as the C1 ones
+/// ([`plant_visibly`]).
 fn uniaxial_records() -> Vec<Record> {
     // A tension-compression cycle with holds (crosses stretch 1) and a
     // tension ramp-hold-unload.
@@ -334,38 +463,35 @@ fn uniaxial_records() -> Vec<Record> {
         ("tension_compression_asymmetry", "zero_offset", true),
         ("tension_compression_asymmetry", "material_form", true),
     ];
-    let c10 = [0.05, 0.08];
-    let c20 = [0.08, 0.1];
-    let prony = [(0.3, 1.0, 0.2, 10.0), (0.25, 2.0, 0.15, 15.0)];
-    let d0 = [0.03, -0.025];
-    let asym = [1.0, 1.5];
+    let base = Homogeneous::new(Law::NeoHookean, Mode::Uniaxial);
     let mut out = Vec::new();
     for (k, &(a, b, crosses)) in pairs.iter().enumerate() {
         for v in 0..2 {
-            let has = |e: &str| a == e || b == e;
-            let (mut model, mut theta): (Arc<dyn ForwardModel>, Vec<f64>) = if has("material_form")
-            {
-                (uniaxial(Law::ReducedPolynomial(2)), vec![c10[v], c20[v]])
-            } else {
-                (uniaxial(Law::NeoHookean), vec![c10[v]])
-            };
-            if has("tension_compression_asymmetry") {
-                model = Arc::new(TensionCompressionAsymmetry::from_arc(model));
-                theta.push(asym[v]);
-            }
-            if has("zero_offset") {
-                model = Arc::new(ZeroOffset::on_stretch(model));
-                theta.push(d0[v]);
-            }
-            if has("viscoelasticity") {
-                let (g1, tau1, g2, tau2) = prony[v];
-                model = Arc::new(Viscoelastic::from_arc(model, 2));
-                theta.extend([g1, tau1, g2, tau2]);
-            }
+            let name = format!("uni-{:02}", 2 * k + v);
             let loading = if crosses { cycle() } else { tension() };
-            let clean = model
-                .predict(&theta, &loading)
-                .expect("uniaxial pair record");
+            let planted = plant_visibly(&base, (a, b), &UNI_EFFECTS, &loading, |e, s| {
+                uni_model(e, v, s)
+            });
+            let Planted {
+                model,
+                theta,
+                clean,
+                visible,
+                scale,
+            } = match planted {
+                Ok(p) => p,
+                Err(p) => {
+                    eprintln!(
+                        "{name} not written: {a} visible {:.2} SD, {b} {:.2} SD beside each other at scales {:?}",
+                        p.visible[0], p.visible[1], p.scale
+                    );
+                    continue;
+                }
+            };
+            eprintln!(
+                "{name}: {a} visible {:.2} SD, {b} {:.2} SD (scales {scale:?})",
+                visible[0], visible[1]
+            );
             let params: Vec<String> = model
                 .space()
                 .names()
@@ -374,17 +500,19 @@ fn uniaxial_records() -> Vec<Record> {
                 .map(|(n, v)| format!("\"{n}\": {v}"))
                 .collect();
             out.push(Record {
-                name: format!("uni-{:02}", 2 * k + v),
+                name,
                 loading,
                 clean,
-                relative_noise: 0.005,
+                relative_noise: PAIR_NOISE,
                 seed: 2000 + (2 * k + v) as u64,
                 truth: format!(
                     "\"base\": \"uniaxial\", \"law\": \"neo-hookean\", \"model\": \"{}\", \"protocol\": \"{}\", \
-                     \"params\": {{{}}}, \"expected\": [\"{a}\", \"{b}\"]",
+                     \"params\": {{{}}}, \"visible_sd\": {{\"{a}\": {:.3}, \"{b}\": {:.3}}}, \"expected\": [\"{a}\", \"{b}\"]",
                     model.name(),
                     if crosses { "tension_compression_cycle" } else { "tension_ramp_hold_unload" },
-                    params.join(", ")
+                    params.join(", "),
+                    visible[0],
+                    visible[1],
                 ),
             });
         }

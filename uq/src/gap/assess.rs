@@ -8,7 +8,7 @@ use super::plausible::degenerate;
 use super::report::{PracticalSize, RankedEffect};
 use super::residual::{ar1_deviance, residuals, rms, sse};
 use super::score::{projected_columns, score_test, sensitivities_at};
-use super::starts::{candidate_starts, projected_line_search, screen_starts};
+use super::starts::{candidate_starts, projected_line_search, scale_scan_starts, screen_starts};
 use super::structure::{chi2_isf, chi2_sf, whiteness};
 use super::GapError;
 use nalgebra::DMatrix;
@@ -263,6 +263,10 @@ pub(crate) fn assess(
     let mut starts = candidate_starts(rich.as_ref(), p, &off, &score.step, duration);
     if let Some(alone) = ctx.solo.get(&effect) {
         starts.extend(set_starts(rich.as_ref(), p, &off, alone, duration));
+    }
+    if !ctx.expensive {
+        let scanned = scale_scan_starts(rich.as_ref(), p, &off, &starts, ctx.loading, ctx.observed);
+        starts.extend(scanned);
     }
     let mut projected = false;
     if ctx.expensive {

@@ -308,3 +308,97 @@ pub(crate) fn projected_line_search(
     }
     Some(best.1)
 }
+
+/// Decades of the scan of [`scale_scan_start`], relative to the distance
+/// from the bound to the parameter's initial value.
+const SCAN_DECADES: std::ops::RangeInclusive<i32> = -2..=6;
+
+/// For a cheap model: a start for each new parameter whose range is
+/// unbounded above and whose "off" value sits on its lower bound (a
+/// compliance-like parameter, such as D1 = 2 / K or c = 1 / k, "off" at 0):
+/// such a parameter acts on a scale the base does not set, and its effect
+/// may show only decades away from "off" (a bulk modulus comparable to the
+/// shear modulus), across a plateau where the moduli absorb it and a fit
+/// started near "off" stays. The parameter is scanned on a log grid,
+/// `lower + g 10^k` for k in [`SCAN_DECADES`] (g the distance from the bound
+/// to its initial value), the others at `off` and the moduli eliminated by
+/// their least-squares factor (one prediction per point); the best point
+/// becomes a start when it fits better than "off" itself. The scan runs
+/// from `off` and from each of `around` (the other starts: a relaxation
+/// restarted on its grid may need the parameter far from "off" too).
+/// Empty when no parameter is of that kind or no point does better.
+pub(crate) fn scale_scan_starts(
+    rich: &dyn ForwardModel,
+    p: usize,
+    off: &[f64],
+    around: &[Vec<f64>],
+    loading: &Loading,
+    observed: &[f64],
+) -> Vec<Vec<f64>> {
+    let specs = &rich.space().params;
+    let scanned: Vec<usize> = (p..specs.len())
+        .filter(|&j| {
+            let s = &specs[j];
+            s.lower.is_finite()
+                && s.upper == f64::INFINITY
+                && off[j] <= s.lower
+                && !s.is_modulus()
+                && !matches!(
+                    s.role,
+                    ParamRole::TimeConstant { .. } | ParamRole::RelaxationWeight { .. }
+                )
+        })
+        .collect();
+    let mut out: Vec<Vec<f64>> = Vec::new();
+    if scanned.is_empty() {
+        return out;
+    }
+    for start in std::iter::once(off).chain(around.iter().map(|s| s.as_slice())) {
+        for &j in &scanned {
+            if let Some(s) = scan_one(rich, j, start, loading, observed) {
+                if !out.contains(&s) {
+                    out.push(s);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The best point of the log-grid scan of parameter `j` from `from` (see
+/// [`scale_scan_starts`]), when it fits better than `from`.
+fn scan_one(
+    rich: &dyn ForwardModel,
+    j: usize,
+    from: &[f64],
+    loading: &Loading,
+    observed: &[f64],
+) -> Option<Vec<f64>> {
+    let specs = &rich.space().params;
+    let misfit = |theta: &[f64]| -> Option<(f64, Vec<f64>)> {
+        let f = rich.predict(theta, loading).ok()?;
+        let (a, scaled) = scale_moduli(specs, theta, &f, observed)?;
+        let sse: f64 = f
+            .iter()
+            .zip(observed)
+            .map(|(v, y)| (y - a * v).powi(2))
+            .sum();
+        sse.is_finite().then_some((sse, scaled))
+    };
+    let s = &specs[j];
+    let at_from = misfit(from).map_or(f64::INFINITY, |m| m.0);
+    let g = if s.initial > s.lower {
+        s.initial - s.lower
+    } else {
+        1.0
+    };
+    let (sse, theta) = SCAN_DECADES
+        .into_par_iter()
+        .filter_map(|k| {
+            let mut theta = from.to_vec();
+            theta[j] = s.lower + g * 10f64.powi(k);
+            misfit(&theta)
+        })
+        .min_by(|a, b| a.0.total_cmp(&b.0))?;
+    (sse < at_from).then_some(theta)
+}
