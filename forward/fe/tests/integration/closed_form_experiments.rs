@@ -230,7 +230,7 @@ fn sneddon_flat_punch() {
 /// mm, against the closed form of `sneddon_flat_punch`; then level 2 on a
 /// cylinder of radius h (20 x 20 mm), whose free side softens it.
 #[test]
-#[ignore = "a convergence table, a minute or two of CPU; cargo test -p palpate-fe --test integration closed_form_experiments::sneddon_flat_punch_levels -- --ignored --nocapture"]
+#[ignore = "a convergence table, minutes of CPU (8 min wall on a loaded 2-core machine); cargo test -p palpate-fe --test integration closed_form_experiments::sneddon_flat_punch_levels -- --ignored --nocapture"]
 fn sneddon_flat_punch_levels() {
     let (a, h) = (1.0, 20.0);
     let depths = [0.02, 0.04];
