@@ -244,7 +244,15 @@ fn ccx_section(dir: &Path, level: Option<usize>) -> anyhow::Result<String> {
          palpate holds the folded side in contact with the platen with the platen's friction, \
          CalculiX frictionless beyond the bonded face, so past 8.5 mm the bonded curves differ \
          by that model too. The frictionless deck stops at 16.5 mm (55 %). Beyond each deck's \
-         reach only palpate's curve is shown.\n"
+         reach only palpate's curve is shown.\n\n\
+         palpate's stated error of a platen run comes from the tool's own mesh levels: \
+         `palpate simulate` solves the levels half and twice the run's (the two below it at \
+         level 2 and finer) and compares them at the run's samples, Richardson with the order \
+         they show where their changes shrink, else a bound (the run's distance from the \
+         finest level plus the largest change between levels). Richardson with the needle's \
+         order did not cover what level 2 changes: at friction 0.28, level 1 is 8.4 % below \
+         level 2 at 18 mm where it stated -0.89 % \
+         (docs/notes/2026-11-29-platen-friction-level1.md).\n"
     )?;
     let mut cols = Vec::new();
     for (experiment, label, ccx, reach, stated) in DECKS {

@@ -440,11 +440,203 @@ impl Refinable for N3Needle {
     }
 }
 
+/// The observed orders a three-level estimate accepts: outside them the
+/// meshes are not in the asymptotic range and the estimate is a bound.
+pub const OBSERVED_ORDERS: (f64, f64) = (0.5, 4.0);
+
+/// A run's discretisation error at one sample, from its mesh family at
+/// three levels ([`from_levels`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct LevelError {
+    /// The run's force minus the estimated converged force (N).
+    pub error: f64,
+    /// The order observed at this sample; `None`: the levels' changes do
+    /// not shrink as an order within [`OBSERVED_ORDERS`] would, and
+    /// `error` is the bound (the run's distance from the finest level plus
+    /// the largest change between two levels), signed as the run's
+    /// difference from the finest level.
+    pub order: Option<f64>,
+}
+
+/// The discretisation error of a run from the forces of its own mesh
+/// family at three levels whose element sizes halve (`forces`: coarse,
+/// middle, fine; `run`: which of them is the run, 0, 1 or 2), at the
+/// samples all three reached. Where the changes shrink (`q = (F0 - F1) /
+/// (F1 - F2) > 1`) with an observed order `p = log2 q` within
+/// [`OBSERVED_ORDERS`], the converged force is the finest one extrapolated
+/// (Richardson with `p`); elsewhere the error is bounded by the run's
+/// distance from the finest force plus the largest change between two
+/// levels (at least the finest level's error if its error is no larger
+/// than the last change, which is what an order of 1 or more gives).
+pub fn from_levels(forces: [&[f64]; 3], run: usize) -> Result<Vec<LevelError>, FeError> {
+    if run > 2 {
+        return Err(FeError::InvalidConfig {
+            field: "run".into(),
+            reason: format!("{run}: the run is level 0, 1 or 2 of the three"),
+        });
+    }
+    if let Some(x) = forces
+        .iter()
+        .flat_map(|f| f.iter())
+        .find(|x| !x.is_finite())
+    {
+        return Err(FeError::InvalidConfig {
+            field: "forces".into(),
+            reason: format!("{x} is not finite"),
+        });
+    }
+    let n = forces.iter().map(|f| f.len()).min().unwrap_or(0);
+    Ok((0..n)
+        .map(|k| {
+            let (f0, f1, f2) = (forces[0][k], forces[1][k], forces[2][k]);
+            let fr = forces[run][k];
+            let (d01, d12) = (f0 - f1, f1 - f2);
+            let agree = crate::discretisation::AGREEMENT * f1.abs().max(f2.abs());
+            if d12.abs() <= agree && d01.abs() <= agree {
+                return LevelError {
+                    error: fr - f2,
+                    order: Some(f64::INFINITY),
+                };
+            }
+            let q = d01 / d12;
+            let p = q.log2();
+            if q > 1.0 && p >= OBSERVED_ORDERS.0 && p <= OBSERVED_ORDERS.1 {
+                let converged = f2 - d12 / (2f64.powf(p) - 1.0);
+                LevelError {
+                    error: fr - converged,
+                    order: Some(p),
+                }
+            } else {
+                let bound = (fr - f2).abs() + d01.abs().max(d12.abs());
+                let sign = if run == 2 { d12 } else { fr - f2 };
+                LevelError {
+                    error: if sign < 0.0 { -bound } else { bound },
+                    order: None,
+                }
+            }
+        })
+        .collect())
+}
+
+/// The three levels (coarse to fine, element sizes halving) that estimate
+/// the error of a run at `level`, and which of them is the run: a run
+/// coarser than the description's default level (2) is compared with the
+/// level twice as fine (and half as fine), since the coarser levels alone
+/// cannot see what the finer mesh changes; a run at the default level or
+/// finer with the two levels below it.
+pub fn levels_about(level: f64) -> ([f64; 3], usize) {
+    if level < crate::cylinder::DEFAULT_LEVEL {
+        ([0.5 * level, level, 2.0 * level], 1)
+    } else {
+        ([0.25 * level, 0.5 * level, level], 2)
+    }
+}
+
+/// One line saying how a run's error was estimated from its levels and
+/// what it is at the deepest sample both reached (`drive`: the samples'
+/// drives, `forces`: the run's, `errors`: [`from_levels`]).
+pub fn levels_line(
+    levels: [f64; 3],
+    drive: &[f64],
+    run_forces: &[f64],
+    errors: &[LevelError],
+) -> String {
+    let head = format!(
+        "discretisation error (from the tool's own mesh levels {}, {} and {}, compared at the run's samples: \
+         Richardson with the order they show where their changes shrink, else bounded by the distance to \
+         the finest level plus the largest change between levels)",
+        round3(levels[0]),
+        round3(levels[1]),
+        round3(levels[2])
+    );
+    let Some(k) = errors.len().checked_sub(1).filter(|&k| k > 0) else {
+        return format!("{head}: not estimated, a level stopped before the first sample");
+    };
+    let e = errors[k];
+    let d = drive[k];
+    let f = run_forces[k];
+    let converged = f - e.error;
+    let rel = if converged != 0.0 {
+        e.error / converged
+    } else {
+        0.0
+    };
+    let bounds = errors.iter().filter(|e| e.order.is_none()).count();
+    let how = match e.order {
+        Some(p) if p.is_finite() => format!("observed order {:.2} at {d} mm", p),
+        Some(_) => format!("the levels agree to round-off at {d} mm"),
+        None => format!("a bound at {d} mm, where the levels' changes do not shrink"),
+    };
+    let mut line = format!(
+        "{head}: {}{:+.2} % at {d} mm ({how}; estimated converged force {converged:.6} N; \
+         bounds at {bounds} of {} samples)",
+        if e.order.is_none() { "at most " } else { "" },
+        100.0 * rel,
+        errors.len()
+    );
+    if errors.len() < drive.len() {
+        line.push_str(&format!(
+            "; a level stopped at {} mm, no estimate beyond",
+            drive[errors.len() - 1]
+        ));
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use palpate_core::Drive;
     use palpate_material::Law;
+
+    /// F(h) = F* + C h^p on three levels: the converged force recovered
+    /// with the observed order, for the run at any of the three; where the
+    /// changes do not shrink, a bound that covers the finest level's
+    /// difference.
+    #[test]
+    fn three_levels_extrapolate_with_their_order_or_bound() {
+        for p in [0.8, 1.5, 3.0] {
+            let exact = [2.0, 5.0, 9.0];
+            let c = [0.3, -0.8, 1.1];
+            let at = |h: f64| -> Vec<f64> {
+                exact
+                    .iter()
+                    .zip(&c)
+                    .map(|(e, c)| e + c * h.powf(p))
+                    .collect()
+            };
+            let (f0, f1, f2) = (at(1.0), at(0.5), at(0.25));
+            for run in 0..3 {
+                let fr = [&f0, &f1, &f2][run];
+                let est = from_levels([&f0, &f1, &f2], run).unwrap();
+                for k in 0..3 {
+                    assert!((est[k].order.unwrap() - p).abs() < 1e-9, "{est:?}");
+                    assert!(
+                        (fr[k] - est[k].error - exact[k]).abs() < 1e-9,
+                        "p {p} run {run}: {est:?}"
+                    );
+                }
+            }
+        }
+        // the middle level off the trend (a jump): a bound, signed as the
+        // run's difference from the finest level, covering it
+        let (f0, f1, f2) = ([10.0, 20.0], [10.5, 19.0], [10.2, 21.0]);
+        let est = from_levels([&f0[..], &f1[..], &f2[..]], 1).unwrap();
+        for k in 0..2 {
+            assert_eq!(est[k].order, None);
+            assert!(est[k].error.abs() >= (f1[k] - f2[k]).abs());
+            assert_eq!(est[k].error.signum(), (f1[k] - f2[k]).signum());
+        }
+        assert!((est[1].error - (-2.0 - 2.0)).abs() < 1e-12, "{est:?}");
+        // the estimate covers the samples all three reached
+        let est = from_levels([&f0[..], &f1[..1], &f2[..]], 1).unwrap();
+        assert_eq!(est.len(), 1);
+        assert!(from_levels([&f0[..], &f1[..], &[f64::NAN, 1.0][..]], 1).is_err());
+        // the levels: the finer level for a run below the default
+        assert_eq!(levels_about(1.0), ([0.5, 1.0, 2.0], 1));
+        assert_eq!(levels_about(2.0), ([0.5, 1.0, 2.0], 2));
+        assert_eq!(levels_about(3.0), ([0.75, 1.5, 3.0], 2));
+    }
 
     fn nh() -> Law {
         "neo-hookean".parse().expect("law")

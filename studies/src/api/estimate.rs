@@ -29,6 +29,11 @@ pub(crate) fn estimate(
     fine: &[f64],
     show: bool,
 ) -> anyhow::Result<Estimate> {
+    if let (Model::N1Needle(m), None) = (model, order) {
+        if let Some((levels, run)) = m.own_levels() {
+            return own_levels(m, levels, run, theta, loading, fine, show);
+        }
+    }
     let (bar, mut cb) = progress_bar(loading.len(), "coarse mesh for the error estimate: ", show);
     // (element-size ratio, coarse mesh, documented order, coarse result)
     let (ratio, mesh, documented, result) = match model {
@@ -105,4 +110,54 @@ pub(crate) fn estimate(
     }
     let errors = (est.len() == fine.len()).then(|| est.iter().map(|e| e.error).collect());
     Ok(Estimate { line, errors })
+}
+
+/// The estimate of a model with its own levels
+/// (`palpate_fe::cylinder::Cylinder::own_levels`, a cylinder between
+/// platens): the other two levels solved, the error per sample from the
+/// three (`palpate_fe::accuracy::from_levels`).
+fn own_levels(
+    m: &palpate_fe::N1Needle,
+    levels: [f64; 3],
+    run: usize,
+    theta: &[f64],
+    loading: &Loading,
+    fine: &[f64],
+    show: bool,
+) -> anyhow::Result<Estimate> {
+    let mut forces: [Vec<f64>; 3] = Default::default();
+    for (i, &level) in levels.iter().enumerate() {
+        if i == run {
+            forces[i] = fine.to_vec();
+            continue;
+        }
+        let (bar, mut cb) = progress_bar(
+            loading.len(),
+            &format!("mesh level {level} for the error estimate: "),
+            show,
+        );
+        let r = m.with_level(level).simulate(theta, loading, Some(&mut cb));
+        drop(cb);
+        bar.finish_and_clear();
+        forces[i] = match r {
+            Ok((sim, _)) => sim.forces,
+            Err(palpate_core::ForwardError::NotConverged { completed, .. }) => completed,
+            Err(e) => {
+                return Ok(Estimate {
+                    line: format!(
+                        "discretisation error: not estimated, the solve at mesh level {level} failed: {e}"
+                    ),
+                    errors: None,
+                })
+            }
+        };
+    }
+    let errors = palpate_fe::accuracy::from_levels([&forces[0], &forces[1], &forces[2]], run)
+        .map_err(|e| anyhow!("{e}"))?;
+    let line = palpate_fe::accuracy::levels_line(levels, &loading.drive, fine, &errors);
+    let per_sample = (errors.len() == fine.len()).then(|| errors.iter().map(|e| e.error).collect());
+    Ok(Estimate {
+        line,
+        errors: per_sample,
+    })
 }

@@ -14,6 +14,8 @@
 //!   regions, facet sets and node sets).
 //! * [`jacobian`] — corner Jacobian determinants (the inversion test).
 //! * [`ogrid`] — the quarter O-grid of hexahedra around a tool's axis (N3).
+//! * [`rim`] — a rectangle refined about one point of its top (a punch's
+//!   rim) in a window about it only.
 //! * [`quadratic`] — order elevation, 4-node to 9-node quadrilaterals and
 //!   8-node to 27-node hexahedra.
 //! * [`vtu`] — VTK XML UnstructuredGrid output of a mesh or a facet set,
@@ -29,6 +31,7 @@ pub mod jacobian;
 pub mod locate;
 pub mod ogrid;
 pub mod quadratic;
+pub mod rim;
 pub mod structured;
 pub mod vtu;
 
@@ -41,6 +44,7 @@ use crate::FeError;
 pub use grading::Grading;
 pub use inclusions::InclusionBlock;
 pub use locate::{Interpolant, Locator};
+pub use rim::RimWindow;
 
 /// The shape of a cell or facet.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]

@@ -41,10 +41,14 @@
 //!   | needle (tip `rho`) | | `5 rho / 2.5` | `0.4 rho / 2.5` (N1's [`MeshDensity`]) | |
 //!   | sphere `R` | `sqrt(R d)` (at most `R`) | `2 a` | `a / 5` | `R / 10` |
 //!   | cone `alpha`, tip `rho` | `2 d tan(alpha) / pi + rho` | `2 a` | `a / 5` | `height / 10` |
-//!   | flat punch `a`, edge `rho` | `a` | `1.5 a` | `a / 10` | `a / 10` |
+//!   | flat punch `a`, edge `rho` | `a` | `1.5 a` | `a / 5` (growth `1 + 0.4 / level`), and about the rim `min(rho / 2, a / 40)` | `a / 10` |
 //!   | platens | | the whole body | `min(radius, height) / 8`, uniform (`height` the modelled half's when mirrored) | `0.3 height` |
 //!
-//!   A zone larger than the body is the whole body.
+//!   A zone larger than the body is the whole body. About a flat punch's
+//!   rim the mesh has a window of half-width `a / 2` ([`crate::mesh::rim`]:
+//!   nested rings of elements growing from the rim's size by `1 + 0.5`
+//!   per ring, radially and in depth), so that the small elements stay
+//!   near the rim instead of running along whole mesh lines.
 
 use palpate_material::Law;
 
@@ -67,6 +71,17 @@ pub type Cylinder = N1Needle;
 /// The growth of the elements away from a flat punch's rim per unit
 /// distance ([`EdgeBand::slope`]).
 pub const EDGE_SLOPE: f64 = 0.5;
+
+/// A flat punch's element size at level 1 outside its rim's window, per
+/// unit punch radius: the contact's interior and the far field converge on
+/// elements twice N1's relative size; the rim's singular pressure is
+/// resolved by the window ([`crate::mesh::rim`]; docs/validation/fe.md,
+/// "Sneddon's flat punch").
+pub const PUNCH_SIZE: f64 = 0.2;
+
+/// A flat punch's element growth beyond its fine zone ([`Sizing::growth`]:
+/// `1 + 0.4 / level`).
+pub const PUNCH_GROWTH: f64 = 0.4;
 
 /// The default mesh level of a description without `mesh.level`.
 pub const DEFAULT_LEVEL: f64 = 2.0;
@@ -369,10 +384,12 @@ impl N1Setup {
                         edge_radius: rho,
                     },
                     &t.friction,
+                    // coarse away from the rim, whose window
+                    // (`edge_band`) takes the small elements
                     Sizing {
-                        h: 0.1 * a,
+                        h: PUNCH_SIZE * a,
                         fine_zone: 1.5 * a,
-                        growth: 0.2,
+                        growth: PUNCH_GROWTH,
                         level,
                     },
                     d / 5.0,
@@ -435,8 +452,8 @@ impl N1Setup {
         m.fine_zone = sizing.fine_zone;
         m.sizing = Some(sizing);
         m.element = element;
-        // the punch's rim: a band graded to half its rounding (at most a
-        // quarter of the fine size) at level 1
+        // the punch's rim: a window about it graded to half its rounding
+        // (at most a fortieth of the punch's radius) at level 1
         if let ToolShape::FlatPunch {
             radius: a,
             edge_radius: rho,
@@ -444,7 +461,7 @@ impl N1Setup {
         {
             m.edge_band = Some(EdgeBand {
                 r: a,
-                h: (0.5 * rho).min(0.25 * sizing.h),
+                h: (0.5 * rho).min(0.025 * a),
                 slope: EDGE_SLOPE,
             });
         }
@@ -493,5 +510,22 @@ impl Cylinder {
     /// ([`N1Setup::from_experiment`]).
     pub fn from_experiment(e: &Experiment) -> Result<Cylinder, FeError> {
         Ok(FeModel::from_setup(N1Setup::from_experiment(e)?))
+    }
+
+    /// For a cylinder between platens meshed by its description's rule:
+    /// the levels of that rule whose forces estimate a run's
+    /// discretisation error, and which is the run
+    /// ([`crate::accuracy::levels_about`], [`crate::accuracy::from_levels`]).
+    /// Between platens the needle's order of convergence does not hold: the
+    /// side rolling onto the platen's edge makes the force converge
+    /// unevenly (at friction 0.28, level 1 is 8.4 % below level 2 at 60 %
+    /// compression, docs/notes/2026-11-29-platen-friction-level1.md), so
+    /// the estimate is made from the tool's own levels. `None` for other
+    /// tools and for a mesh given as a grading.
+    pub fn own_levels(&self) -> Option<([f64; 3], usize)> {
+        match (self.tool, self.sizing, self.grading) {
+            (ToolShape::Platen, Some(s), None) => Some(crate::accuracy::levels_about(s.level)),
+            _ => None,
+        }
     }
 }

@@ -46,8 +46,7 @@ use crate::dofs::Dirichlet;
 use crate::kernel::kernel_for;
 use crate::kinematics::Kinematics;
 use crate::material::LawMaterial;
-use crate::mesh::grading::refine_towards;
-use crate::mesh::{Grading, Mesh};
+use crate::mesh::{Grading, Mesh, RimWindow};
 use crate::model::{
     doubled, friction_param, graded_mesh_words, law_space, Bulk, FeModel, Path, PlaneCell, Setup,
     Support,
@@ -201,11 +200,10 @@ pub struct N1Setup {
 }
 
 /// The mesh about a tool's edge, where the contact pressure is singular (a
-/// flat punch's rim at radius `r` on the top face): the radial mesh lines
-/// about `r` and the axial ones under the top are split to elements of `h`
-/// mm there, growing by about `1 + slope` per element until they meet the
-/// grading's ([`crate::mesh::grading::refine_towards`]), as Q1 refines its
-/// punch edge ([`crate::Q1Setup::edge_refinement`]).
+/// flat punch's rim at radius `r` on the top face): a window about it, of
+/// half the smaller of `r` and the grading's fine zone, in which elements
+/// of `h` mm at the edge grow by about `1 + slope` per element, radially
+/// and in depth, until they meet the grading's ([`crate::mesh::rim`]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct EdgeBand {
     /// Radius of the edge (mm).
@@ -379,15 +377,24 @@ impl N1Setup {
                 &self.interfaces(),
             )?,
             (Some(b), map) => {
-                let h = self.edge_size(&b);
-                let rs = refine_towards(&g.positions(self.radius)?, b.r, h, b.slope);
-                let zs = match map {
-                    None => refine_towards(&g.positions(self.height)?, 0.0, h, b.slope),
-                    Some(map) => {
-                        map.apply(&refine_towards(&g.positions(map.from)?, 0.0, h, b.slope))
-                    }
+                let ts = match map {
+                    None => g.positions(self.height)?,
+                    Some(map) => map.apply(&g.positions(map.from)?),
                 };
-                Mesh::lines_in_layers(&rs, &zs, self.height, &self.interfaces())?
+                let window = RimWindow {
+                    centre: b.r,
+                    half_width: 0.5 * b.r.min(g.fine_length),
+                    spacing: g.h_fine,
+                    h: self.edge_size(&b),
+                    slope: b.slope,
+                };
+                Mesh::rim_refined(
+                    &g.positions(self.radius)?,
+                    &ts,
+                    self.height,
+                    &self.interfaces(),
+                    window,
+                )?
             }
         };
         match self.element {
