@@ -19,6 +19,7 @@
 //! these. The effects of the gap diagnosis it offers are in
 //! `models/n1_effects.rs`.
 
+use palpate_core::enrichable::EffectForm;
 use palpate_core::{Drive, Effect, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec};
 use palpate_enrich::prony_params;
 use palpate_material::Law;
@@ -918,6 +919,9 @@ impl Setup for N1Setup {
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         self.enriched(effect)
+    }
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        self.enriched_forms(effect)
     }
 }
 
