@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Independent reference values for the phantom database study's ANOVA of
 the modulus on family x thinner, in kPa and in ln kPa (the
-`replicates_summary` step, studies/src/steps/replicates_summary.rs, whose
+`replicates_summary` step, studies/src/steps/replicates_summary/anova.rs, whose
 unit test compares with them to 6 significant digits).
 
 Input: the per-record moduli a run of studies/phantom-database.toml writes

@@ -7,9 +7,10 @@
 //! conversion of solver failures into [`ForwardError`].
 
 use palpate_core::{
-    check_output_slots, enrichable::not_applicable, Drive, Effect, Enrichable, Evaluator,
-    ForwardError, ForwardModel, Loading, Observable, Output, ParamRole, ParamSpace, ParamSpec,
-    Sensitivities,
+    check_output_slots,
+    enrichable::{not_applicable, one_form, EffectForm},
+    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable, Output,
+    ParamRole, ParamSpace, ParamSpec, Sensitivities,
 };
 use palpate_material::{Law, Volumetric};
 
@@ -238,6 +239,11 @@ pub trait Setup: Clone + std::fmt::Debug + PartialEq + Send + Sync + 'static {
     /// The model with `effect` ([`Enrichable::enrich`]).
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         Err(not_applicable(effect, &self.name()))
+    }
+    /// The forms of `effect` ([`Enrichable::enrich_forms`]), the first the
+    /// one [`Setup::enrich`] gives. Default: that one alone.
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        Ok(one_form(self.enrich(effect)?))
     }
     /// Whether some parameters move the geometry (a specimen's thickness):
     /// the mesh is then built per run from [`Setup::geometry`], and the
@@ -508,6 +514,9 @@ impl<S: Setup> Enrichable for FeModel<S> {
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
         self.setup.enrich(effect)
+    }
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        self.setup.enrich_forms(effect)
     }
 }
 

@@ -3,10 +3,11 @@
 //! described height the enriched model is the base, bit for bit; at
 //! another thickness it is close to the description of that thickness
 //! (the same cells stretched below the fine zone instead of a mesh of its
-//! own); the N1 benchmark model keeps the sliding switch. The fast test
-//! of the effect that `experiment_diagnose.rs` diagnoses with.
+//! own); the sliding base is its second form, on a described cylinder as
+//! on the N1 model. The fast test of the effect that
+//! `experiment_diagnose.rs` diagnoses with.
 
-use palpate_core::enrichable::{effects_of, embed, enrich};
+use palpate_core::enrichable::{effects_of, embed, enrich, enrich_forms};
 use palpate_core::{Drive, Effect, ForwardModel, Loading};
 use palpate_fe::experiment::Experiment;
 use palpate_fe::N1Needle;
@@ -70,9 +71,13 @@ fn a_described_bonded_cylinder_offers_its_thickness() {
 }
 
 #[test]
-fn the_n1_model_keeps_its_sliding_base() {
+fn the_sliding_base_is_the_second_form_on_every_cylinder() {
     let n1 = N1Needle::new(Law::NeoHookean);
-    let rich = enrich(&n1, Effect::BoundaryCondition).unwrap();
-    assert_eq!(rich.space().len(), n1.space().len());
-    assert!(rich.name().contains("sliding base"), "{}", rich.name());
+    for model in [gel(40.0), Box::new(n1) as Box<dyn ForwardModel>] {
+        let forms = enrich_forms(model.as_ref(), Effect::BoundaryCondition).unwrap();
+        let names: Vec<&str> = forms.iter().map(|f| f.name.as_str()).collect();
+        assert_eq!(names, ["thickness", "sliding_base"], "{}", model.name());
+        assert_eq!(forms[1].model.space().len(), model.space().len());
+        assert!(forms[1].model.name().contains("sliding base"));
+    }
 }

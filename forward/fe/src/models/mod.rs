@@ -3,7 +3,8 @@
 //!
 //! * [`n1`] — N1, needle indentation of a cylinder (axisymmetric), and
 //!   [`cylinder`], the axisymmetric cylinder of an experiment description
-//!   (N1's setup with any tool, support, layers and materials);
+//!   (N1's setup with any tool, support, layers and materials), and
+//!   `n1_effects`, the effects of the gap diagnosis they offer;
 //! * [`n3`] — N3, the same needle on a block in 3D (quarter model);
 //! * [`c1`] — C1, compression of a short cylinder between platens;
 //! * [`q1`] — Q1, flat-punch ramp-and-hold indentation, and
@@ -15,6 +16,7 @@
 pub mod c1;
 pub mod cylinder;
 pub mod n1;
+mod n1_effects;
 pub mod n3;
 pub mod q1;
 pub mod r2;

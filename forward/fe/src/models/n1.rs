@@ -16,25 +16,12 @@
 //! horizontal bands of several materials ([`N1Setup::layers`]), Prony
 //! terms fixed or as parameters, and a mesh by a sizing rule at any level
 //! ([`Sizing`], [`N1Needle::with_level`]). N1 is the preset with none of
-//! these. Effects:
-//!
-//! * `friction` — the friction coefficient becomes a parameter (bounds 0..2).
-//! * `boundary_condition` — the base slides radially (`u_z = 0` only) instead
-//!   of being bonded. This is a discrete switch: the enriched model has the
-//!   same parameters as the base model, and a gap diagnosis compares the two
-//!   fits. (A continuous bonded-to-sliding blend would need a base spring
-//!   whose stiffness spans many decades, badly conditioned near "bonded";
-//!   the switch answers the same question.)
-//! * `material_form` — the next richer law (neo-Hookean -> reduced
-//!   polynomial N=2 with a stiffening C20 >= 0, ...; `palpate_enrich::richer_law`).
-//! * `zero_offset` — contact starts at a recorded displacement d0
-//!   (`palpate_enrich::ZeroOffset`, the same wrapper as for C1).
+//! these. The effects of the gap diagnosis it offers are in
+//! `models/n1_effects.rs`.
 
-use palpate_core::{
-    enrichable::not_applicable, Drive, Effect, ForwardError, ForwardModel, Loading, ParamSpace,
-    ParamSpec,
-};
-use palpate_enrich::{prony_params, richer_law, MaterialForm, ZeroOffset};
+use palpate_core::enrichable::EffectForm;
+use palpate_core::{Drive, Effect, ForwardError, ForwardModel, Loading, ParamSpace, ParamSpec};
+use palpate_enrich::prony_params;
 use palpate_material::Law;
 use std::sync::Arc;
 
@@ -469,7 +456,7 @@ impl N1Setup {
     }
 
     /// The number of parameters after the law's.
-    fn extra_len(&self) -> usize {
+    pub(super) fn extra_len(&self) -> usize {
         2 * self.prony_parameters
             + self
                 .materials
@@ -929,159 +916,27 @@ impl Setup for N1Setup {
     fn has_geometric_parameters(&self) -> bool {
         self.thickness_is_parameter
     }
-    /// With the thickness a parameter: the specimen at that thickness,
-    /// meshed by the lines of its own height moved with the base.
+    /// With the thickness a parameter: the specimen at that thickness
+    /// ([`N1Setup::at_thickness`]).
     fn geometry(&self, extra: &[f64]) -> Result<N1Setup, FeError> {
-        let mut g = self.clone();
-        if self.thickness_is_parameter {
-            let n = self.extra_len();
-            let h = *extra.get(n - 1).ok_or_else(|| FeError::InvalidConfig {
-                field: "parameters".into(),
-                reason: format!("{} parameters after the law's, {n} expected", extra.len()),
-            })?;
-            if !(h > 0.0 && h.is_finite()) {
-                return Err(FeError::InvalidConfig {
-                    field: "thickness_mm".into(),
-                    reason: format!("{h} mm: expected a finite thickness > 0"),
-                });
-            }
-            g.mesh_height = Some(self.mesh_height.unwrap_or(self.height));
-            g.height = h;
-        }
-        Ok(g)
+        self.at_thickness(extra)
     }
     fn effects(&self) -> Option<Vec<Effect>> {
-        let mut v = Vec::new();
-        if self.friction_offered() {
-            v.push(Effect::Friction);
-        }
-        if self.base == Support::Bonded
-            && self.base_friction.is_none()
-            && !self.thickness_is_parameter
-        {
-            v.push(Effect::BoundaryCondition);
-        }
-        // (one enrichment at a time: the richer law of a model whose friction
-        // is already a parameter is not offered)
-        if self.material_form_offered() {
-            v.push(Effect::MaterialForm);
-        }
-        v.push(Effect::ZeroOffset);
-        if self.modelling_space_applies() {
-            v.push(Effect::ModellingSpace);
-        }
-        Some(v)
+        Some(self.offered_effects())
     }
     fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        match effect {
-            Effect::Friction if self.friction_offered() => {
-                let mut m = self.clone();
-                m.friction_is_parameter = true;
-                if let Some(space) = &mut m.space {
-                    // the tool's friction comes before the base's
-                    let at = space.params.len() - usize::from(m.base_friction_is_parameter);
-                    space.params.insert(at, friction_param(m.friction));
-                }
-                Ok(Box::new(FeModel::from_setup(m)))
-            }
-            Effect::BoundaryCondition if self.thickness_offered() => {
-                let mut m = self.clone();
-                m.thickness_is_parameter = true;
-                let p = self.thickness_param();
-                if let Some(space) = &mut m.space {
-                    space.params.push(p);
-                }
-                Ok(Box::new(FeModel::from_setup(m)))
-            }
-            Effect::BoundaryCondition
-                if self.base == Support::Bonded
-                    && self.base_friction.is_none()
-                    && !self.thickness_is_parameter =>
-            {
-                let mut m = self.clone();
-                m.base = Support::Sliding;
-                Ok(Box::new(FeModel::from_setup(m)))
-            }
-            Effect::MaterialForm if self.material_form_offered() => {
-                let richer = richer_law(&self.law).expect("checked above");
-                let mut inner = self.clone();
-                inner.law = richer.law;
-                inner.space = None;
-                let space = richer.space.clone();
-                inner.law_bounds = Some(space.clone());
-                Ok(Box::new(MaterialForm::new(
-                    Box::new(FeModel::from_setup(inner)),
-                    richer.embed_law_params.clone(),
-                    self.law.to_string(),
-                    space,
-                )))
-            }
-            Effect::ZeroOffset => Ok(Box::new(ZeroOffset::from_arc(Arc::new(
-                FeModel::from_setup(self.clone()),
-            )))),
-            Effect::ModellingSpace if self.modelling_space_applies() => Ok(Box::new(self.in_3d())),
-            _ => Err(not_applicable(effect, &self.name())),
-        }
+        self.enriched(effect)
+    }
+    fn enrich_forms(&self, effect: Effect) -> Result<Vec<EffectForm>, ForwardError> {
+        self.enriched_forms(effect)
     }
 }
 
 impl N1Setup {
-    /// Whether the parameters after the law's are none (the model is the
-    /// law's alone, as the richer law's wrapper needs).
-    fn law_only(&self) -> bool {
-        self.prony_parameters == 0
-            && self.materials.is_empty()
-            && !self.friction_is_parameter
-            && !self.base_friction_is_parameter
-            && !self.thickness_is_parameter
-    }
-
-    /// Whether `friction` is offered: the tool's coefficient is a finite
-    /// number (and the thickness, which must stay the last parameter, is
-    /// not one).
-    fn friction_offered(&self) -> bool {
-        !self.friction_is_parameter && self.friction.is_finite() && !self.thickness_is_parameter
-    }
-
-    /// Whether `boundary_condition` is the specimen's finite thickness: a
-    /// described cylinder (an experiment description's, whose height a lab
-    /// may have given wrong or as "a large block") of one material on a
-    /// bonded base, pressed by a tool (not platens, whose travel is the
-    /// height's), with room below the fine zone to move its base. The N1
-    /// benchmark model keeps the sliding switch that its withheld-effect
-    /// records were made with.
-    fn thickness_offered(&self) -> bool {
-        self.space.is_some()
-            && self.base == Support::Bonded
-            && self.base_friction.is_none()
-            && self.layers.is_empty()
-            && !self.mirror
-            && self.tool != ToolShape::Platen
-            && !self.thickness_is_parameter
-            && self.thickness_range().is_some()
-    }
-
     /// The fine zone's depth (mm): the mesh lines above it stay where they
     /// are when the thickness changes.
-    fn kept_depth(&self) -> f64 {
+    pub(super) fn kept_depth(&self) -> f64 {
         self.effective_grading().fine_length
-    }
-
-    /// The range of the thickness parameter (mm): from one and a half
-    /// fine zones (and a tenth of the height) to twice the height; `None`
-    /// when the fine zone leaves no room.
-    fn thickness_range(&self) -> Option<(f64, f64)> {
-        let h = self.mesh_height.unwrap_or(self.height);
-        let lower = (1.5 * self.kept_depth()).max(0.1 * h);
-        (lower < 0.9 * h).then_some((lower, 2.0 * h))
-    }
-
-    /// The `thickness_mm` parameter, starting at the height (the effect
-    /// off: the base model, bit for bit).
-    fn thickness_param(&self) -> ParamSpec {
-        let h = self.mesh_height.unwrap_or(self.height);
-        let (lower, upper) = self.thickness_range().unwrap_or((h, h));
-        ParamSpec::new("thickness_mm", "mm", lower, upper, h)
     }
 
     /// How the axial mesh lines are stretched: from `mesh_height` to
@@ -1093,50 +948,6 @@ impl N1Setup {
             to: self.height,
             keep: self.kept_depth().min(0.5 * from.min(self.height)),
         })
-    }
-
-    /// Whether `material_form` is offered: one material, its law's
-    /// parameters the only ones, and a richer law exists.
-    fn material_form_offered(&self) -> bool {
-        self.law_only() && richer_law(&self.law).is_some()
-    }
-}
-
-impl N1Setup {
-    /// Whether `modelling_space` is offered: the axisymmetric model of N1's
-    /// 70 x 80 mm cylinder with a bonded base, its friction fixed, elastic
-    /// (N3 is that specimen's block, with neither a sliding base nor
-    /// viscoelasticity).
-    fn modelling_space_applies(&self) -> bool {
-        // the 3D model is N3's block, the 3D counterpart of N1's specimen only
-        self.radius == 35.0
-            && self.height == 80.0
-            && !self.mirror
-            && self.base == Support::Bonded
-            && self.base_friction.is_none()
-            && self.law_only()
-            && self.layers.is_empty()
-            && self.friction.is_finite()
-            && self.tool != ToolShape::Platen
-            && self.prony.is_none()
-    }
-
-    /// The `modelling_space` enrichment: the same needle, law, bulk
-    /// treatment and friction in 3D ([`crate::N3Needle`], docs/benchmarks.md N3:
-    /// the quarter of a 70 x 80 x 80 mm block, 8-node mixed hexahedra, mesh
-    /// level 1, 25-41 s of CPU to 10 mm against N1's ~1.5 s on the coarse
-    /// mesh). A discrete switch like `boundary_condition`: the same
-    /// parameters, compared by their two fits. The cylinder of N1 (radius
-    /// 35 mm) becomes N3's square block (half-widths 35 and 40 mm), part of
-    /// what "3D instead of axisymmetric" means for this specimen.
-    pub fn in_3d(&self) -> crate::N3Needle {
-        let mut m = crate::N3Needle::new(self.law);
-        m.bulk = self.bulk;
-        m.friction = self.friction;
-        m.tool = self.tool;
-        m.penalty = self.penalty;
-        m.penetration_tol = self.penetration_tol;
-        m
     }
 }
 

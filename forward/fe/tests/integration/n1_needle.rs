@@ -125,16 +125,22 @@ fn forces_are_bit_identical_on_one_and_two_threads() {
     }
 }
 
-/// GAP.md `boundary_condition`: the enriched model slides on its base
-/// (u_z = 0 only), keeps the parameters, and is a little softer than the
-/// bonded one (the base is 80 mm below a 2 mm indentation, so the change is
-/// small but not zero).
+/// GAP.md `boundary_condition` in its `sliding_base` form: the enriched
+/// model slides on its base (u_z = 0 only), keeps the parameters, and is a
+/// little softer than the bonded one (the base is 80 mm below a 2 mm
+/// indentation, so the change is small but not zero). Its default form,
+/// the thickness as a parameter, is tested in `models/n1_effects.rs`.
 #[test]
 fn boundary_condition_effect_gives_a_sliding_base() {
     let m = model("neo-hookean", 0.8);
     let effects = m.effects();
     assert!(effects.contains(&Effect::Friction) && effects.contains(&Effect::BoundaryCondition));
-    let sliding = m.enrich(Effect::BoundaryCondition).unwrap();
+    let forms = m.enrich_forms(Effect::BoundaryCondition).unwrap();
+    let sliding = &forms
+        .iter()
+        .find(|f| f.name == "sliding_base")
+        .expect("a sliding_base form")
+        .model;
     assert_eq!(sliding.space().len(), m.space().len());
     assert!(
         sliding.name().contains("sliding base"),
