@@ -77,10 +77,10 @@ fn modelling_space_turns_the_axisymmetric_needle_into_the_3d_one() {
     );
     assert!(n3.name().contains("friction 0.3"), "{}", n3.name());
     assert_eq!(embed(n3.as_ref(), &[1e-3]), [1e-3]);
-    // not offered where N3 lacks the physics: a sliding base, friction as
-    // a parameter
-    let sliding = enrich(&n1, Effect::BoundaryCondition).unwrap();
-    assert!(!effects_of(sliding.as_ref()).contains(&Effect::ModellingSpace));
+    // not offered where N3 lacks the physics: a different support (the
+    // thickness or a sliding base), friction as a parameter
+    let support = enrich(&n1, Effect::BoundaryCondition).unwrap();
+    assert!(!effects_of(support.as_ref()).contains(&Effect::ModellingSpace));
     let rough = enrich(&n1, Effect::Friction).unwrap();
     assert!(!effects_of(rough.as_ref()).contains(&Effect::ModellingSpace));
 }
