@@ -3,10 +3,9 @@
 //! ([`palpate_studies::api::simulate::simulate`], the force curve out),
 //! `calibrate` ([`palpate_studies::api::calibrate`] and
 //! [`palpate_studies::api::calibrate_experiment`], the data in), `diagnose`
-//! ([`palpate_studies::api::diagnose`], the record in), and
-//! `sample_arrays` (the data in, the draws out; still the command line's
-//! options, [`palpate_studies::cli::sample::draw`]). The GIL is released
-//! while they run.
+//! ([`palpate_studies::api::diagnose`], the record in), and `sample`
+//! ([`palpate_studies::api::sample::sample`], the data in, the draws out).
+//! The GIL is released while they run.
 //!
 //! The options are typed keywords; the texts among them (law, residual,
 //! estimator, a record's `TEST[key=value]` form) are read by the same
@@ -21,10 +20,10 @@
 //!   the array's memory is the Vec's, owned by a Rust container object that
 //!   is the array's `base`).
 
-use crate::{parse_cli, to_py, PalpateError};
+use crate::{to_py, PalpateError};
 use numpy::{PyArray1, PyReadonlyArray1};
-use palpate_studies::api::{self, simulate::SimulateOptions, Observer, Silent, Stderr};
-use palpate_studies::cli::{sample, Command};
+use palpate_studies::api::{self, sample::SampleOptions, simulate::SimulateOptions};
+use palpate_studies::api::{Observer, Silent, Stderr};
 use palpate_studies::records::arrays::ArrayRecord;
 use palpate_studies::records::data_option::{read_data_with, read_force_records};
 use palpate_studies::records::ReadOptions;
@@ -38,17 +37,6 @@ type PyRecord<'py> = (Vec<String>, Vec<PyReadonlyArray1<'py, f64>>);
 /// A record's names and its columns as slices (borrowed, or copied when
 /// the array was not contiguous).
 type Columns<'a> = (Vec<String>, Vec<Cow<'a, [f64]>>);
-
-/// The command line `palpate NAME ARGS...` parsed.
-fn parse(name: &str, args: Vec<String>) -> PyResult<Command> {
-    Ok(parse_cli(std::iter::once(name.to_string()).chain(args).collect())?.command)
-}
-
-/// The error for a subcommand other than `expected` (not reachable from
-/// the Python package, which names the subcommand itself).
-fn other(expected: &str) -> PyErr {
-    crate::PalpateError::new_err(format!("expected the options of `palpate {expected}`"))
-}
 
 /// The columns of the records as slices: borrowed when contiguous, else
 /// copied once (returned in the Cow).
@@ -120,7 +108,10 @@ fn json_to_py<'py>(py: Python<'py>, v: &serde_json::Value) -> PyResult<Bound<'py
 /// ([`palpate_studies::api::simulate::simulate`]) with the arrays moved
 /// out of palpate's Vecs: a dict of `displacement_mm`, `force_N` and, when
 /// present, `time_s`, `error_estimate_N`, with `comments` (the CSV's
-/// comment lines) and `title`.
+/// comment lines) and `title`. R2: the scan
+/// ([`palpate_studies::api::simulate::r2::scan`]), `position_mm`,
+/// `force_N`, `force_x_N`, `error_estimate_N` and the pressing phase
+/// (`press_displacement_mm`, `press_force_N`, `press_force_x_N`).
 #[pyfunction]
 #[pyo3(signature = (
     benchmark=None, experiment=None, law=None, params=Vec::new(), *, friction=None, rd=None,
@@ -193,6 +184,28 @@ pub fn simulate<'py>(
         hold,
     };
     let show = observer(verbose);
+    if options.benchmark().eq_ignore_ascii_case("r2") {
+        let s = py
+            .detach(|| api::simulate::r2::scan(&options, show))
+            .map_err(to_py)?
+            .scan;
+        let d = PyDict::new(py);
+        d.set_item("position_mm", PyArray1::from_vec(py, s.position_mm))?;
+        d.set_item("force_N", PyArray1::from_vec(py, s.force_n))?;
+        d.set_item("force_x_N", PyArray1::from_vec(py, s.force_x_n))?;
+        if let Some(e) = s.error_estimate_n {
+            d.set_item("error_estimate_N", PyArray1::from_vec(py, e))?;
+        }
+        d.set_item(
+            "press_displacement_mm",
+            PyArray1::from_vec(py, s.press_depth_mm),
+        )?;
+        d.set_item("press_force_N", PyArray1::from_vec(py, s.press_force_n))?;
+        d.set_item("press_force_x_N", PyArray1::from_vec(py, s.press_force_x_n))?;
+        d.set_item("comments", s.comments)?;
+        d.set_item("title", s.title)?;
+        return Ok(d);
+    }
     let c = py
         .detach(|| api::simulate::simulate(&options, show).map(|s| s.curve))
         .map_err(to_py)?;
@@ -315,30 +328,158 @@ pub fn diagnose<'py>(
     json_to_py(py, &value)
 }
 
-/// `palpate sample ARGS` with `--data TEST=<array:K>` taking the K-th of
-/// `records`. Returns (names, draws, n_chains, n_draws, summary JSON): the
-/// draws a flat float64 array moved out of palpate's Vec, chain-major
-/// (reshape to (n_chains, n_draws, len(names)) for a view).
+/// The posterior of `law`'s (or `experiment`'s) parameters
+/// ([`palpate_studies::api::sample::sample`]) on the records `data`
+/// (`TEST=FILE`, a benchmark's or experiment's `FILE`, with `<array:K>`
+/// for the K-th of `records`). Returns (names, draws, n_chains, n_draws,
+/// report, table, warnings): the draws a flat float64 array moved out of
+/// palpate's Vec, chain-major (reshape to (n_chains, n_draws, len(names))
+/// for a view), the report the `--json` of `palpate sample` as Python
+/// data, the table and warnings the command line prints.
 #[pyfunction]
-#[allow(clippy::type_complexity)]
-pub fn sample_arrays<'py>(
+#[pyo3(signature = (
+    law, data, records, *, experiment=None, benchmark=None, sampler="nuts", draws=None,
+    max_draws=None, tune=None, parallel=None, seed=0, sigma=None, ar1=false, prior=Vec::new(),
+    boxes=Vec::new(), mesh=None, bulk=None, friction=None, prony=None, edge_radius=None,
+    design=None, holdout=None, cache=None, evidence=false, verbose=false
+))]
+#[allow(clippy::too_many_arguments, clippy::type_complexity)]
+pub fn sample<'py>(
     py: Python<'py>,
-    args: Vec<String>,
+    law: Option<String>,
+    data: Vec<String>,
     records: Vec<PyRecord<'py>>,
-) -> PyResult<(Vec<String>, Bound<'py, PyArray1<f64>>, usize, usize, String)> {
-    let Command::Sample(a) = parse("sample", args)? else {
-        return Err(other("sample"));
-    };
+    experiment: Option<String>,
+    benchmark: Option<String>,
+    sampler: &str,
+    draws: Option<usize>,
+    max_draws: Option<usize>,
+    tune: Option<usize>,
+    parallel: Option<usize>,
+    seed: u64,
+    sigma: Option<f64>,
+    ar1: bool,
+    prior: Vec<String>,
+    boxes: Vec<String>,
+    mesh: Option<String>,
+    bulk: Option<String>,
+    friction: Option<f64>,
+    prony: Option<String>,
+    edge_radius: Option<f64>,
+    design: Option<usize>,
+    holdout: Option<usize>,
+    cache: Option<std::path::PathBuf>,
+    evidence: bool,
+    verbose: bool,
+) -> PyResult<(
+    Vec<String>,
+    Bound<'py, PyArray1<f64>>,
+    usize,
+    usize,
+    Bound<'py, PyAny>,
+    String,
+    Vec<String>,
+)> {
     let cols = columns(&records);
     let recs = array_records(&cols);
-    let s = py.detach(|| sample::draw(&a, &recs)).map_err(to_py)?;
-    let summary = serde_json::to_string(&s.summary).map_err(|e| to_py(e.into()))?;
+    let show = observer(verbose);
+    let s = py
+        .detach(|| {
+            let options = SampleOptions {
+                law,
+                experiment,
+                benchmark,
+                data,
+                reading: ReadOptions::default(),
+                boxes,
+                mesh,
+                bulk,
+                friction,
+                prony,
+                edge_radius,
+                design,
+                holdout,
+                cache,
+                sampler: sampler.parse()?,
+                draws,
+                max_draws,
+                tune,
+                parallel,
+                seed,
+                sigma,
+                ar1,
+                priors: prior,
+                evidence,
+            };
+            api::sample::sample(&options, &recs, show)
+        })
+        .map_err(to_py)?;
+    let report = json_to_py(py, &s.report)?;
     let (n_chains, n_draws) = (s.chains.n_chains, s.chains.n_draws);
     Ok((
         s.names,
         PyArray1::from_vec(py, s.chains.values),
         n_chains,
         n_draws,
-        summary,
+        report,
+        s.table,
+        s.warnings,
     ))
+}
+
+/// The staged identification of one Q1 ramp-and-hold record
+/// ([`palpate_studies::api::identify::identify_q1`]): `data` is `FILE`,
+/// `Q1=FILE` or `<array:K>` for the K-th of `records`. Returns (report,
+/// text): the result as Python data (the `--json` of `palpate calibrate
+/// --benchmark Q1`) and the report the command line prints.
+#[pyfunction]
+#[pyo3(signature = (
+    law, data, records, *, stages=None, prony_terms=None, fit_mesh=None, correct_mesh=None,
+    time_step=None, edge_radius=None, fit_edge_radius=None, mesh_check=None, compare=false,
+    profile=false, verbose=false
+))]
+#[allow(clippy::too_many_arguments)]
+pub fn identify_q1<'py>(
+    py: Python<'py>,
+    law: String,
+    data: String,
+    records: Vec<PyRecord<'_>>,
+    stages: Option<String>,
+    prony_terms: Option<usize>,
+    fit_mesh: Option<f64>,
+    correct_mesh: Option<f64>,
+    time_step: Option<f64>,
+    edge_radius: Option<f64>,
+    fit_edge_radius: Option<f64>,
+    mesh_check: Option<f64>,
+    compare: bool,
+    profile: bool,
+    verbose: bool,
+) -> PyResult<(Bound<'py, PyAny>, String)> {
+    use palpate_studies::api::identify::{identify_q1, q1_record, Q1Options};
+    let cols = columns(&records);
+    let recs = array_records(&cols);
+    let show = observer(verbose);
+    let result = py
+        .detach(|| {
+            let options = Q1Options {
+                stages,
+                prony_terms,
+                fit_mesh,
+                correct_mesh,
+                time_step,
+                edge_radius,
+                fit_edge_radius,
+                mesh_check,
+                compare,
+                profile,
+            }
+            .for_law(&law)?;
+            let record = q1_record(&data, &recs)?;
+            identify_q1(&record, &options, show)
+        })
+        .map_err(to_py)?;
+    let text = palpate_studies::apps::two_stage::report(&result, None);
+    let value = serde_json::to_value(&result).map_err(|e| to_py(e.into()))?;
+    Ok((json_to_py(py, &value)?, text))
 }

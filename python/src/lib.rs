@@ -1,9 +1,8 @@
 //! `palpate._native`: the Rust side of the Python package (docs/python.md).
 //!
 //! It runs palpate's own implementations in this process: the typed
-//! library API ([`palpate_studies::api`]) for `simulate`, `calibrate` and
-//! `diagnose` ([`arrays`], numpy arrays in memory), `sample_arrays` (the
-//! command line's options parsed by its clap definitions), a subcommand of
+//! library API ([`palpate_studies::api`]) for `simulate`, `calibrate`,
+//! `sample` and `diagnose` ([`arrays`], numpy arrays in memory), a subcommand of
 //! the command line (`run_cli`, so the options, defaults and error messages
 //! are those of `palpate --help`), a study
 //! ([`palpate_studies::study::runner::run_study_counted`]) or the merge of
@@ -11,9 +10,8 @@
 //! the whole run (`Python::detach`), so Python threads (a Dask worker's
 //! other tasks) go on meanwhile. An error is raised as `PalpateError` with
 //! the message the command line prints (`error: ...` and each
-//! `caused by: ...`). The Q1 identification of `calibrate` and the R2 scan
-//! of `simulate` run the command line through `run_cli`, their records and
-//! outputs as temporary files.
+//! `caused by: ...`). The Q1 identification of `calibrate`
+//! (`identify_q1`) and the R2 scan of `simulate` call the API too.
 
 mod arrays;
 
@@ -65,12 +63,6 @@ fn try_parse(args: Vec<String>) -> PyResult<Result<Cli, String>> {
             }
         }
     }
-}
-
-/// [`try_parse`] where a help text is an error too (the array functions
-/// return results, not texts).
-pub(crate) fn parse_cli(args: Vec<String>) -> PyResult<Cli> {
-    try_parse(args)?.map_err(PalpateError::new_err)
 }
 
 /// Runs `palpate ARGS...` in this process, the GIL released. Returns the
@@ -153,6 +145,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(arrays::simulate, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::calibrate, m)?)?;
     m.add_function(wrap_pyfunction!(arrays::diagnose, m)?)?;
-    m.add_function(wrap_pyfunction!(arrays::sample_arrays, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::sample, m)?)?;
+    m.add_function(wrap_pyfunction!(arrays::identify_q1, m)?)?;
     Ok(())
 }

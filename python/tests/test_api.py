@@ -143,3 +143,52 @@ def test_a_study_run_is_quiet_and_an_object(tmp_path, capfd, monkeypatch):
     assert isinstance(run, palpate.StudyRun) and run.folder == tmp_path / "run"
     assert run.computed > 0 and run.results["study"]
     assert "results" not in repr(run) and "computed=" in repr(run)
+
+
+def message(call) -> str:
+    with pytest.raises(palpate.PalpateError) as e:
+        call()
+    return str(e.value)
+
+
+def test_sample_returns_the_table_and_warnings_quietly(capfd):
+    stretch, stress = treloar()
+    kw = dict(sampler="demc", draws=20, max_draws=20, tune=20, parallel=1, seed=1, arviz=False)
+    post = palpate.sample("neo-hookean", {"uniaxial": (stretch, stress)}, **kw)
+    assert capfd.readouterr() == ("", "")
+    assert post.table.startswith("demc on uniaxial neo-hookean"), post.table
+    # 20 draws cannot reach the bulk ESS of 400
+    assert post.warnings and post.warnings[0].startswith("warning: not converged"), post.warnings
+    # the table is the command line's, but for the wall time on its first line
+    palpate.cli("sample", "--law", "neo-hookean", "--data", f"uniaxial={TRELOAR}", "--sampler", "demc",
+                "--draws", "20", "--max-draws", "20", "--tune", "20", "--parallel", "1", "--seed", "1")
+    out, err = capfd.readouterr()
+    assert out.splitlines()[1:] == post.table.splitlines()[1:]
+    assert post.warnings[0] in err.splitlines()
+
+
+def test_fe_records_go_in_memory_and_errors_are_the_command_lines(tmp_path):
+    """The FE benchmarks of sample, the Q1 identification and the R2 scan
+    take their records and options in memory (no temporary file); their
+    refusals are the command line's, word for word."""
+    d, f = np.array([0.0, 0.5, 1.0]), np.array([0.0, 0.1, 0.3])
+    assert "Q1 arrays: a Q1 record is a timed ramp-and-hold: it needs a time_s column" in message(
+        lambda: palpate.calibrate("neo-hookean", (d, f), benchmark="Q1"))
+    assert "it needs a time_s column" in message(
+        lambda: palpate.sample("neo-hookean", (d, f), benchmark="Q1", box={"C10": (0.001, 0.01)}, arviz=False))
+    path = tmp_path / "q1.csv"
+    path.write_text("displacement_mm,force_N\n0,0\n0.5,0.1\n1,0.3\n")
+    assert message(lambda: palpate.calibrate("yeoh", {"uniaxial": TRELOAR}, stages="elastic")) == message(
+        lambda: palpate.cli("calibrate", "--law", "yeoh", "--data", f"uniaxial={TRELOAR}", "--stages", "elastic"))
+    assert message(lambda: palpate.calibrate("neo-hookean", path, benchmark="Q1", fit_mesh=-1.0)) == message(
+        lambda: palpate.cli("calibrate", "--benchmark", "Q1", "--law", "neo-hookean", "--data", str(path),
+                            "--fit-mesh", "-1"))
+    assert message(lambda: palpate.simulate("R2", nodules="75:15")) == message(
+        lambda: palpate.cli("simulate", "--benchmark", "R2", "--nodules", "75:15"))
+    assert message(lambda: palpate.simulate("R2", rd=1.0, params={"mu": 0.005})) == message(
+        lambda: palpate.cli("simulate", "--benchmark", "R2", "--rd", "1", "--param", "mu=0.005"))
+    # accuracy: a keyword of simulate, refused for C1 as the command line refuses it
+    assert message(lambda: palpate.simulate("C1", accuracy=0.01, error_estimate="off", **C1)) == message(
+        lambda: palpate.cli("simulate", "--benchmark", "C1", "--law", "neo-hookean", "--param", "C10=0.2",
+                            "--mesh", "coarse", "--depth", "1", "--step", "0.5", "--accuracy", "0.01",
+                            "--error-estimate", "off"))

@@ -9,11 +9,17 @@
 //! * [`diagnose::diagnose`]: the sim-to-real gap of a record
 //!   ([`diagnose::gap_options`] -> `GapReport`);
 //! * [`localize`]: nodules from an R2 rolled record ([`LocalizeOptions`] -> [`Localized`]);
+//! * [`identify::identify_q1`]: the staged identification of a Q1
+//!   ramp-and-hold record ([`identify::Q1Options`] -> `TwoStageResult`);
 //! * [`calibrate_experiment`]: fit an experiment description's parameters
 //!   to force records by finite elements ([`experiment_spec`] reads the
 //!   description, [`ExperimentFitOptions`]);
 //! * [`simulate::simulate`]: an FE benchmark's or experiment's force curve
-//!   ([`simulate::SimulateOptions`] -> [`simulate::Simulated`]);
+//!   ([`simulate::SimulateOptions`] -> [`simulate::Simulated`]), and
+//!   [`simulate::r2::scan`] the R2 scan (-> [`simulate::r2::Scan`]);
+//! * [`sample::sample`]: the posterior of a law's or an experiment's
+//!   parameters by MCMC ([`sample::SampleOptions`] -> [`sample::Sampled`]:
+//!   the draws, their diagnostics, the report);
 //! * [`run_study`] and [`check_study`]: a study manifest into its run folder,
 //!   or only checked.
 //!
@@ -45,6 +51,8 @@ use std::path::{Path, PathBuf};
 
 pub mod diagnose;
 mod estimate;
+pub mod identify;
+pub mod sample;
 pub mod simulate;
 
 /// Where a long run's lines (summaries, warnings, the error estimate) and

@@ -8,10 +8,10 @@ Arrays go in as numpy arrays (or file paths) and come out as numpy arrays
 in result objects (:class:`Calibration`, :class:`Curve`,
 :class:`Posterior`, :class:`Diagnosis`, :class:`StudyRun`; ``to_dict()``
 gives JSON-like data). The functions print nothing unless ``verbose=True``.
-``calibrate``, ``simulate`` and ``diagnose`` call palpate's typed library
-API (the functions the command line calls after reading its options);
-``calibrate``, ``simulate``, ``sample`` and ``diagnose`` pass arrays in
-memory (no copy at the boundary, docs/python.md says where).
+``calibrate``, ``simulate``, ``sample`` and ``diagnose`` call palpate's
+typed library API (the functions the command line calls after reading its
+options) and pass arrays in memory (no copy at the boundary, docs/python.md
+says where).
 
 See docs/python.md for a worked example.
 """
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import sys
 from pathlib import Path
 from typing import Any, Mapping
 
@@ -104,19 +104,6 @@ def _column(values: Any) -> np.ndarray:
     return a if a.ndim == 1 else a.ravel()
 
 
-def _write_record(value: Any, test: str | None, folder: str, name: str) -> str:
-    """A record as a file path: a path as it is; arrays written as CSV
-    (see :func:`_columns`), for the functions that read files only."""
-    columns = _columns(value, test, name)
-    if columns is None:
-        return os.fspath(value)
-    names, cols = columns
-    path = os.path.join(folder, f"{name}.csv")
-    # repr-exact: 17 significant digits read back to the same doubles.
-    np.savetxt(path, np.column_stack(cols), delimiter=",", header=",".join(names), comments="", fmt="%.17g")
-    return path
-
-
 def _data_in_memory(data: Any, benchmark: str | None) -> tuple[list[str], list]:
     """``--data`` options and the records they name: a record given as
     arrays is ``--data TEST=<array:K>`` with K its place in the list (passed
@@ -141,49 +128,11 @@ def _data_in_memory(data: Any, benchmark: str | None) -> tuple[list[str], list]:
     return out, records
 
 
-def _data_options(data: Any, benchmark: str | None, folder: str) -> list[str]:
-    """``--data`` options for a mapping {test: record} or one benchmark record."""
-    if benchmark is not None and not isinstance(data, Mapping) or _is_columns(data):
-        return ["--data", _write_record(data, None, folder, "record")]
-    if isinstance(data, (str, os.PathLike)):
-        return ["--data", os.fspath(data)]
-    out = []
-    for i, (test, rec) in enumerate(data.items()):
-        base = test.split("[", 1)[0]
-        path = _write_record(rec, base, folder, f"{i}-{base}")
-        out += ["--data", f"{test}={path}"]
-    return out
-
-
 def _is_columns(data: Any) -> bool:
     """A mapping of column names to arrays (one record), not of tests to records."""
     return isinstance(data, Mapping) and any(
         k in ("displacement_mm", "force_N", "time_s") for k in data.keys()
     )
-
-
-def _flags(options: Mapping[str, Any]) -> list[str]:
-    """Keyword options as command-line options: ``mesh="coarse"`` ->
-    ``--mesh coarse``; True -> a flag; a list or tuple -> the option repeated;
-    a mapping -> ``--key NAME=VALUE`` repeated; None and False are left out."""
-    out: list[str] = []
-    for key, value in options.items():
-        opt = "--" + key.replace("_", "-")
-        if value is None or value is False:
-            continue
-        if value is True:
-            out.append(opt)
-        elif isinstance(value, Mapping):
-            for k, v in value.items():
-                if isinstance(v, (tuple, list)):
-                    v = ",".join(repr(float(x)) for x in v)
-                out += [opt, f"{k}={v}"]
-        elif isinstance(value, (list, tuple)):
-            for v in value:
-                out += [opt, str(v)]
-        else:
-            out += [opt, repr(value) if isinstance(value, float) else str(value)]
-    return out
 
 
 def _experiment_option(experiment: Any) -> list[str]:
@@ -246,24 +195,23 @@ def calibrate(
     ``converged``, ``predictions`` with numpy arrays, ``report``).
 
     Records given as float64 arrays go to palpate in memory (read there as
-    borrowed slices). ``benchmark="Q1"`` (and its options) runs the
-    command line's staged identification, which reads files, so its record
-    is written to a temporary CSV.
+    borrowed slices), for ``benchmark="Q1"`` too.
     """
     if data is None:
         raise TypeError("calibrate() missing required argument: 'data'")
     if law is None and experiment is None:
         raise TypeError("calibrate() needs 'law' or 'experiment'")
-    options = dict(benchmark=benchmark, residual=residual, estimator=estimator, fix=fix,
-                   viscoelastic=viscoelastic, stages=stages, prony_terms=prony_terms, fit_mesh=fit_mesh,
-                   correct_mesh=correct_mesh, time_step=time_step, edge_radius=edge_radius,
-                   fit_edge_radius=fit_edge_radius, mesh_check=mesh_check, compare=compare, profile=profile)
-    flags = _flags(options)
-    model_args = (["--law", law] if law is not None else []) + _experiment_option(experiment)
     q1_options = dict(stages=stages, prony_terms=prony_terms, fit_mesh=fit_mesh, correct_mesh=correct_mesh,
                       time_step=time_step, edge_radius=edge_radius, fit_edge_radius=fit_edge_radius,
                       mesh_check=mesh_check, compare=compare, profile=profile)
-    if (benchmark or "").lower() != "q1" and not any(v not in (None, False) for v in q1_options.values()):
+    if (benchmark or "").lower() != "q1":
+        given = [k for k, v in q1_options.items() if v not in (None, False)]
+        if given:
+            name = "--" + given[0].replace("_", "-")
+            if experiment is not None:
+                raise PalpateError(f"{name}: not an option of an experiment's calibration "
+                                   "(its description holds the model)")
+            raise PalpateError(f"{name}: an option of --benchmark Q1 (the staged inverse FE identification)")
         one_record = benchmark if experiment is None else "experiment"
         data_args, records = _data_in_memory(data, one_record)
         specs = data_args[1::2]  # the values of the --data options
@@ -273,12 +221,21 @@ def calibrate(
             estimator=estimator, fix=[(k, float(v)) for k, v in (fix or {}).items()],
             viscoelastic=viscoelastic, verbose=verbose)
         return Calibration.from_report(report)
-    with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
-        out = os.path.join(tmp, "fit.json")
-        args = ["calibrate", *model_args, *_data_options(data, benchmark, tmp), "--json", out]
-        with _quiet(not verbose):
-            _run_cli(args + flags)
-        report = json.loads(Path(out).read_text())
+    # The staged identification of one ramp-and-hold record.
+    for name, given in (("viscoelastic", viscoelastic is not None), ("fix", bool(fix))):
+        if given:
+            raise PalpateError(f"--{name}: not an option of --benchmark Q1")
+    if residual != "absolute" or estimator != "lm":
+        raise PalpateError("--benchmark Q1 fits by Levenberg-Marquardt on absolute residuals "
+                           "(--residual absolute, --estimator lm)")
+    if law is None:
+        raise TypeError("calibrate(benchmark='Q1') needs 'law'")
+    data_args, records = _data_in_memory(data, benchmark)
+    if len(data_args) != 2:
+        raise PalpateError(f"--benchmark Q1: give one record (--data FILE), got {len(data_args) // 2}")
+    report, text = _native.identify_q1(law, data_args[1], records, verbose=verbose, **q1_options)
+    if verbose:
+        print(text, end="")
     return Calibration.from_report(report)
 
 
@@ -303,6 +260,7 @@ def simulate(
     hold: float | None = None,
     error_estimate: str = "on",
     order: float | None = None,
+    accuracy: float | None = None,
     rd: float | None = None,
     nodules: str | None = None,
     nodule_law: str | None = None,
@@ -322,47 +280,32 @@ def simulate(
     medium, fine or a level; ``depth`` and ``step`` in mm; ``friction``,
     ``tool``, ``element``, ``bulk``, ``bonded`` (C1), ``sliding_base`` (N1),
     ``edge_radius`` (Q1); ``prony="g1=..,tau1=.."`` with ``ramp`` and
-    ``hold`` in s; ``error_estimate`` ``"on"``/``"off"`` and ``order``; R2:
-    ``rd``, ``nodules``, ``nodule_law``, ``nodule_params``.
+    ``hold`` in s; ``error_estimate`` ``"on"``/``"off"`` and ``order``;
+    ``accuracy`` (N1, N3): the mesh chosen for this relative error of the
+    force instead of ``mesh``; R2: ``rd``, ``nodules``, ``nodule_law``,
+    ``nodule_params``.
     ``palpate simulate --help`` says what each does and its default.
     ``verbose``: print the FE summary and the error estimate.
 
     Returns a :class:`Curve`: ``displacement_mm``, ``force_N`` and, when
     present, ``time_s``, ``error_estimate_N`` (R2: ``position_mm``,
-    ``force_N``, ``force_x_N``), and ``comments``.
-
-    N1, N3, C1, Q1: the arrays are palpate's own vectors, moved into numpy
-    (no copy, full precision). R2 (a scan) goes through a CSV file (values
-    to the CSV's 10 significant digits).
+    ``force_N``, ``force_x_N``, ``error_estimate_N`` and the pressing phase,
+    ``press_displacement_mm``, ``press_force_N``, ``press_force_x_N``), and
+    ``comments``. The arrays are palpate's own vectors, moved into numpy (no
+    copy, full precision).
     """
     if (benchmark is None) == (experiment is None):
         raise TypeError("simulate() needs exactly one of 'benchmark' and 'experiment'")
-    if (benchmark or "").lower() != "r2":
-        curve = _native.simulate(
-            benchmark, (_experiment_option(experiment)[1:] or [None])[0], law,
-            [(k, float(v)) for k, v in (params or {}).items()],
-            friction=friction, rd=rd, nodules=nodules, nodule_law=nodule_law,
-            nodule_params=[(k, float(v)) for k, v in (nodule_params or {}).items()],
-            bonded=bonded, sliding_base=sliding_base, tool=tool, element=element, edge_radius=edge_radius,
-            depth=depth, step=step, mesh=None if mesh is None else str(mesh), bulk=_text(bulk),
-            error_estimate=error_estimate, order=order, prony=prony, ramp=ramp, hold=hold, verbose=verbose)
-        return Curve(**curve)
-    args = ["--benchmark", benchmark]
-    if law is not None:
-        args += ["--law", law]
-    for k, v in (params or {}).items():
-        args += ["--param", f"{k}={float(v)!r}"]
-    for k, v in (nodule_params or {}).items():
-        args += ["--nodule-param", f"{k}={float(v)!r}"]
-    args += _flags(dict(mesh=mesh, depth=depth, step=step, friction=friction, tool=tool, element=element,
-                        bulk=bulk, bonded=bonded, sliding_base=sliding_base, edge_radius=edge_radius,
-                        prony=prony, ramp=ramp, hold=hold, error_estimate=error_estimate, order=order,
-                        rd=rd, nodules=nodules, nodule_law=nodule_law))
-    with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
-        out = os.path.join(tmp, "curve.csv")
-        with _quiet(not verbose):
-            _run_cli(["simulate", *args, "--csv", out])
-        return Curve(**_read_curve(out))
+    curve = _native.simulate(
+        benchmark, (_experiment_option(experiment)[1:] or [None])[0], law,
+        [(k, float(v)) for k, v in (params or {}).items()],
+        friction=friction, rd=rd, nodules=nodules, nodule_law=nodule_law,
+        nodule_params=[(k, float(v)) for k, v in (nodule_params or {}).items()],
+        bonded=bonded, sliding_base=sliding_base, tool=tool, element=element, edge_radius=edge_radius,
+        depth=depth, step=step, mesh=None if mesh is None else str(mesh), accuracy=accuracy,
+        bulk=_text(bulk), error_estimate=error_estimate, order=order, prony=prony, ramp=ramp, hold=hold,
+        verbose=verbose)
+    return Curve(**curve)
 
 
 def _text(value: Any) -> str | None:
@@ -373,21 +316,11 @@ def _text(value: Any) -> str | None:
     return repr(value) if isinstance(value, float) else str(value)
 
 
-def _read_curve(path: str) -> dict:
-    lines = Path(path).read_text().splitlines()
-    comments = [line[1:].strip() for line in lines if line.startswith("#")]
-    rows = [line for line in lines if line and not line.startswith("#")]
-    header = rows[0].split(",")
-    values = np.loadtxt(rows[1:], delimiter=",", ndmin=2) if len(rows) > 1 else np.empty((0, len(header)))
-    out: dict = {name: values[:, i].copy() for i, name in enumerate(header)}
-    out["comments"] = comments
-    return out
-
-
 def sample(
-    law: str,
-    data: Any,
+    law: str | None = None,
+    data: Any = None,
     *,
+    experiment: Any = None,
     benchmark: str | None = None,
     sampler: str = "nuts",
     draws: int | None = None,
@@ -398,6 +331,7 @@ def sample(
     sigma: float | None = None,
     ar1: bool = False,
     prior: Mapping[str, str] | None = None,
+    evidence: bool = False,
     box: Mapping[str, tuple[float, float]] | None = None,
     mesh: str | int | None = None,
     bulk: str | float | None = None,
@@ -412,38 +346,51 @@ def sample(
 ):
     """Samples the posterior of ``law``'s parameters (as ``palpate sample``).
 
-    ``data`` as for :func:`calibrate`. ``sampler``: nuts, ensemble or demc;
-    ``draws``, ``max_draws``, ``tune``, ``parallel`` (chains), ``seed``;
-    ``sigma`` (noise, estimated when None), ``ar1``; ``prior={"C10":
-    "lognormal:-7,1"}``. FE benchmarks (N1, N3, Q1): ``box={"C10": (lo,
-    hi)}``, ``mesh``, ``bulk``, ``friction``, ``prony``, ``edge_radius``,
-    ``design``, ``holdout``, ``cache`` (the surrogate's). ``palpate sample
-    --help`` says what each does and its default. ``verbose``: print the
-    sampler's progress and summary.
+    ``data`` as for :func:`calibrate`. ``experiment``: a lab's own
+    experiment (a dict, a file path or a preset's name) instead of ``law``,
+    sampled through a surrogate of its FE model (``box`` for each of its
+    parameters). ``sampler``: nuts, ensemble or demc; ``draws``,
+    ``max_draws``, ``tune``, ``parallel`` (chains), ``seed``; ``sigma``
+    (noise, estimated when None), ``ar1``; ``prior={"C10":
+    "lognormal:-7,1"}``; ``evidence`` (thermodynamic integration, needs a
+    proper prior on every parameter). FE benchmarks (N1, N3, Q1): ``box={"C10":
+    (lo, hi)}``, ``mesh``, ``bulk``, ``friction``, ``prony``,
+    ``edge_radius``, ``design``, ``holdout``, ``cache`` (the surrogate's).
+    ``palpate sample --help`` says what each does and its default.
+    ``verbose``: print the sampler's progress, its table and warnings.
 
     Returns an ArviZ ``InferenceData`` (posterior draws per parameter, dims
     chain x draw; the summary in ``attrs``) when arviz is importable
     (``arviz=False`` refuses it), else a :class:`Posterior` (``draws``:
-    name -> array chains x draws; ``summary``).
+    name -> array chains x draws; ``summary``, the report of ``palpate
+    sample --json``; ``table`` and ``warnings``, what the command line prints).
 
     The draws are palpate's own vector moved into numpy (no copy): each
     parameter's array is a strided view of it. Records given as float64
-    arrays go to palpate in memory; for the FE benchmarks (N1, N3, Q1) the
-    record is written to a temporary CSV (their surrogate reads files).
+    arrays go to palpate in memory, for the FE benchmarks too.
     """
-    flags = _flags(dict(benchmark=benchmark, sampler=sampler, draws=draws, max_draws=max_draws, tune=tune,
-                        parallel=parallel, seed=seed, sigma=sigma, ar1=ar1, prior=prior, box=box, mesh=mesh,
-                        bulk=bulk, friction=friction, prony=prony, edge_radius=edge_radius, design=design,
-                        holdout=holdout, cache=None if cache is None else os.fspath(cache)))
-    with tempfile.TemporaryDirectory(prefix="palpate-") as tmp:
-        if (benchmark or "").lower() in ("n1", "n3", "q1"):
-            data_args, records = _data_options(data, benchmark, tmp), []
-        else:
-            data_args, records = _data_in_memory(data, benchmark)
-        args = ["--law", law, *data_args, *flags]
-        with _quiet(not verbose):
-            names, flat, n_chains, n_draws, summary = _native.sample_arrays(args, records)
-    summary = json.loads(summary)
+    if data is None:
+        raise TypeError("sample() missing required argument: 'data'")
+    if law is None and experiment is None:
+        raise TypeError("sample() needs 'law' or 'experiment'")
+    fe = experiment is not None or (benchmark or "").lower() in ("n1", "n3", "q1")
+    one_record = benchmark if experiment is None else "experiment"
+    data_args, records = _data_in_memory(data, one_record)
+    boxes = [f"{k}={float(lo)!r},{float(hi)!r}" for k, (lo, hi) in (box or {}).items()]
+    # The surrogate's cache reports its FE runs on the process's stderr itself.
+    with _quiet(fe and not verbose):
+        names, flat, n_chains, n_draws, summary, table, warnings = _native.sample(
+            law, data_args[1::2], records, experiment=(_experiment_option(experiment)[1:] or [None])[0],
+            benchmark=benchmark, sampler=sampler, draws=draws, max_draws=max_draws, tune=tune,
+            parallel=parallel, seed=seed, sigma=sigma, ar1=ar1,
+            prior=[f"{k}={v}" for k, v in (prior or {}).items()], boxes=boxes,
+            mesh=None if mesh is None else str(mesh), bulk=_text(bulk), friction=friction, prony=prony,
+            edge_radius=edge_radius, design=design, holdout=holdout,
+            cache=None if cache is None else os.fspath(cache), evidence=evidence, verbose=verbose)
+    if verbose:
+        print(table, end="")
+        for w in warnings:
+            print(w, file=sys.stderr)
     values = flat.reshape(n_chains, n_draws, len(names))  # a view of palpate's vector
     drawn = {name: values[:, :, j] for j, name in enumerate(names)}
     if arviz is not False:
@@ -459,7 +406,7 @@ def sample(
                 idata = az.from_dict({"posterior": drawn})  # arviz >= 1: an xarray DataTree
             idata.posterior.attrs["palpate_summary"] = json.dumps(summary)
             return idata
-    return Posterior(drawn, summary)
+    return Posterior(drawn, summary, table, list(warnings))
 
 
 def diagnose(

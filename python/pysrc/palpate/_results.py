@@ -112,7 +112,8 @@ class Curve(_Result):
     """A simulated force curve (``palpate.simulate``): ``displacement_mm``,
     ``force_N`` and, when present, ``time_s`` and ``error_estimate_N``
     (numpy arrays); R2 scans carry ``position_mm`` and ``force_x_N``
-    instead of ``displacement_mm``. ``comments``: the lines the CSV of the
+    instead of ``displacement_mm``, and their pressing phase
+    (``press_displacement_mm``, ``press_force_N``, ``press_force_x_N``). ``comments``: the lines the CSV of the
     command line starts with (model, volumetric treatment, error estimate)."""
 
     force_N: np.ndarray
@@ -121,6 +122,9 @@ class Curve(_Result):
     error_estimate_N: np.ndarray | None = None
     position_mm: np.ndarray | None = None
     force_x_N: np.ndarray | None = None
+    press_displacement_mm: np.ndarray | None = None
+    press_force_N: np.ndarray | None = None
+    press_force_x_N: np.ndarray | None = None
     comments: list = dataclasses.field(default_factory=list)
     title: str | None = None
 
@@ -129,12 +133,15 @@ class Curve(_Result):
 class Posterior(_Result):
     """Posterior draws (``palpate.sample`` without ArviZ): ``draws`` (name
     -> array of shape (chains, draws)), ``summary`` (the command line's
-    ``--json``: per parameter mean, sd, rhat, ess, ...)."""
+    ``--json``: per parameter mean, sd, rhat, ess, ...), ``table`` and
+    ``warnings`` (what the command line prints)."""
 
     draws: dict
     summary: dict
+    table: str = ""
+    warnings: list = dataclasses.field(default_factory=list)
 
-    _repr_skip = ("summary",)
+    _repr_skip = ("summary", "table", "warnings")
 
 
 @dataclasses.dataclass(repr=False)

@@ -351,7 +351,7 @@ pub fn fit(args: &Args, arrays: &[ArrayRecord]) -> anyhow::Result<Calibration> {
 /// `palpate calibrate --benchmark Q1`: the staged inverse FE identification
 /// ([`crate::apps::two_stage`]).
 fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
-    use crate::apps::two_stage::{identify, report, Q1Record, TwoStageOptions};
+    use crate::apps::two_stage::{identify, report, Q1Record};
     anyhow::ensure!(
         args.data.len() == 1,
         "--benchmark Q1: give one record (--data FILE), got {}",
@@ -368,40 +368,19 @@ fn run_q1(args: &Args, law: Law) -> anyhow::Result<()> {
         args.residual == "absolute" && args.estimator == "lm",
         "--benchmark Q1 fits by Levenberg-Marquardt on absolute residuals (--residual absolute, --estimator lm)"
     );
-    let mut o = TwoStageOptions::new(law);
-    if let Some(s) = &args.stages {
-        o.stages = TwoStageOptions::parse_stages(s)?;
+    let o = crate::api::identify::Q1Options {
+        stages: args.stages.clone(),
+        prony_terms: args.prony_terms,
+        fit_mesh: args.fit_mesh,
+        correct_mesh: args.correct_mesh,
+        time_step: args.time_step,
+        edge_radius: args.edge_radius,
+        fit_edge_radius: args.fit_edge_radius,
+        mesh_check: args.mesh_check,
+        compare: args.compare,
+        profile: args.profile,
     }
-    if let Some(n) = args.prony_terms {
-        o.set_terms(n)
-            .map_err(|e| anyhow::anyhow!("--prony-terms {n}: {e}"))?;
-    }
-    if let Some(h) = args.fit_mesh {
-        o.set_fit_mesh(h)
-            .map_err(|e| anyhow::anyhow!("--fit-mesh {h}: {e}"))?;
-    }
-    if let Some(h) = args.correct_mesh {
-        o.set_correct_mesh(h)
-            .map_err(|e| anyhow::anyhow!("--correct-mesh {h}: {e}"))?;
-    }
-    if let Some(dt) = args.time_step {
-        o.set_time_step(dt)
-            .map_err(|e| anyhow::anyhow!("--time-step {dt}: {e}"))?;
-    }
-    if let Some(rho) = args.edge_radius {
-        o.set_edge_radius(rho)
-            .map_err(|e| anyhow::anyhow!("--edge-radius {rho}: {e}"))?;
-    }
-    if let Some(rho) = args.fit_edge_radius {
-        o.set_fit_edge_radius(rho)
-            .map_err(|e| anyhow::anyhow!("--fit-edge-radius {rho}: {e}"))?;
-    }
-    if let Some(h) = args.mesh_check {
-        o.set_mesh_check(h)
-            .map_err(|e| anyhow::anyhow!("--mesh-check {h}: {e}"))?;
-    }
-    o.one_stage = args.compare;
-    o.profile = args.profile;
+    .two_stage(law)?;
     let path = args.data[0]
         .split_once('=')
         .filter(|(t, _)| t.eq_ignore_ascii_case("q1"))

@@ -15,7 +15,6 @@ pub mod reading;
 pub mod realtime;
 pub mod run;
 pub mod sample;
-pub mod sample_fe;
 pub mod simulate;
 pub mod simulate_r2;
 

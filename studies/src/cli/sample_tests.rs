@@ -1,6 +1,8 @@
 //! Unit tests of `sample.rs`.
 
 use super::*;
+use serde_json::Value;
+use std::path::Path;
 
 /// `palpate sample` on C1 with a neo-Hookean law, a record that does not
 /// exist and every other option at its default: the tests change what
@@ -92,7 +94,7 @@ fn bad_options_are_named() {
         prior: vec![prior.into()],
         ..c1_args()
     };
-    let e = sampler_from(&args("gibbs", "")).unwrap_err().to_string();
+    let e = options(&args("gibbs", "")).unwrap_err().to_string();
     assert!(e.contains("gibbs"), "{e}");
     let e = run(args("nuts", "C10=flat")).unwrap_err().to_string();
     assert!(e.contains("x.csv"), "{e}");

@@ -8,18 +8,16 @@
 //! `error_estimate_N` column of the CSV.
 
 //!
-//! The run itself is [`crate::api::simulate`]; this module reads the
-//! options into [`SimulateOptions`] and writes or prints the curve (the R2
-//! scan: `simulate_r2.rs`).
+//! The run itself is [`crate::api::simulate`] (the R2 scan:
+//! [`crate::api::simulate::r2`]); this module reads the options into
+//! [`SimulateOptions`] and writes or prints the curve (the R2 scan's files:
+//! `simulate_r2.rs`).
 
 use std::path::PathBuf;
 
 use anyhow::{anyhow, Context};
-use indicatif::ProgressBar;
-use palpate_fe::Progress;
 use palpate_material::Law;
 
-pub(crate) use crate::api::simulate::volumetric;
 use crate::api::simulate::{curve_text, Curve, NotConverged, SimulateOptions};
 use crate::model::{Model, ModelSpec};
 use crate::report::plot::{Plot, Series};
@@ -174,8 +172,11 @@ pub fn options(args: &Args) -> anyhow::Result<SimulateOptions> {
     } else {
         param_pairs(&args.params)?
     };
+    let nodule_params = param_pairs(&args.nodule_params)
+        .map_err(|e| anyhow!("{}", e.to_string().replace("--param", "--nodule-param")))?;
     Ok(SimulateOptions {
         params,
+        nodule_params,
         ..spec_options(args)
     })
 }
@@ -261,8 +262,8 @@ pub fn run(args: Args) -> anyhow::Result<()> {
         let model = model_spec(&args)?
             .validate()
             .map_err(|e| anyhow!("{}", e.as_option()))?;
-        if let Model::R2(m) = model {
-            return super::simulate_r2::run(&args, m);
+        if let Model::R2(_) = model {
+            return super::simulate_r2::run(&args, &options(&args)?);
         }
     }
     let options = options(&args)?;
@@ -331,11 +332,6 @@ fn write_outputs(
         );
     }
     Ok(())
-}
-
-/// A progress bar on standard error (`simulate_r2.rs`).
-pub(crate) fn progress_bar(len: usize, prefix: &str) -> (ProgressBar, impl FnMut(&Progress)) {
-    crate::api::simulate::progress_bar(len, prefix, true)
 }
 
 fn write_curve(path: &std::path::Path, c: &Curve) -> anyhow::Result<()> {

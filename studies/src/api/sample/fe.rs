@@ -1,26 +1,31 @@
-//! `palpate sample --benchmark N1|N3|Q1`: the record's finite-element model
-//! behind a surrogate (`palpate_uq::surrogate`, cached by
-//! [`crate::run::surrogate::load_or_build`]), whose held-out error is added to the
-//! likelihood as a variance ([`palpate_uq::likelihood::Posterior::with_model_error`]).
+//! Sampling a finite-element record (`--benchmark N1|N3|Q1`, or an
+//! experiment): the record's FE model behind a surrogate
+//! (`palpate_uq::surrogate`, cached by [`crate::run::surrogate::load_or_build`]),
+//! whose held-out error is added to the likelihood as a variance
+//! ([`palpate_uq::likelihood::Posterior::with_model_error`]).
 //!
 //! The surrogate is trained on the record's own loading history (its
 //! displacement samples, and times for Q1), inside the box given by `--box`
 //! for every law parameter: the box is the posterior's support, since the
 //! surrogate does not extrapolate.
 
-use super::sample::Args;
-use crate::model::{ExperimentSpec, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
-use crate::records::{TestData, TestKind};
-use crate::run::surrogate::{default_cache_dir, load_or_build, parse_box, CacheStatus};
-
-use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
+
+use palpate_uq::surrogate::{ParamBox, Surrogate, SurrogateOptions};
+use serde_json::{json, Value};
+
+use super::SampleOptions;
+use crate::api::Observer;
+use crate::model::{ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec};
+use crate::records::arrays::{record_for, ArrayRecord};
+use crate::records::{ReadOptions, TestData, TestKind};
+use crate::run::surrogate::{default_cache_dir, load_or_build, parse_box, CacheStatus};
 
 /// The benchmarks sampled through a surrogate.
 pub const FE_BENCHMARKS: [&str; 3] = ["N1", "N3", "Q1"];
 
-/// The FE benchmark named by `--benchmark`, upper case, if it is one.
+/// The FE benchmark named by `benchmark`, upper case, if it is one.
 pub fn fe_benchmark(benchmark: Option<&str>) -> Option<&'static str> {
     let b = benchmark?;
     FE_BENCHMARKS
@@ -30,39 +35,39 @@ pub fn fe_benchmark(benchmark: Option<&str>) -> Option<&'static str> {
 }
 
 /// Refuses an FE option without an FE benchmark, or one of another FE
-/// benchmark, naming it.
-pub fn check_options(args: &Args) -> anyhow::Result<()> {
-    if args.experiment.is_some() {
+/// benchmark, and a model option with an experiment, naming it.
+pub(super) fn check_options(o: &SampleOptions) -> anyhow::Result<()> {
+    if o.experiment.is_some() {
         // the model's settings have their place in the description
         let model_options: [(bool, &str, &str); 5] = [
-            (args.mesh.is_some(), "--mesh", "[mesh] level and element"),
-            (args.bulk.is_some(), "--bulk", "materials.NAME.bulk"),
-            (args.friction.is_some(), "--friction", "tool.friction"),
-            (args.prony.is_some(), "--prony", "materials.NAME.prony"),
+            (o.mesh.is_some(), "--mesh", "[mesh] level and element"),
+            (o.bulk.is_some(), "--bulk", "materials.NAME.bulk"),
+            (o.friction.is_some(), "--friction", "tool.friction"),
+            (o.prony.is_some(), "--prony", "materials.NAME.prony"),
             (
-                args.edge_radius.is_some(),
+                o.edge_radius.is_some(),
                 "--edge-radius",
                 "tool.edge_radius of a flat punch",
             ),
         ];
-        if let Some((_, name, place)) = model_options.iter().find(|o| o.0) {
+        if let Some((_, name, place)) = model_options.iter().find(|x| x.0) {
             anyhow::bail!(
                 "{name}: not an option with --experiment: the description holds the model (give its {place} there)"
             );
         }
         return Ok(());
     }
-    let kind = fe_benchmark(args.benchmark.as_deref());
+    let kind = fe_benchmark(o.benchmark.as_deref());
     let given: [(bool, &str, &[&str]); 9] = [
-        (!args.boxes.is_empty(), "--box", &FE_BENCHMARKS),
-        (args.mesh.is_some(), "--mesh", &FE_BENCHMARKS),
-        (args.design.is_some(), "--design", &FE_BENCHMARKS),
-        (args.holdout.is_some(), "--holdout", &FE_BENCHMARKS),
-        (args.cache.is_some(), "--cache", &FE_BENCHMARKS),
-        (args.bulk.is_some(), "--bulk", &FE_BENCHMARKS),
-        (args.friction.is_some(), "--friction", &["N1", "N3"]),
-        (args.prony.is_some(), "--prony", &["Q1"]),
-        (args.edge_radius.is_some(), "--edge-radius", &["Q1"]),
+        (!o.boxes.is_empty(), "--box", &FE_BENCHMARKS),
+        (o.mesh.is_some(), "--mesh", &FE_BENCHMARKS),
+        (o.design.is_some(), "--design", &FE_BENCHMARKS),
+        (o.holdout.is_some(), "--holdout", &FE_BENCHMARKS),
+        (o.cache.is_some(), "--cache", &FE_BENCHMARKS),
+        (o.bulk.is_some(), "--bulk", &FE_BENCHMARKS),
+        (o.friction.is_some(), "--friction", &["N1", "N3"]),
+        (o.prony.is_some(), "--prony", &["Q1"]),
+        (o.edge_radius.is_some(), "--edge-radius", &["Q1"]),
     ];
     for (on, name, users) in given {
         if on && !kind.is_some_and(|k| users.contains(&k)) {
@@ -80,82 +85,87 @@ pub fn check_options(args: &Args) -> anyhow::Result<()> {
 }
 
 /// The model spec of the record: the docs/benchmarks.md set-up with the
-/// options given (mesh coarse unless `--mesh`).
-pub fn model_spec(kind: &str, args: &Args) -> ModelSpec {
-    let mesh = Some(args.mesh.clone().unwrap_or_else(|| "coarse".into()));
+/// options given (mesh coarse unless `mesh`).
+pub fn model_spec(kind: &str, o: &SampleOptions) -> ModelSpec {
+    let mesh = Some(o.mesh.clone().unwrap_or_else(|| "coarse".into()));
     match kind {
         "N1" => ModelSpec::N1Needle(N1NeedleSpec {
-            law: args.law.clone().unwrap_or_default(),
-            friction: args.friction,
+            law: o.law.clone().unwrap_or_default(),
+            friction: o.friction,
             mesh,
-            bulk: args.bulk.clone(),
+            bulk: o.bulk.clone(),
             ..Default::default()
         }),
         "N3" => ModelSpec::N3Needle(N3NeedleSpec {
-            law: args.law.clone().unwrap_or_default(),
-            friction: args.friction,
+            law: o.law.clone().unwrap_or_default(),
+            friction: o.friction,
             mesh,
-            bulk: args.bulk.clone(),
+            bulk: o.bulk.clone(),
             ..Default::default()
         }),
         _ => ModelSpec::Q1(Q1Spec {
-            law: args.law.clone().unwrap_or_default(),
+            law: o.law.clone().unwrap_or_default(),
             mesh,
-            bulk: args.bulk.clone(),
-            prony: args.prony.clone(),
-            edge_radius: args.edge_radius,
+            bulk: o.bulk.clone(),
+            prony: o.prony.clone(),
+            edge_radius: o.edge_radius,
             ..Default::default()
         }),
     }
 }
 
-/// The record, its surrogate and where it came from.
-pub struct FeRecord {
-    pub data: TestData,
-    pub spec: ModelSpec,
-    pub surrogate: Arc<Surrogate>,
-    pub status: CacheStatus,
-}
-
-/// Reads the record, builds or loads the surrogate of its FE model.
-pub fn setup(kind: &str, args: &Args) -> anyhow::Result<FeRecord> {
+/// Reads the one record of the FE benchmark `kind` (`FILE` or
+/// `KIND=FILE`, or `<array:K>`; columns displacement_mm, force_N, and
+/// time_s for Q1).
+pub(super) fn read_record(
+    kind: &str,
+    data: &[String],
+    arrays: &[ArrayRecord],
+) -> anyhow::Result<TestData> {
     anyhow::ensure!(
-        args.data.len() == 1,
+        data.len() == 1,
         "--benchmark {kind}: give one record (--data FILE), got {}",
-        args.data.len()
+        data.len()
     );
-    let d = &args.data[0];
+    let d = &data[0];
     let path = d
         .split_once('=')
         .filter(|(t, _)| t.eq_ignore_ascii_case(kind))
         .map_or(d.as_str(), |(_, p)| p);
-    let data = TestData::read(kind, TestKind::N1, Path::new(path))?;
+    let data = match record_for(path, arrays)? {
+        Some(r) => TestData::from_table(
+            kind,
+            TestKind::N1,
+            r.table(&format!("{kind} arrays"))?,
+            ReadOptions::default(),
+        )?,
+        None => TestData::read(kind, TestKind::N1, Path::new(path))?,
+    };
     if kind == "Q1" && data.loading.time.is_none() {
         anyhow::bail!(
             "{}: a Q1 record is a timed ramp-and-hold: it needs a time_s column (as `palpate simulate --benchmark Q1 --csv` writes)",
             path
         );
     }
-    let spec = model_spec(kind, args);
-    surrogate(data, spec, args)
+    Ok(data)
 }
 
-/// Reads the force record of `--experiment` and builds or loads the
-/// surrogate of the description's model (meshed for the record's deepest
-/// displacement when its protocol is the record's).
-pub fn setup_experiment(spec: ExperimentSpec, args: &Args) -> anyhow::Result<FeRecord> {
-    anyhow::ensure!(
-        args.data.len() == 1,
-        "--experiment: give one record (--data FILE), got {}",
-        args.data.len()
-    );
-    let data = crate::cli::diagnose::read_force_record(&args.data[0])?;
-    let spec = crate::steps::diagnose::experiment_base(spec, None, &data)?;
-    surrogate(data, spec, args)
+/// The record, its surrogate and where it came from.
+pub(super) struct FeRecord {
+    pub data: TestData,
+    pub spec: ModelSpec,
+    pub surrogate: Arc<Surrogate>,
+    pub status: CacheStatus,
 }
 
-/// The surrogate of `spec`'s model on the record's loading.
-fn surrogate(data: TestData, spec: ModelSpec, args: &Args) -> anyhow::Result<FeRecord> {
+/// The surrogate of `spec`'s model on the record's loading, built or read
+/// from the cache; its build and held-out error to `observer`.
+pub(super) fn surrogate(
+    data: TestData,
+    spec: ModelSpec,
+    o: &SampleOptions,
+    observer: &dyn Observer,
+) -> anyhow::Result<FeRecord> {
     let model = spec
         .validate()
         .map_err(|e| match &spec {
@@ -163,9 +173,9 @@ fn surrogate(data: TestData, spec: ModelSpec, args: &Args) -> anyhow::Result<FeR
             _ => anyhow::anyhow!("{}", e.as_option()),
         })?
         .into_forward();
-    let bounds = parse_box(&args.boxes, model.as_ref())?;
+    let bounds = parse_box(&o.boxes, model.as_ref())?;
     let mut options = SurrogateOptions::for_dimension(bounds.len());
-    if let Some(n) = args.design {
+    if let Some(n) = o.design {
         anyhow::ensure!(
             n >= bounds.len() + 2,
             "--design {n}: at least {} training runs are needed for {} parameters",
@@ -174,11 +184,11 @@ fn surrogate(data: TestData, spec: ModelSpec, args: &Args) -> anyhow::Result<FeR
         );
         options.training_runs = n;
     }
-    if let Some(n) = args.holdout {
+    if let Some(n) = o.holdout {
         anyhow::ensure!(n >= 1, "--holdout {n}: at least 1 held-out run is needed");
         options.validation_runs = n;
     }
-    let cache: PathBuf = args.cache.clone().unwrap_or_else(default_cache_dir);
+    let cache: PathBuf = o.cache.clone().unwrap_or_else(default_cache_dir);
     let t0 = std::time::Instant::now();
     let (s, status) = load_or_build(
         model.as_ref(),
@@ -190,15 +200,15 @@ fn surrogate(data: TestData, spec: ModelSpec, args: &Args) -> anyhow::Result<FeR
         &format!("surrogate of {}", model.name()),
     )?;
     let v = s.validation();
-    match &status {
-        CacheStatus::Hit(p) => eprintln!(
+    observer.message(&match &status {
+        CacheStatus::Hit(p) => format!(
             "surrogate loaded from the cache {} in {:.2} s (built from {} FE runs in {:.1} s)",
             p.display(),
             t0.elapsed().as_secs_f64(),
             s.fe_runs,
             s.build_time_s
         ),
-        CacheStatus::Built(p) => eprintln!(
+        CacheStatus::Built(p) => format!(
             "surrogate built from {} FE runs in {:.1} s wall{}, stored in {}",
             s.fe_runs,
             s.build_time_s,
@@ -207,21 +217,21 @@ fn surrogate(data: TestData, spec: ModelSpec, args: &Args) -> anyhow::Result<FeR
                 .unwrap_or_default(),
             p.display()
         ),
-    }
-    eprintln!(
+    });
+    observer.message(&format!(
         "surrogate error on {} held-out FE runs: max {:.3e}, RMS {:.3e} of the peak force ({} basis vectors); added to the likelihood as a variance",
         v.points,
         v.max_relative_error,
         v.rms_relative_error,
         s.basis_size()
-    );
+    ));
     if !s.failed.is_empty() {
-        eprintln!(
+        observer.message(&format!(
             "warning: {} FE runs of the design failed and were left out (first at {:?}: {})",
             s.failed.len(),
             s.failed[0].theta,
             s.failed[0].reason
-        );
+        ));
     }
     Ok(FeRecord {
         data,
@@ -242,4 +252,29 @@ pub fn truncated(bounds: &ParamBox, summary: &[palpate_uq::mcmc::ParamSummary]) 
         })
         .map(|k| bounds.names[k].clone())
         .collect()
+}
+
+/// The `surrogate` section of the report.
+pub(super) fn report(fe: &FeRecord, summary: &[palpate_uq::mcmc::ParamSummary]) -> Value {
+    let s = &fe.surrogate;
+    let val = s.validation();
+    let b = s.bounds();
+    json!({
+        "model": format!("{:?}", fe.spec),
+        "fe_runs": s.fe_runs,
+        "training_runs": s.options().training_runs,
+        "held_out_runs": val.points,
+        "failed_runs": s.failed.len(),
+        "basis_size": s.basis_size(),
+        "max_rel_error": val.max_relative_error,
+        "rms_rel_error": val.rms_relative_error,
+        "max_abs_error_N": val.max_abs_error.first(),
+        "box": (0..b.len()).map(|k| json!({"name": b.names[k], "lower": b.lower[k], "upper": b.upper[k]})).collect::<Vec<_>>(),
+        "box_truncates": truncated(b, summary),
+        "build_time_s": s.build_time_s,
+        "build_cpu_s": s.build_cpu_s,
+        "cache": fe.status.word(),
+        "cache_file": fe.status.path().display().to_string(),
+        "key": s.key(),
+    })
 }
