@@ -17,9 +17,8 @@
 //! ```
 //!
 //! Without `--release` it times the dev-profile binary (opt-level 2,
-//! dependencies at 3) and the table says so. CPU times grow with the
-//! machine's load (CalculiX's n6 run: 164 s quiet, 438 s at load 10-16), so
-//! run it on a quiet machine; the table prints the load average.
+//! dependencies at 3) and the table says so. Run it on a quiet machine:
+//! the table prints the load average.
 //!
 //! `--recorded-ccx` quotes CalculiX's run recorded in docs/validation/fe.md
 //! instead of rerunning it (~5-10 min); `--page FILE` replaces the section
