@@ -8,7 +8,7 @@ use palpate_core::{
     Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
     ParamSpace, ParamSpec,
 };
-use palpate_enrich::qlv_convolve;
+use palpate_enrich::{check_prony, qlv_convolve};
 use palpate_material::Law;
 
 /// Uniaxial nominal stress of an incompressible viscoelastic solid whose
@@ -103,25 +103,7 @@ impl Evaluator for ViscousUniaxialEvaluator<'_> {
         m.space.check(theta)?;
         let (law_theta, prony) = theta.split_at(theta.len() - 2 * m.terms);
         check_law_params(&m.law, &law_space(&m.law), law_theta)?;
-        let mut sum = 0.0;
-        for i in 0..m.terms {
-            sum += prony[2 * i];
-            let tau = prony[2 * i + 1];
-            if tau.is_nan() || tau <= 0.0 {
-                return Err(ForwardError::InvalidParameter {
-                    name: format!("tau{}_s", i + 1),
-                    value: tau,
-                    reason: "relaxation time must be positive".into(),
-                });
-            }
-        }
-        if sum.is_nan() || sum > 1.0 {
-            return Err(ForwardError::InvalidParameter {
-                name: format!("g{}", m.terms),
-                value: prony[2 * (m.terms - 1)],
-                reason: format!("sum of g_i = {sum} must not exceed 1"),
-            });
-        }
+        check_prony(prony, m.terms)?;
         check_loading(loading, Drive::Stretch, out.len())?;
         let time = loading.time.as_deref().ok_or_else(|| {
             ForwardError::InvalidLoading(

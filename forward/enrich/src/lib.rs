@@ -55,6 +55,6 @@ pub use asymmetry::TensionCompressionAsymmetry;
 pub use convert::law_space;
 pub use material_form::{material_forms, richer_law, richer_laws, LawMap, MaterialForm, RicherLaw};
 pub use tool_compliance::ToolCompliance;
-pub use viscoelastic::{prony_params, qlv_convolve, Viscoelastic};
+pub use viscoelastic::{check_prony, prony_params, qlv_convolve, Viscoelastic};
 pub use wrap::{wrap, wrapper_effects, DEFAULT_PRONY_TERMS, WRAPPER_EFFECTS};
 pub use zero_offset::ZeroOffset;

@@ -53,31 +53,6 @@ impl Viscoelastic {
         self.terms
     }
 
-    /// Checks the Prony parameters `[g1, tau1, g2, tau2, ...]`: g_i >= 0
-    /// (bounds), tau_i > 0 and sum g_i <= 1 (so G(inf) = 1 - sum g_i >= 0).
-    fn check_prony(&self, prony: &[f64]) -> Result<(), ForwardError> {
-        let mut sum = 0.0;
-        for i in 0..self.terms {
-            let (g, tau) = (prony[2 * i], prony[2 * i + 1]);
-            sum += g;
-            if tau.is_nan() || tau <= 0.0 {
-                return Err(ForwardError::InvalidParameter {
-                    name: format!("tau{}_s", i + 1),
-                    value: tau,
-                    reason: "relaxation time must be positive".into(),
-                });
-            }
-        }
-        if sum.is_nan() || sum > 1.0 {
-            return Err(ForwardError::InvalidParameter {
-                name: format!("g{}", self.terms),
-                value: prony[2 * (self.terms - 1)],
-                reason: format!("sum of g_i = {sum} must not exceed 1"),
-            });
-        }
-        Ok(())
-    }
-
     /// The same parameter vector with the Prony terms sorted by increasing
     /// relaxation time (the canonical labelling: the response does not
     /// depend on the order of the terms, so estimates and samples should be
@@ -95,6 +70,33 @@ impl Viscoelastic {
         }
         out
     }
+}
+
+/// Checks the Prony parameters `[g1, tau1, g2, tau2, ...]` of `terms` terms:
+/// tau_i > 0 and sum g_i <= 1 (so G(inf) = 1 - sum g_i >= 0); g_i >= 0 is
+/// the parameter space's bound. The error names the parameter
+/// (`tau2_s`, `g3`) as [`prony_params`] does.
+pub fn check_prony(prony: &[f64], terms: usize) -> Result<(), ForwardError> {
+    let mut sum = 0.0;
+    for i in 0..terms {
+        let (g, tau) = (prony[2 * i], prony[2 * i + 1]);
+        sum += g;
+        if tau.is_nan() || tau <= 0.0 {
+            return Err(ForwardError::InvalidParameter {
+                name: format!("tau{}_s", i + 1),
+                value: tau,
+                reason: "relaxation time must be positive".into(),
+            });
+        }
+    }
+    if sum.is_nan() || sum > 1.0 {
+        return Err(ForwardError::InvalidParameter {
+            name: format!("g{terms}"),
+            value: prony[2 * (terms - 1)],
+            reason: format!("sum of g_i = {sum} must not exceed 1"),
+        });
+    }
+    Ok(())
 }
 
 /// The parameters of `terms` Prony terms, `g1, tau1_s, g2, tau2_s, ...`:
@@ -179,7 +181,7 @@ impl ViscoelasticEvaluator<'_> {
         let m = self.model;
         let (base_theta, prony) = split(theta, &m.space, 2 * m.terms)?;
         if m.terms > 0 {
-            m.check_prony(prony)?;
+            check_prony(prony, m.terms)?;
         }
         let time = loading.time.as_ref().ok_or_else(|| {
             ForwardError::InvalidLoading(
