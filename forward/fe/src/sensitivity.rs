@@ -118,6 +118,7 @@ impl Differentiation {
         let h0 = sys.histories();
         let u0 = sys.u.clone();
         let done = self.differentiate(sys, target, set, observe, &h0, &u0);
+        sys.hold_branches(false);
         if done.is_err() {
             // the parameters were accepted at the run's start
             let _ = set(sys, &self.theta);
@@ -144,6 +145,8 @@ impl Differentiation {
         let zero = vec![0.0; sys.equations()];
         sys.assemble(target, true)?;
         sys.factorize_tangent()?;
+        // every difference below on the branch this tangent was assembled on
+        sys.hold_branches(true);
         let mut dh_new = Vec::with_capacity(self.theta.len());
         for j in 0..self.theta.len() {
             let (e, a, b) = self.steps[j];
@@ -190,6 +193,7 @@ impl Differentiation {
             );
         }
         self.dh = dh_new;
+        sys.hold_branches(false);
         set(sys, &self.theta)?;
         sys.set_histories(h0, h0, 0.0);
         sys.set_state(u0, &zero, 0.0);
