@@ -39,10 +39,21 @@
 //!
 //! What is differentiated is the discrete run with its increments held: the
 //! same increments (the nominal run's step control), the Uzawa update of the
-//! contact multipliers at each commit, stick and slip as the nominal run
-//! found them. Across a switch (a point coming into contact or starting to
-//! slip within `e` of the nominal state) the derivative is one-sided, as
-//! the forces themselves are only piecewise smooth there. Augmentations
+//! contact multipliers at each commit, and contact, stick and slip as the
+//! nominal run found them: while it takes its differences, every
+//! contribution holds the discrete state of the converged assembly
+//! ([`crate::contribution::Contribution::hold_branches`]: a contact point
+//! touching or clear, sticking or sliding), each piece's law extended
+//! beyond its switch, so that the right-hand side, the new history and the
+//! outputs are differentiated on the branch the tangent was assembled on.
+//! A point within `e` of a switch would otherwise mix the two laws: on the
+//! needle at friction 0.345, a point that stuck on one side of the
+//! difference and slid on the other made the friction column 50 times too
+//! large at one depth, and its stick point carried the error on
+//! (`tests/integration/sensitivity_friction.rs`). At a switch the derivative
+//! is one-sided, as the forces themselves are only piecewise smooth there,
+//! and central differences of whole runs agree only with steps that fall
+//! between the switches. Augmentations
 //! within an increment (`SolverOptions::max_augmentations > 0` with a
 //! penetration above tolerance) are treated as converged: their multipliers
 //! are held, which is exact only once the augmentation has converged.
