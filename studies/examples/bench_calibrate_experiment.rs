@@ -25,6 +25,15 @@
 //! ```text
 //! nice cargo run -p palpate-studies --example bench_calibrate_experiment -- [n1] [gel] [--noise 0.005] [--level 1]
 //! ```
+//!
+//! `--jacobian P1,P2,...` makes no fit: at that point of a case's
+//! parameters (in the order of its truth) it prints, at the record's
+//! depths on the fit's mesh, the exact derivatives of the force (one run
+//! with sensitivities) beside central differences of whole runs (steps of
+//! 1e-4 of each parameter), the check of the Jacobian a fit is given
+//! (`-- n1 --jacobian 1.108e-3,0.345`: a point the N1 fit visits on its
+//! way from the start to the truth); `--only NAME` differences that
+//! parameter alone.
 
 use clap::Parser;
 use palpate_core::{Drive, Loading};
@@ -92,9 +101,27 @@ fn main() {
         .position(|a| a == "--level")
         .and_then(|k| args.get(k + 1))
         .map_or(1, |v| v.parse().expect("--level: a level 1, 2, ..."));
+    let jacobian_at: Option<Vec<f64>> = args
+        .iter()
+        .position(|a| a == "--jacobian")
+        .and_then(|k| args.get(k + 1))
+        .map(|v| {
+            v.split(',')
+                .map(|x| x.parse().expect("--jacobian: numbers separated by commas"))
+                .collect()
+        });
+    let only = args
+        .iter()
+        .position(|a| a == "--only")
+        .and_then(|k| args.get(k + 1));
     let chosen: Vec<&String> = args
         .iter()
-        .filter(|a| !a.starts_with("--") && a.parse::<f64>().is_err())
+        .filter(|a| {
+            !a.starts_with("--")
+                && a.parse::<f64>().is_err()
+                && !a.contains(',')
+                && Some(*a) != only
+        })
         .collect();
     let dir = tempfile::tempdir().expect("temporary folder");
     println!(
@@ -120,6 +147,10 @@ fn main() {
             .map(|k| case.depth * k as f64 / case.samples as f64)
             .collect();
         let theta: Vec<f64> = case.truth.iter().map(|t| t.1).collect();
+        if let Some(at) = &jacobian_at {
+            jacobian_check(&case, level, at, &depths, only.map(String::as_str));
+            continue;
+        }
         let cache = record_cache(&fine_text, &theta, &depths);
         let (forces, record_cpu, cached) = match read_cached(&cache, depths.len()) {
             Some((f, cpu)) => (f, cpu, true),
@@ -204,6 +235,61 @@ fn main() {
                 "  {name} = {v:.6e} +- {se:.2e} (truth {t:.6e}: {:+.2} %, {:+.2} SE)",
                 100.0 * (v / t - 1.0),
                 (v - t) / se
+            );
+        }
+    }
+}
+
+/// The exact derivatives of the force at `at` on the fit's mesh against
+/// central differences of whole runs (steps of 1e-4 of each parameter).
+fn jacobian_check(case: &Case, level: usize, at: &[f64], depths: &[f64], only: Option<&str>) {
+    assert_eq!(
+        at.len(),
+        case.truth.len(),
+        "--jacobian: one value per parameter of {}",
+        case.name
+    );
+    let text = format!("{}\n[mesh]\nlevel = {level}\n", case.description);
+    let exp: Experiment = toml::from_str(&text).expect("the fit's description");
+    let model = exp.model().expect("the fit's model");
+    let forward = model.as_forward();
+    let loading = Loading::quasi_static(Drive::DisplacementMm, depths.to_vec());
+    println!(
+        "\n== {}: the exact Jacobian at {at:?} on {}",
+        case.name,
+        forward.name()
+    );
+    let t0 = cpu_seconds(false);
+    let (forces, columns) = forward
+        .as_sensitivities()
+        .expect("FE models offer sensitivities")
+        .predict_with_jacobian(at, &loading)
+        .expect("the run with sensitivities");
+    println!(
+        "one run with sensitivities: {:.1} s CPU",
+        cpu_seconds(false) - t0
+    );
+    for (j, (name, _)) in case.truth.iter().enumerate() {
+        if only.is_some_and(|o| o != *name) {
+            continue;
+        }
+        let h = 1e-4 * at[j].abs();
+        let run = |s: f64| {
+            let mut t = at.to_vec();
+            t[j] += s * h;
+            forward.predict(&t, &loading).expect("a whole run")
+        };
+        let (p, m) = (run(1.0), run(-1.0));
+        println!("d F / d {name} (depth mm, F N, exact, central difference, relative deviation)");
+        for k in 0..depths.len() {
+            let fd = (p[k] - m[k]) / (2.0 * h);
+            println!(
+                "  {:5.2} {:.5e} {:+.6e} {:+.6e} {:+.2e}",
+                depths[k],
+                forces[k],
+                columns[j][k],
+                fd,
+                (columns[j][k] - fd) / fd.abs().max(f64::MIN_POSITIVE)
             );
         }
     }

@@ -144,6 +144,25 @@ pub(crate) struct PointHistory {
     gap: f64,
 }
 
+/// The discrete state of a contact point: clear of the tool, in contact
+/// and sticking (or frictionless), or in contact and sliding.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Branch {
+    Clear,
+    Stick,
+    Slip,
+}
+
+impl Branch {
+    fn of(h: &PointHistory) -> Branch {
+        match (h.normal_force > 0.0, h.slipping) {
+            (false, _) => Branch::Clear,
+            (true, false) => Branch::Stick,
+            (true, true) => Branch::Slip,
+        }
+    }
+}
+
 /// Force on the body at a contact point and its derivative with respect
 /// to the point's position.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -185,6 +204,8 @@ pub struct RigidContact {
     /// [`ContactPoints::EdgeSplit`]: per facet its reference length and the
     /// volume factors at its two nodes (`None` for the fixed points).
     split: Option<Vec<(f64, f64, f64)>>,
+    /// Branches held by [`Contribution::hold_branches`].
+    held: Option<Vec<Branch>>,
 }
 
 impl RigidContact {
@@ -260,6 +281,7 @@ impl RigidContact {
             points,
             facets,
             split,
+            held: None,
         };
         c.reset(&mesh.nodes);
         let pose = c.motion.pose(&vec![0.0; channels]);
@@ -457,6 +479,21 @@ impl Tool<'_> {
         c: &PointHistory,
         x: [f64; 3],
     ) -> (PointHistory, PointForce) {
+        self.point_on(area, lambda, c, x, None)
+    }
+
+    /// [`Tool::point`] on the branch `held` when given (a point held in
+    /// contact keeps the linear normal law below zero force, a point held
+    /// clear has none, and a point held sticking or sliding does so
+    /// whatever its trial traction), on its own branch otherwise.
+    pub(crate) fn point_on(
+        &self,
+        area: f64,
+        lambda: f64,
+        c: &PointHistory,
+        x: [f64; 3],
+        held: Option<Branch>,
+    ) -> (PointHistory, PointForce) {
         let (o, dim, surface) = (self.options, self.dim, self.surface);
         let pr = self.pose.project(surface, x);
         let (eps_n, eps_t) = (o.penalty_normal * area, o.penalty_tangent * area);
@@ -480,10 +517,19 @@ impl Tool<'_> {
             gap: pr.gap,
             ..Default::default()
         };
-        if tn <= 0.0 {
+        let clear = match held {
+            Some(b) => b == Branch::Clear,
+            None => tn <= 0.0,
+        };
+        if clear {
             return (t, PointForce::default());
         }
         t.normal_force = tn;
+        let stick_held = match held {
+            Some(Branch::Stick) => Some(true),
+            Some(Branch::Slip) => Some(false),
+            _ => None,
+        };
         let nv = pr.normal;
         let dtn: [f64; 3] = std::array::from_fn(|j| -slope * nv[j]);
         let mut f: [f64; 3] = std::array::from_fn(|i| tn * nv[i]);
@@ -494,7 +540,8 @@ impl Tool<'_> {
             }
         }
         if o.friction > 0.0 && dim == 3 {
-            let (stick, slipping, tt, dtt) = self.friction_3d(&pr, eps_t, tn, &dtn, c, x);
+            let (stick, slipping, tt, dtt) =
+                self.friction_3d(&pr, eps_t, tn, &dtn, c, x, stick_held);
             t.stick_point = Some(stick);
             t.slipping = slipping;
             for i in 0..3 {
@@ -512,7 +559,7 @@ impl Tool<'_> {
             let slip = pr.xi - stick;
             let tt_trial = -eps_t * slip;
             let limit = o.friction * tn;
-            let (tt, dtt) = if tt_trial.abs() <= limit {
+            let (tt, dtt) = if stick_held.unwrap_or(tt_trial.abs() <= limit) {
                 t.stick = Some(stick);
                 (
                     tt_trial,
@@ -547,7 +594,9 @@ impl Tool<'_> {
     /// documentation for the equations): the stick point in the tool frame,
     /// the tangential traction `t_T` on the body and `d t_T / d x`, given
     /// whether it slips, given the projection `pr` of `x`, `eps_T = eps_t`, `t_N = tn` and
-    /// `d t_N / d x = dtn`.
+    /// `d t_N / d x = dtn`; `stick_held`: stick (`true`) or slip whatever
+    /// the trial traction.
+    #[allow(clippy::too_many_arguments)]
     fn friction_3d(
         &self,
         pr: &SurfacePoint,
@@ -556,6 +605,7 @@ impl Tool<'_> {
         dtn: &[f64; 3],
         c: &PointHistory,
         x: [f64; 3],
+        stick_held: Option<bool>,
     ) -> ([f64; 3], bool, [f64; 3], [[f64; 3]; 3]) {
         let stick = c.stick_point.unwrap_or_else(|| {
             // first contact: stick to the tool's material point closest to
@@ -581,7 +631,7 @@ impl Tool<'_> {
         });
         let limit = self.options.friction * tn;
         let norm_s = dot(s, s).sqrt();
-        if eps_t * norm_s <= limit {
+        if stick_held.unwrap_or(eps_t * norm_s <= limit) {
             // stick: t_T = -eps_T s
             let tt = s.map(|v| -eps_t * v);
             let dtt = ds.map(|row| row.map(|v| -eps_t * v));
@@ -661,7 +711,8 @@ impl Contribution for RigidContact {
         }
         for (k, p) in self.points.iter().enumerate() {
             let x = p.position(|n| ctx.position(n));
-            let (t, f) = tool.point(p.area, self.lambda[k], &self.committed[k], x);
+            let held = self.held.as_ref().map(|h| h[k]);
+            let (t, f) = tool.point_on(p.area, self.lambda[k], &self.committed[k], x, held);
             self.trial[k] = t;
             self.forces[k] = f;
         }
@@ -725,6 +776,14 @@ impl Contribution for RigidContact {
             };
             self.lambda[k] = self.committed[k].lambda;
         }
+    }
+
+    /// Holds which points touch, stick and slip as the last assembly found
+    /// them (the fixed points; a split edge's points move with the edge and
+    /// carry no history, so they follow the state).
+    fn hold_branches(&mut self, hold: bool) {
+        self.held =
+            (hold && self.split.is_none()).then(|| self.trial.iter().map(Branch::of).collect());
     }
 
     fn rollback(&mut self) {

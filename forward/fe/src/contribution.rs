@@ -155,6 +155,14 @@ pub trait Contribution: Send + std::any::Any {
     /// returned it, possibly perturbed); the trial state follows at the
     /// next assembly.
     fn set_history(&mut self, _h: &[f64]) {}
+    /// Holds (`true`) the discrete state the last assembly found (a contact
+    /// point touching or clear, sticking or sliding) in every later
+    /// assembly, each piece's law extended beyond its switch, until released
+    /// (`false`): the direct differentiation of a run
+    /// ([`crate::sensitivity`]) takes its differences about the converged
+    /// state on the branch that state's tangent was assembled on. Default:
+    /// nothing to hold.
+    fn hold_branches(&mut self, _hold: bool) {}
     /// Force the tool exerts on the body along `axis` at the last assembly
     /// (N; minus the body's reaction on the tool): a tool pressed down
     /// reports its compression force on `axis = -y`, and a tool dragging the

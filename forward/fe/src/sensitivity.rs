@@ -39,10 +39,21 @@
 //!
 //! What is differentiated is the discrete run with its increments held: the
 //! same increments (the nominal run's step control), the Uzawa update of the
-//! contact multipliers at each commit, stick and slip as the nominal run
-//! found them. Across a switch (a point coming into contact or starting to
-//! slip within `e` of the nominal state) the derivative is one-sided, as
-//! the forces themselves are only piecewise smooth there. Augmentations
+//! contact multipliers at each commit, and contact, stick and slip as the
+//! nominal run found them: while it takes its differences, every
+//! contribution holds the discrete state of the converged assembly
+//! ([`crate::contribution::Contribution::hold_branches`]: a contact point
+//! touching or clear, sticking or sliding), each piece's law extended
+//! beyond its switch, so that the right-hand side, the new history and the
+//! outputs are differentiated on the branch the tangent was assembled on.
+//! A point within `e` of a switch would otherwise mix the two laws: on the
+//! needle at friction 0.345, a point that stuck on one side of the
+//! difference and slid on the other made the friction column 50 times too
+//! large at one depth, and its stick point carried the error on
+//! (`tests/integration/sensitivity_friction.rs`). At a switch the derivative
+//! is one-sided, as the forces themselves are only piecewise smooth there,
+//! and central differences of whole runs agree only with steps that fall
+//! between the switches. Augmentations
 //! within an increment (`SolverOptions::max_augmentations > 0` with a
 //! penetration above tolerance) are treated as converged: their multipliers
 //! are held, which is exact only once the augmentation has converged.
@@ -118,6 +129,7 @@ impl Differentiation {
         let h0 = sys.histories();
         let u0 = sys.u.clone();
         let done = self.differentiate(sys, target, set, observe, &h0, &u0);
+        sys.hold_branches(false);
         if done.is_err() {
             // the parameters were accepted at the run's start
             let _ = set(sys, &self.theta);
@@ -144,6 +156,8 @@ impl Differentiation {
         let zero = vec![0.0; sys.equations()];
         sys.assemble(target, true)?;
         sys.factorize_tangent()?;
+        // every difference below on the branch this tangent was assembled on
+        sys.hold_branches(true);
         let mut dh_new = Vec::with_capacity(self.theta.len());
         for j in 0..self.theta.len() {
             let (e, a, b) = self.steps[j];
@@ -190,6 +204,7 @@ impl Differentiation {
             );
         }
         self.dh = dh_new;
+        sys.hold_branches(false);
         set(sys, &self.theta)?;
         sys.set_histories(h0, h0, 0.0);
         sys.set_state(u0, &zero, 0.0);

@@ -836,6 +836,14 @@ impl System {
         self.contributions = contributions;
     }
 
+    /// Every contribution holds the discrete state of the last assembly, or
+    /// lets it follow the state again ([`Contribution::hold_branches`]).
+    pub(crate) fn hold_branches(&mut self, hold: bool) {
+        for c in self.contributions.iter_mut() {
+            c.hold_branches(hold);
+        }
+    }
+
     /// Restores the contributions' history of the last commit (the state
     /// vector is the stepper's to restore).
     pub(crate) fn rollback(&mut self) {

@@ -19,3 +19,4 @@ mod r2_rolling;
 mod regions;
 mod regression_original_solver;
 mod sensitivity;
+mod sensitivity_friction;
