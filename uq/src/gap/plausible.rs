@@ -243,7 +243,7 @@ mod tests {
         let y0: Vec<f64> = y.iter().map(|v| v - 0.025).collect();
         let (lo, hi) = offset_range(&loading, &y0, 1e-4).unwrap();
         assert!(lo <= 0.0 && lo > -0.02, "{lo}");
-        assert!(hi >= 0.0 && hi < 0.03, "{hi}");
+        assert!((0.0..0.03).contains(&hi), "{hi}");
     }
 
     fn prony_specs() -> Vec<ParamSpec> {
