@@ -163,7 +163,12 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
     // (not at a minimum short of it) is reported as `on_limit`.
     let blocked = outcome.blocked;
     let outcome = match outcome.blocked {
-        true => match wall_slide(objective, &options.fd, &outcome) {
+        true => match wall_slide(
+            objective,
+            &options.fd,
+            &outcome,
+            slide_budget(&options.method),
+        ) {
             Some(slid) => {
                 evaluations += slid.evaluations;
                 jacobians += slid.jacobians;
@@ -217,6 +222,17 @@ pub fn fit(objective: &Objective, options: &FitOptions) -> Result<FitReport, Inv
     report.best_start = best_start;
     report.failed_starts = failed;
     Ok(report)
+}
+
+/// Evaluations the wall slide after a blocked run may spend: the method's
+/// own budget of one run (Levenberg-Marquardt's `max_evaluations`), or, for
+/// a method that counts only iterations, 5000 (the Levenberg-Marquardt
+/// default).
+fn slide_budget(method: &Method) -> usize {
+    match method {
+        Method::LevenbergMarquardt(lm) => lm.max_evaluations,
+        Method::Bfgs(_) | Method::Lbfgs { .. } => crate::LmOptions::default().max_evaluations,
+    }
 }
 
 /// Statistics at free unbounded values `z` (the solver fields of the report

@@ -1037,3 +1037,61 @@ fn rejected_trials_do_not_pay_for_sensitivities() {
     assert!(rejected_exact < rejected, "{rejected_exact} of {rejected}");
     assert_eq!(exact, 1 + report.iterations as usize + rejected_exact);
 }
+
+/// The line of [`an_optimum_on_an_admissibility_limit_is_reached_along_it`]
+/// whose law rejects a + b <= 0, on its 11 samples.
+fn walled_line() -> Objective {
+    let walled: Arc<dyn ForwardModel> = Arc::new(FnModel {
+        name: "walled line",
+        space: ParamSpace::new(vec![p("a", -INF, INF, 1.0), p("b", -INF, INF, 1.0)]),
+        law: |t, x| {
+            if t[0] + t[1] > 0.0 {
+                Ok(t[0] + t[1] * x)
+            } else {
+                Err(ForwardError::InvalidParameter {
+                    name: "a + b".into(),
+                    value: t[0] + t[1],
+                    reason: "must be > 0".into(),
+                })
+            }
+        },
+    });
+    let x = times(11, 4.0);
+    let y: Vec<f64> = x
+        .iter()
+        .enumerate()
+        .map(|(i, v)| -1.0 + 0.5 * v + if i % 2 == 0 { 0.05 } else { -0.05 })
+        .collect();
+    let s = DataSet::new(
+        "line",
+        walled,
+        Loading::quasi_static(Drive::DisplacementMm, x),
+        y,
+    );
+    Objective::new(vec![s], ResidualKind::Absolute, &[]).unwrap()
+}
+
+/// The wall slide after a blocked run keeps to the run's evaluation budget:
+/// with 60 evaluations per run it stops after the slide that crosses the
+/// budget, short of the optimum along the limit that the default budget
+/// reaches.
+#[test]
+fn the_wall_slide_keeps_to_the_run_budget() {
+    let obj = walled_line();
+    let full = fit(&obj, &lm()).unwrap();
+    let capped = fit(
+        &obj,
+        &FitOptions::with_method(Method::LevenbergMarquardt(LmOptions {
+            max_evaluations: 60,
+            ..LmOptions::default()
+        })),
+    )
+    .unwrap();
+    assert!(
+        capped.evaluations < full.evaluations / 2,
+        "{} evaluations capped, {} not",
+        capped.evaluations,
+        full.evaluations
+    );
+    assert!(capped.sse > full.sse, "{} vs {}", capped.sse, full.sse);
+}

@@ -2,7 +2,7 @@
 //! exact (refit per fold) and linearised (one Gauss-Newton step per fold)
 //! held-out predictions.
 
-use super::fit::{fit_from_starts, Fitted};
+use super::fit::{fit_from_starts, refit_kept, Fitted};
 use super::residual::residuals;
 use super::score::sensitivities_at;
 use super::{FoldLayout, GapError};
@@ -168,13 +168,17 @@ fn cross_validate(
 ) -> Result<Vec<f64>, GapError> {
     let mut out = vec![0.0; observed.len()];
     for f in 0..folds.count {
-        refit_fold(model, loading, observed, folds, f, starts, fixed, &mut out)?;
+        refit_fold(
+            model, loading, observed, folds, f, starts, fixed, true, &mut out,
+        )?;
     }
     Ok(out)
 }
 
 /// The exact refit of one fold (see [`cross_validate`]): its held-out
-/// predictions written into `out`.
+/// predictions written into `out`. `reference`: with the tight settings
+/// of the `refit` cross-validation; otherwise with those of a whole-record
+/// fit ([`refit_kept`], a fold the linearised form left unsettled).
 #[allow(clippy::too_many_arguments)]
 fn refit_fold(
     model: &Arc<dyn ForwardModel>,
@@ -184,28 +188,20 @@ fn refit_fold(
     f: usize,
     starts: &[Vec<f64>],
     fixed: &[(String, f64)],
+    reference: bool,
     out: &mut [f64],
 ) -> Result<(), GapError> {
     let keep = folds.kept(f, observed.len());
-    let mut fitted = fit_from_starts(
-        model,
-        loading,
-        observed,
-        Some(&keep),
-        &starts[..1],
-        fixed,
-        false,
-    );
+    let refit = |starts: &[Vec<f64>]| {
+        if reference {
+            fit_from_starts(model, loading, observed, Some(&keep), starts, fixed, false)
+        } else {
+            refit_kept(model, loading, observed, &keep, starts, fixed)
+        }
+    };
+    let mut fitted = refit(&starts[..1]);
     if fitted.is_err() && starts.len() > 1 {
-        fitted = fit_from_starts(
-            model,
-            loading,
-            observed,
-            Some(&keep),
-            &starts[1..],
-            fixed,
-            false,
-        );
+        fitted = refit(&starts[1..]);
     }
     let fitted = fitted?;
     for i in folds.held_out(f) {
@@ -439,7 +435,9 @@ pub(crate) fn cross_validate_by(
         let (mut out, unsettled) =
             cross_validate_linearised(model.as_ref(), observed, folds, fitted, free, jac, refine)?;
         for f in unsettled {
-            refit_fold(model, loading, observed, folds, f, starts, fixed, &mut out)?;
+            refit_fold(
+                model, loading, observed, folds, f, starts, fixed, false, &mut out,
+            )?;
         }
         Ok(out)
     } else {

@@ -289,7 +289,7 @@ pub fn diagnose(
     );
 
     // Explain: the verdict as the first member of a set of effects.
-    let stage = Stage {
+    let mut stage = Stage {
         base,
         base_theta: &base_theta,
         loading,
@@ -320,7 +320,7 @@ pub fn diagnose(
         .and_then(|e| assessed.iter().find(|a| a.ranked.effect == e));
     let (explanation_set, remainder, dropped, set_fit, explanation) = match first {
         Some(first) => {
-            let set = explain(&stage, &base_fit.full, &base_fit.cv, first, &offered);
+            let set = explain(&mut stage, &base_fit.full, &base_fit.cv, first, &offered);
             let mut text = decision.explanation.clone();
             if set.members.len() > 1 || !set.dropped.is_empty() {
                 text.push_str(&set_sentence(&set.members, &set.dropped));

@@ -15,7 +15,17 @@
 //! the span of the unloaded samples' drives widened by 2 % of the drive
 //! range (the response of a soft contact rises slowly and stays below the
 //! threshold for a while) and always holding d0 = 0, the base model.
+//!
+//! Only the first loading counts (the samples up to the end of the first
+//! phase over which the drive moves): once loaded, a history-dependent
+//! material (relaxation, an asymmetry) unloads through zero load away
+//! from its unloaded state (a relaxed specimen carries compression on the
+//! way back to its recorded zero), so a zero load met later says nothing
+//! about where the unloaded state is. A record that starts loaded has its
+//! unloaded state before its start: the offset is free on that side and
+//! held at 0 on the other.
 
+use super::crossval::phases;
 use palpate_core::{Drive, Loading, ParamRole, ParamSpec};
 use std::collections::BTreeMap;
 
@@ -34,27 +44,41 @@ pub(crate) fn offset_range(loading: &Loading, observed: &[f64], sigma: f64) -> O
         Drive::AmountOfShear => 0.0,
         Drive::PositionMm => return None,
     };
+    let drive = &loading.drive;
+    if drive.is_empty() || observed.len() != drive.len() {
+        return None;
+    }
     let peak = observed.iter().fold(0.0f64, |a, v| a.max(v.abs()));
     let threshold = (3.0 * sigma).max(UNLOADED_SHARE * peak);
-    let (lo, hi) = loading
-        .drive
+    let (dmin, dmax) = drive
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &d| {
+            (a.min(d), b.max(d))
+        });
+    // the first loading: up to the end of the first phase that moves
+    let first = phases(drive)
+        .into_iter()
+        .find(|&(a, b)| (drive[b - 1] - drive[a]).abs() > 1e-9 * (dmax - dmin))
+        .map_or(drive.len(), |(_, b)| b);
+    let (lo, hi) = drive[..first]
         .iter()
         .zip(observed)
         .filter(|(_, y)| y.abs() <= threshold)
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), (&d, _)| {
             (a.min(d), b.max(d))
         });
-    if !(lo.is_finite() && hi.is_finite()) {
-        return None;
-    }
-    let (dmin, dmax) = loading
-        .drive
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &d| {
-            (a.min(d), b.max(d))
-        });
     let slack = SLACK_SHARE * (dmax - dmin);
-    Some(((lo - slack - u0).min(0.0), (hi + slack - u0).max(0.0)))
+    if lo.is_finite() && hi.is_finite() {
+        return Some(((lo - slack - u0).min(0.0), (hi + slack - u0).max(0.0)));
+    }
+    // loaded from the start: the unloaded state lies before it, on the
+    // side the loading moves away from
+    let start = drive[0] - u0;
+    match drive[first - 1].partial_cmp(&drive[0]) {
+        Some(std::cmp::Ordering::Greater) => Some((f64::NEG_INFINITY, start.max(0.0))),
+        Some(std::cmp::Ordering::Less) => Some((start.min(0.0), f64::INFINITY)),
+        _ => None,
+    }
 }
 
 /// `specs` with every zero offset ([`ParamRole::Offset`]) held within
@@ -186,9 +210,40 @@ mod tests {
             vec![ParamSpec::new("d0_stretch", "1", -0.5, 0.5, 0.0).with_role(ParamRole::Offset)];
         assert!(bound_offsets(&mut specs, Some((lo, hi))));
         assert_eq!((specs[0].lower, specs[0].upper), (lo, hi));
-        // a record that is loaded everywhere permits anything
+        // a record that is loaded everywhere, its drive falling from the
+        // start: the unloaded state lies above its start, anywhere there
         let loaded = vec![1.0; 301];
-        assert!(offset_range(&loading, &loaded, 1e-3).is_none());
+        assert_eq!(
+            offset_range(&loading, &loaded, 1e-3),
+            Some((0.0, f64::INFINITY))
+        );
+    }
+
+    #[test]
+    fn only_the_first_loading_locates_the_unloaded_state() {
+        // Tension from stretch 1 to 1.4 and back, loaded at the start (the
+        // unloaded state lies below stretch 1), crossing zero load on the
+        // way back at 1.04 as a relaxed specimen does.
+        let mut s: Vec<f64> = (0..=200).map(|i| 1.0 + 0.002 * i as f64).collect();
+        s.extend((1..=200).map(|i| 1.4 - 0.002 * i as f64));
+        let y: Vec<f64> = s
+            .iter()
+            .enumerate()
+            .map(|(i, &l)| if i <= 200 { l - 0.975 } else { l - 1.04 })
+            .collect();
+        let loading = Loading::quasi_static(Drive::Stretch, s);
+        // the zero load at 1.04 on the way back does not count: below the
+        // start anything, above it nothing
+        assert_eq!(
+            offset_range(&loading, &y, 1e-4),
+            Some((f64::NEG_INFINITY, 0.0))
+        );
+        // unloaded at the start: the same record permits a small range
+        // around its first zero load only
+        let y0: Vec<f64> = y.iter().map(|v| v - 0.025).collect();
+        let (lo, hi) = offset_range(&loading, &y0, 1e-4).unwrap();
+        assert!(lo <= 0.0 && lo > -0.02, "{lo}");
+        assert!((0.0..0.03).contains(&hi), "{hi}");
     }
 
     fn prony_specs() -> Vec<ParamSpec> {

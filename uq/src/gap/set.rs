@@ -31,7 +31,7 @@ use super::rank::rank;
 use super::residual::{residuals, rms, sse};
 use super::structure::WhitenessTests;
 use super::structure::{chi2_isf, chi2_sf, significant_windows, whiteness, GapWindow};
-use palpate_core::enrichable::embed;
+use palpate_core::enrichable::{embed, enrich_forms};
 use palpate_core::{Effect, ForwardModel, Loading};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
@@ -228,6 +228,17 @@ impl Stage<'_> {
     /// `effects` fitted to the record, starting from the parameters of
     /// `donor` (by name; the others at "off"), cross-validated.
     fn fit_set(&self, effects: &[Effect], donor: &SetFit) -> Option<SetFit> {
+        self.fit_set_with(effects, donor, &self.form_index())
+    }
+
+    /// [`Self::fit_set`] with the effects of several forms in the forms
+    /// `forms` (by index).
+    fn fit_set_with(
+        &self,
+        effects: &[Effect],
+        donor: &SetFit,
+        forms: &BTreeMap<Effect, usize>,
+    ) -> Option<SetFit> {
         let prefix = self.base.space().names();
         let model: Arc<dyn ForwardModel> = Arc::new(compose(
             self.base,
@@ -235,7 +246,7 @@ impl Stage<'_> {
             &prefix,
             self.base_theta,
             self.offsets,
-            &self.form_index(),
+            forms,
         )?);
         let names = model.space().names();
         let donor_names = &donor.names;
@@ -359,6 +370,59 @@ impl Stage<'_> {
         Some((best, next))
     }
 
+    /// The form of every member of several forms (the law of
+    /// `material_form`) chosen again given the other members of `current`,
+    /// by the rule of the first step (the held-out misfit, each parameter
+    /// charged the chi2(1) quantile at alpha): the form chosen against the
+    /// base alone shapes what the other effects leave there (an Ogden law
+    /// bends to mimic a zero offset), and once the offset is in the set a
+    /// simpler law may predict better. Returns the set refitted in the new
+    /// forms and the members whose form changed, or `None` when every form
+    /// stands.
+    fn rechoose_forms(&mut self, current: &SetFit) -> Option<(SetFit, Vec<Effect>)> {
+        if current.effects.len() < 2 {
+            return None;
+        }
+        let s2 = self.sigma * self.sigma;
+        let charge = chi2_isf(self.alpha, 1.0);
+        let score =
+            |s: &SetFit| sse(&residuals(self.observed, &s.cv)) / s2 + charge * s.names.len() as f64;
+        let mut best = current.clone();
+        let mut changed = Vec::new();
+        for &e in &current.effects {
+            let Some(&(k0, _)) = self.forms.get(&e) else {
+                continue;
+            };
+            let names: Vec<String> = enrich_forms(self.base, e)
+                .map(|f| f.into_iter().map(|f| f.name).collect())
+                .unwrap_or_default();
+            if names.len() < 2 {
+                continue;
+            }
+            let tried: Vec<(usize, SetFit)> = (0..names.len())
+                .into_par_iter()
+                .filter(|&k| k != k0)
+                .filter_map(|k| {
+                    let mut forms = self.form_index();
+                    forms.insert(e, k);
+                    self.fit_set_with(&best.effects, &best, &forms)
+                        .map(|s| (k, s))
+                })
+                .collect();
+            let winner = tried
+                .into_iter()
+                .min_by(|a, b| score(&a.1).total_cmp(&score(&b.1)));
+            if let Some((k, s)) = winner {
+                if score(&s) < score(&best) {
+                    self.forms.insert(e, (k, names[k].clone()));
+                    best = s;
+                    changed.push(e);
+                }
+            }
+        }
+        (!changed.is_empty()).then_some((best, changed))
+    }
+
     /// Whether `member` earns its place in `set` against `without` (the set
     /// refitted without it): likelihood ratio, held-out gain, materiality.
     /// Returns (earns, likelihood ratio, held-out gain).
@@ -411,7 +475,7 @@ type Drop = (Effect, SetFit, bool, f64, f64);
 /// backward check); `base_full` and `base_cv` are the base fit and its
 /// held-out predictions.
 pub(crate) fn explain(
-    stage: &Stage<'_>,
+    stage: &mut Stage<'_>,
     base_full: &Fitted,
     base_cv: &[f64],
     first: &Assessed,
@@ -454,6 +518,26 @@ pub(crate) fn explain(
         joined.push(Joined::from(&best));
         cache.push(next.clone());
         current = next;
+        // The set changed: the forms of its members are chosen again, and
+        // the fits made in the old forms are forgotten.
+        if let Some((refit, changed)) = stage.rechoose_forms(&current) {
+            cache.retain(|s| !s.effects.iter().any(|e| changed.contains(e)));
+            for j in joined.iter_mut().filter(|j| changed.contains(&j.effect)) {
+                let name = stage.forms.get(&j.effect).map_or("", |f| f.1.as_str());
+                j.evidence.push_str(&format!(
+                    "; form chosen again once {{{}}} were in the set: {name}",
+                    refit
+                        .effects
+                        .iter()
+                        .filter(|e| **e != j.effect)
+                        .map(|e| e.name())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ));
+            }
+            cache.push(refit.clone());
+            current = refit;
+        }
     }
     // Backward check: drop the weakest member that no longer earns its
     // place, until every one does.
