@@ -298,6 +298,37 @@ fn tool_compliance_satisfies_the_series_spring_relation() {
     }
 }
 
+/// Around a relaxing specimen (QLV, one Prony term) and a compliance stiff
+/// against it, the solved travel still satisfies d = u + c F(u) sample by
+/// sample through a ramp and a hold.
+#[test]
+fn tool_compliance_holds_around_a_relaxing_specimen() {
+    let base = Viscoelastic::new(Box::new(C1Compression::new(Law::NeoHookean)), 1);
+    let theta_base = [2e-2, 0.6, 0.5]; // C10 MPa, g1, tau1 s
+    let time: Vec<f64> = (0..=60).map(|i| 0.05 * i as f64).collect();
+    let u: Vec<f64> = time.iter().map(|t| 1.5 * t.min(1.0)).collect();
+    let fu = base
+        .predict(
+            &theta_base,
+            &Loading::timed(Drive::DisplacementMm, time.clone(), u.clone()),
+        )
+        .unwrap();
+    let peak = fu.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    // mm/N: the machine deflects as far as the tool travels at the peak
+    let c = 1.5 / peak;
+    let d: Vec<f64> = u.iter().zip(&fu).map(|(ui, fi)| ui + c * fi).collect();
+    let model = ToolCompliance::new(Box::new(base));
+    let f = model
+        .predict(
+            &[theta_base[0], theta_base[1], theta_base[2], c],
+            &Loading::timed(Drive::DisplacementMm, time, d),
+        )
+        .unwrap();
+    for (a, b) in f.iter().zip(&fu) {
+        assert!((a - b).abs() < 1e-7 * peak, "{a} vs {b}");
+    }
+}
+
 /// Independent compressible neo-Hookean C1: Psi(l, m) = C10 (J^-2/3 (l^2 + 2 m^2) - 3) + (J - 1)^2 / D1,
 /// J = l m^2; the lateral stretch m makes dPsi/dm = 0 (bisection), P = dPsi/dl (central difference).
 fn compressible_nh_hand(c10: f64, d1: f64, l: f64) -> f64 {
