@@ -6,7 +6,9 @@
 
 use crate::model::{ModelError, Viscous, DEFAULT_MESH, MAX_MESH_LEVEL};
 use palpate_analytic::Mode;
-use palpate_fe::{Bulk, MeshDensity, N3Element, PlaneCell, Platens, Prony, Support, ToolShape};
+use palpate_fe::{
+    Bulk, MeshDensity, N3Element, Nodule, PlaneCell, Platens, Prony, Support, ToolShape,
+};
 use serde::Deserialize;
 use std::fmt;
 
@@ -259,6 +261,26 @@ impl Setting for ToolShape {
             _ => Err("expected needle, sphere:RADIUS, punch:RADIUS or platen".into()),
         }
     }
+}
+
+impl Setting for Vec<Nodule> {
+    const FIELD: &'static str = "nodules";
+    /// `X:DEPTH,...` (mm) or `none`.
+    fn from_text(s: &str) -> Result<Vec<Nodule>, String> {
+        Nodule::parse_list(s)
+    }
+}
+
+/// Nodules as `X:DEPTH,...` (mm) or `none`, as [`Nodule::parse_list`] reads them.
+pub fn nodules_text(nodules: &[Nodule]) -> String {
+    if nodules.is_empty() {
+        return "none".into();
+    }
+    let items: Vec<String> = nodules
+        .iter()
+        .map(|n| format!("{}:{}", n.x, n.depth))
+        .collect();
+    items.join(",")
 }
 
 pub(crate) fn parse_mode(s: &str) -> Result<Mode, ModelError> {

@@ -93,7 +93,7 @@ pub use defaults::{
     check_effects, default_effects, for_test, gap_base, gap_base_for, parse_effects,
     spans_tension_and_compression,
 };
-pub use fields::{parse_mesh, parse_setting, text_or_number, Mesh, Setting};
+pub use fields::{nodules_text, parse_mesh, parse_setting, text_or_number, Mesh, Setting};
 use fields::{parse_mode, setting};
 
 /// Default Coulomb friction between the N1 needle and the material (docs/benchmarks.md).
@@ -143,8 +143,8 @@ pub struct R2Spec {
     /// Rolling depth (mm).
     pub rd: f64,
     /// `X:DEPTH,...` (mm) or `none`; default docs/benchmarks.md's three nodules.
-    #[serde(default)]
-    pub nodules: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub nodules: Option<Vec<Nodule>>,
     /// Coulomb friction between wheel and block (default 0).
     #[serde(default)]
     pub friction: Option<f64>,
@@ -661,8 +661,12 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
         ));
     }
     let mut m = R2Rolling::new(law, nodule_law, s.rd);
-    let text = s.nodules.as_deref().unwrap_or(R2_DEFAULT_NODULES);
-    m.nodules = Nodule::parse_list(text).map_err(|e| ModelError::new(K, "nodules", text, e))?;
+    m.nodules = match &s.nodules {
+        Some(n) => n.clone(),
+        None => Nodule::parse_list(R2_DEFAULT_NODULES)
+            .map_err(|e| ModelError::new(K, "nodules", R2_DEFAULT_NODULES, e))?,
+    };
+    let text = fields::nodules_text(&m.nodules);
     let friction = s.friction.unwrap_or(0.0);
     if !(friction >= 0.0 && friction.is_finite()) {
         return Err(ModelError::new(

@@ -253,3 +253,36 @@ fn spec_error(text: &str) -> String {
         Ok(s) => panic!("{text} reads: {s:?}"),
     }
 }
+
+/// `[r2]`: the nodules read as `X:DEPTH,...` or `none`, and write back so.
+#[test]
+fn r2_reads_its_nodules() {
+    let r2 =
+        |extra: &str| -> ModelSpec { toml::from_str(&format!("[r2]\nrd = 6\n{extra}\n")).unwrap() };
+    let ModelSpec::R2(s) = r2("nodules = \"37.5:10, 75:15\"") else {
+        panic!("not r2")
+    };
+    let n = s.nodules.unwrap();
+    assert_eq!(nodules_text(&n), "37.5:10,75:15");
+    assert_eq!(
+        Vec::<palpate_fe::Nodule>::from_text(&nodules_text(&n)),
+        Ok(n)
+    );
+    let default = match r2("").validate() {
+        Ok(Model::R2(m)) => m.nodules.clone(),
+        other => panic!("{other:?}"),
+    };
+    assert_eq!(nodules_text(&default), R2_DEFAULT_NODULES);
+    assert!(
+        matches!(r2("nodules = \"none\"").validate(), Ok(Model::R2(m)) if m.nodules.is_empty())
+    );
+    assert_eq!(
+        spec_error("[r2]\nrd = 6\nnodules = \"75\"\n"),
+        "nodules = \"75\": `75`: expected X:DEPTH (mm), e.g. 75:15"
+    );
+    let e = r2("nodules = \"200:15\"")
+        .validate()
+        .unwrap_err()
+        .to_string();
+    assert!(e.starts_with("r2.nodules = \"200:15\""), "{e}");
+}

@@ -126,7 +126,7 @@ pub fn model_spec(o: &SimulateOptions) -> anyhow::Result<ModelSpec> {
             law: o.law.clone().unwrap_or_else(|| "arruda-boyce".into()),
             nodule_law: o.nodule_law.clone(),
             rd,
-            nodules: o.nodules.clone(),
+            nodules: opt(&o.nodules)?,
             friction: o.friction,
             mesh: opt::<Mesh>(&o.mesh)?,
             bulk: opt(&o.bulk)?,
