@@ -157,12 +157,6 @@ impl DofMap {
         self.eq[k]
     }
 
-    /// State index of component `c` of node `n`.
-    #[inline]
-    pub fn node_dof(&self, n: usize, c: usize) -> usize {
-        n * self.dim + c
-    }
-
     /// Whether a channel drives some condition.
     pub fn uses_channel(&self, channel: usize) -> bool {
         self.prescribed

@@ -94,12 +94,6 @@ impl QuadratureRule {
     }
 }
 
-/// Points and weights of the 2 x 2 Gauss rule, counter-clockwise.
-pub fn gauss_2x2() -> [([f64; 2], f64); 4] {
-    let r = QuadratureRule::gauss(CellType::Quad4, 2);
-    std::array::from_fn(|k| ([r.points[k][0], r.points[k][1]], r.weights[k]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -595,7 +595,13 @@ fn prepare_simulations(
             let model_spec = ModelSpec::N1Needle(N1NeedleSpec {
                 law: law_text.clone(),
                 friction,
-                mesh: setting(run, "mesh").or_else(|| spec.mesh.clone()),
+                mesh: crate::model::parse_setting(
+                    "n1_needle",
+                    setting(run, "mesh")
+                        .or_else(|| spec.mesh.clone())
+                        .as_deref(),
+                )
+                .map_err(|e| anyhow::anyhow!("{}: {e}", at()))?,
                 ..Default::default()
             });
             let checked = model_spec

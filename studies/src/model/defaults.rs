@@ -4,9 +4,10 @@
 //! gap diagnosis, and the effects it looks for. Moved out of
 //! [`crate::model`] (the spec and its factory), which re-exports them.
 
-use crate::model::{C1Spec, HomogeneousSpec, ModelSpec, N1NeedleSpec};
+use crate::model::{C1Spec, HomogeneousSpec, Mesh, ModelSpec, N1NeedleSpec};
 use crate::records::TestKind;
 use palpate_core::{Effect, ForwardModel};
+use palpate_fe::{N3Element, PlaneCell};
 use palpate_material::Law;
 
 /// The model of a data set's test for a law (the legacy manifest form
@@ -57,7 +58,7 @@ pub fn gap_base(test: TestKind, law: Law) -> anyhow::Result<ModelSpec> {
         TestKind::N1 => Ok(ModelSpec::N1Needle(N1NeedleSpec {
             law: spec_law,
             friction: Some(0.0),
-            mesh: Some("coarse".into()),
+            mesh: Some(Mesh::Level(1)),
             ..Default::default()
         })),
         TestKind::Homogeneous(_) | TestKind::GeneralBiaxial | TestKind::SimpleShear => {
@@ -150,10 +151,6 @@ pub fn parse_effects(names: &[String]) -> anyhow::Result<Vec<Effect>> {
         .collect()
 }
 
-/// The N1 mesh name of the Q2/P1 benchmark mesh (and, for `quad4`, the
-/// Q1/P0 one, `MeshDensity::BENCH_GRADING`).
-pub const BENCH_MESH: &str = "bench";
-
 /// Sets the mesh and element of an N1 model from a spec's `mesh` and
 /// `element` (the model's tool and friction already set).
 ///
@@ -168,36 +165,33 @@ pub const BENCH_MESH: &str = "bench";
 /// (`coarse`, `medium`, `fine`, `N`) keeps its meaning: Q1/P0 elements of
 /// 0.4/N mm unless `element` says otherwise.
 pub(crate) fn set_n1_mesh(
-    kind: &'static str,
-    mesh: Option<&str>,
-    element: Option<&str>,
+    mesh: Option<Mesh>,
+    element: Option<PlaneCell>,
     m: &mut palpate_fe::N1Needle,
-) -> Result<(), super::ModelError> {
-    use palpate_fe::{accuracy::N1_QUAD9_BENCH, MeshDensity, PlaneCell, ToolShape};
+) {
+    use palpate_fe::{accuracy::N1_QUAD9_BENCH, MeshDensity, ToolShape};
     let needle = m.tool == ToolShape::n1_needle();
-    let explicit = element
-        .map(|e| super::fields::parse_element(kind, Some(e)))
-        .transpose()?;
     match mesh {
-        None if needle && explicit != Some(PlaneCell::Quad4) => {
+        None if needle && element != Some(PlaneCell::Quad4) => {
             m.element = PlaneCell::Quad9;
             m.grading = Some(N1_QUAD9_BENCH);
         }
-        Some(BENCH_MESH) => {
-            m.element = explicit.unwrap_or(PlaneCell::Quad9);
+        Some(Mesh::Bench) => {
+            m.element = element.unwrap_or(PlaneCell::Quad9);
             m.grading = Some(match m.element {
                 PlaneCell::Quad9 => N1_QUAD9_BENCH,
                 PlaneCell::Quad4 => MeshDensity::BENCH_GRADING,
             });
         }
-        _ => {
-            m.element = explicit.unwrap_or(PlaneCell::Quad4);
-            m.mesh = MeshDensity {
-                level: super::parse_mesh(kind, mesh)?,
-            };
+        None => {
+            m.element = element.unwrap_or(PlaneCell::Quad4);
+            m.mesh = super::DEFAULT_MESH;
+        }
+        Some(Mesh::Level(level)) => {
+            m.element = element.unwrap_or(PlaneCell::Quad4);
+            m.mesh = MeshDensity { level };
         }
     }
-    Ok(())
 }
 
 /// The default N3 element when the spec names none. With no `mesh`, for
@@ -206,10 +200,10 @@ pub(crate) fn set_n1_mesh(
 /// box is +6.4 %). Otherwise the 8-node Q1/P0 box: a mesh level names the
 /// box's level, and frictionless the 27-node cells stop near 5.5 mm
 /// (docs/validation/fe.md "N3").
-pub(crate) fn n3_default_element(m: &palpate_fe::N3Needle, mesh_given: bool) -> &'static str {
+pub(crate) fn n3_default_element(m: &palpate_fe::N3Needle, mesh_given: bool) -> N3Element {
     if !mesh_given && m.friction > 0.0 && m.tool == palpate_fe::ToolShape::n1_needle() {
-        "hex27"
+        N3Element::Hex27
     } else {
-        "hex8"
+        N3Element::Hex8
     }
 }

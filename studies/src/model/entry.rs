@@ -17,7 +17,7 @@ pub struct ModelEntry {
     pub fixed: BTreeMap<String, f64>,
     /// With `law = "..."`: a viscoelastic form of the homogeneous tests,
     /// `qlv:N` or `finite:N` ([`super::Viscous`]).
-    pub viscoelastic: Option<String>,
+    pub viscoelastic: Option<super::Viscous>,
 }
 
 /// The two forms of a named model.
@@ -60,7 +60,7 @@ impl<'de> Deserialize<'de> for ModelEntry {
                 let mut law: Option<String> = None;
                 let mut spec: Option<ModelSpec> = None;
                 let mut fixed = BTreeMap::new();
-                let mut viscoelastic: Option<String> = None;
+                let mut viscoelastic: Option<super::Viscous> = None;
                 while let Some(key) = map.next_key::<String>()? {
                     let next = match key.as_str() {
                         "law" => {
@@ -121,10 +121,6 @@ impl<'de> Deserialize<'de> for ModelEntry {
                         "`viscoelastic = \"{v}\"` goes with `law = ...`; inside the `{}` table give it there",
                         s.kind()
                     )));
-                }
-                if let Some(v) = &viscoelastic {
-                    super::Viscous::parse(v)
-                        .map_err(|e| A::Error::custom(format!("viscoelastic: {e}")))?;
                 }
                 Ok(ModelEntry {
                     model,

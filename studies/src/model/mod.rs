@@ -81,7 +81,8 @@ use palpate_analytic::{
 };
 use palpate_core::ForwardModel;
 use palpate_fe::{
-    C1Fe, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, Platens, Q1Punch, R2Rolling, Support,
+    Bulk, C1Fe, MeshDensity, N1Needle, N3Element, N3Mesh, N3Needle, Nodule, PlaneCell, Platens,
+    Prony, Q1Punch, R2Rolling, Support, ToolShape,
 };
 use palpate_material::Law;
 use serde::Deserialize;
@@ -92,14 +93,14 @@ pub use defaults::{
     check_effects, default_effects, for_test, gap_base, gap_base_for, parse_effects,
     spans_tension_and_compression,
 };
-use fields::{parse_bulk, parse_element, parse_mode, parse_prony, parse_tool};
-pub use fields::{parse_mesh, text_or_number};
+pub use fields::{nodules_text, parse_mesh, parse_setting, text_or_number, Mesh, Setting};
+use fields::{parse_mode, setting};
 
 /// Default Coulomb friction between the N1 needle and the material (docs/benchmarks.md).
 pub const DEFAULT_FRICTION: f64 = 0.8;
 /// Default mesh of the FE models (level 2: N1 0.2 mm elements under the
 /// tool, C1 38 x 18 elements).
-pub const DEFAULT_MESH: &str = "medium";
+pub const DEFAULT_MESH: MeshDensity = MeshDensity::MEDIUM;
 /// The finest mesh level accepted.
 pub const MAX_MESH_LEVEL: usize = 12;
 
@@ -142,18 +143,18 @@ pub struct R2Spec {
     /// Rolling depth (mm).
     pub rd: f64,
     /// `X:DEPTH,...` (mm) or `none`; default docs/benchmarks.md's three nodules.
-    #[serde(default)]
-    pub nodules: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub nodules: Option<Vec<Nodule>>,
     /// Coulomb friction between wheel and block (default 0).
     #[serde(default)]
     pub friction: Option<f64>,
     /// `coarse` (default), `medium`, `fine` or a level 1..R2_MAX_LEVEL:
     /// 9-node elements of 2/N mm at the surface and around the nodules.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub mesh: Option<String>,
+    #[serde(default)]
+    pub mesh: Option<Mesh>,
     /// `exact` (default) or a bulk-to-shear ratio K/mu.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub bulk: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub bulk: Option<Bulk>,
 }
 
 fn arruda_boyce() -> String {
@@ -179,7 +180,7 @@ pub struct HomogeneousSpec {
     pub axial_stretch: Option<f64>,
     /// A viscoelastic form ([`Viscous`]): `qlv:N` or `finite:N`; none: elastic.
     #[serde(default)]
-    pub viscoelastic: Option<String>,
+    pub viscoelastic: Option<Viscous>,
 }
 
 /// A viscoelastic form of a homogeneous test, with its number of Prony terms.
@@ -237,18 +238,18 @@ pub struct C1Spec {
 pub struct C1FeSpec {
     pub law: String,
     /// `frictionless` (default) or `bonded`.
-    #[serde(default)]
-    pub platens: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub platens: Option<Platens>,
     /// `coarse`, `medium` (default), `fine` or a level 1..12: 19N x 9N elements.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub mesh: Option<String>,
+    #[serde(default)]
+    pub mesh: Option<Mesh>,
     /// `exact` (default) or a bulk-to-shear ratio K/mu.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub bulk: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub bulk: Option<Bulk>,
     /// A Prony series `g1=..,tau1=..,g2=..,tau2=..` on the law's isochoric
     /// stress (`palpate_fe::Viscoelastic`); none: elastic.
-    #[serde(default)]
-    pub prony: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub prony: Option<Prony>,
 }
 
 /// `[... .n1_needle]`
@@ -260,25 +261,25 @@ pub struct N1NeedleSpec {
     #[serde(default)]
     pub friction: Option<f64>,
     /// `coarse`, `medium` (default), `fine` or a level 1..12: elements of 0.4/N mm under the tool.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub mesh: Option<String>,
+    #[serde(default)]
+    pub mesh: Option<Mesh>,
     /// `exact` (default) or a bulk-to-shear ratio K/mu.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub bulk: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub bulk: Option<Bulk>,
     /// `bonded` (default) or `sliding`.
-    #[serde(default)]
-    pub base: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub base: Option<Support>,
     /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
-    #[serde(default)]
-    pub tool: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub tool: Option<ToolShape>,
     /// `quad4` (default: 4-node Q1/P0) or `quad9` (9-node Q2/P1 on the
     /// same grading, each cell made quadratic).
-    #[serde(default)]
-    pub element: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub element: Option<PlaneCell>,
     /// A Prony series `g1=..,tau1=..,g2=..,tau2=..` on the law's isochoric
     /// stress (`palpate_fe::Viscoelastic`); none: elastic.
-    #[serde(default)]
-    pub prony: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub prony: Option<Prony>,
 }
 
 /// `[... .q1]`
@@ -287,17 +288,17 @@ pub struct N1NeedleSpec {
 pub struct Q1Spec {
     pub law: String,
     /// `coarse`, `medium` (default), `fine` or a level 1..12: elements of 0.2/N mm under the punch.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub mesh: Option<String>,
+    #[serde(default)]
+    pub mesh: Option<Mesh>,
     /// `exact` (default) or a bulk-to-shear ratio K/mu.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub bulk: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub bulk: Option<Bulk>,
     /// `quad4` (default, Q1/P0) or `quad9` (Q2/P1).
-    #[serde(default)]
-    pub element: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub element: Option<PlaneCell>,
     /// A Prony series `g1=..,tau1=..,g2=..,tau2=..`; none: elastic.
-    #[serde(default)]
-    pub prony: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub prony: Option<Prony>,
     /// Radius of the punch's rounded edge (mm), 0 < edge_radius < 2 (the
     /// punch radius); default 0.2 (`palpate_fe::q1::DEFAULT_EDGE_RADIUS`).
     #[serde(default)]
@@ -324,24 +325,24 @@ pub struct N3NeedleSpec {
     pub friction: Option<f64>,
     /// `coarse` (default for N3), `medium`, `fine` or a level 1..N3_MAX_LEVEL:
     /// hexahedra of 0.8/N mm under the tool.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub mesh: Option<String>,
-    /// `exact` (default) or a bulk-to-shear ratio K/mu.
-    #[serde(default, deserialize_with = "text_or_number")]
-    pub bulk: Option<String>,
-    /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
     #[serde(default)]
-    pub tool: Option<String>,
+    pub mesh: Option<Mesh>,
+    /// `exact` (default) or a bulk-to-shear ratio K/mu.
+    #[serde(default, deserialize_with = "setting")]
+    pub bulk: Option<Bulk>,
+    /// `needle` (default), `sphere:R`, `punch:R` or `platen`.
+    #[serde(default, deserialize_with = "setting")]
+    pub tool: Option<ToolShape>,
     /// `hex8` (default: 8-node Q1/P0 hexahedra on the box) or `hex27`
     /// (27-node Q2/P1 hexahedra on the quarter O-grid, cells of 1.6/N mm).
-    #[serde(default)]
-    pub element: Option<String>,
+    #[serde(default, deserialize_with = "setting")]
+    pub element: Option<N3Element>,
 }
 
 /// The default N3 mesh: level 1 (the box of 0.8 mm hexahedra, 2,340 cells,
 /// 10,125 equations; level 2 has 17,400 cells, ~70,000 equations;
 /// docs/validation/fe.md "N3").
-pub const N3_DEFAULT_MESH: &str = "coarse";
+pub const N3_DEFAULT_MESH: Mesh = Mesh::Level(1);
 /// The finest N3 level accepted: level 3 (the box: ~57,000 hexahedra)
 /// would need more memory and time than a 2-core, few-GiB machine has.
 pub const N3_MAX_LEVEL: usize = 2;
@@ -541,32 +542,20 @@ impl ModelSpec {
             ModelSpec::C1(_) => Model::C1(C1Compression::new(law)),
             ModelSpec::C1Fe(s) => {
                 const K: &str = "c1_fe";
-                let platens = match s.platens.as_deref().unwrap_or("frictionless") {
-                    "frictionless" => Platens::Frictionless,
-                    "bonded" => Platens::Bonded,
-                    other => {
-                        return Err(ModelError::new(
-                            K,
-                            "platens",
-                            other,
-                            "expected frictionless or bonded",
-                        ))
-                    }
-                };
-                let mut m = C1Fe::new(law, platens);
-                let level = parse_mesh(K, s.mesh.as_deref())?;
+                let mut m = C1Fe::new(law, s.platens.unwrap_or(Platens::Frictionless));
+                let level = mesh_level(K, s.mesh)?;
                 m.elements = (19 * level, 9 * level);
-                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
-                m.prony = parse_prony(K, s.prony.as_deref())?;
+                m.bulk = s.bulk.unwrap_or(Bulk::Exact);
+                m.prony = s.prony.clone();
                 Model::C1Fe(m)
             }
             ModelSpec::Q1(s) => {
                 const K: &str = "q1";
                 let mut m = Q1Punch::new(law);
-                m.level = parse_mesh(K, s.mesh.as_deref())?;
-                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
-                m.element = parse_element(K, s.element.as_deref())?;
-                m.prony = parse_prony(K, s.prony.as_deref())?;
+                m.level = mesh_level(K, s.mesh)?;
+                m.bulk = s.bulk.unwrap_or(Bulk::Exact);
+                m.element = s.element.unwrap_or(PlaneCell::Quad4);
+                m.prony = s.prony.clone();
                 if let Some(rho) = s.edge_radius {
                     m.set_edge_radius(rho)
                         .map_err(|e| ModelError::new(K, "edge_radius", rho, e))?;
@@ -586,22 +575,11 @@ impl ModelSpec {
                     ));
                 }
                 m.friction = friction;
-                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
-                m.base = match s.base.as_deref().unwrap_or("bonded") {
-                    "bonded" => Support::Bonded,
-                    "sliding" => Support::Sliding,
-                    other => {
-                        return Err(ModelError::new(
-                            K,
-                            "base",
-                            other,
-                            "expected bonded or sliding",
-                        ))
-                    }
-                };
-                m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
-                defaults::set_n1_mesh(K, s.mesh.as_deref(), s.element.as_deref(), &mut m)?;
-                m.prony = parse_prony(K, s.prony.as_deref())?;
+                m.bulk = s.bulk.unwrap_or(Bulk::Exact);
+                m.base = s.base.unwrap_or(Support::Bonded);
+                m.tool = s.tool.unwrap_or_else(ToolShape::n1_needle);
+                defaults::set_n1_mesh(s.mesh, s.element, &mut m);
+                m.prony = s.prony.clone();
                 Model::N1Needle(m)
             }
             ModelSpec::N3Needle(s) => {
@@ -617,13 +595,13 @@ impl ModelSpec {
                     ));
                 }
                 m.friction = friction;
-                let text = s.mesh.as_deref().unwrap_or(N3_DEFAULT_MESH);
-                let level = parse_mesh(K, Some(text))?;
+                let mesh = s.mesh.unwrap_or(N3_DEFAULT_MESH);
+                let level = mesh.level(K)?;
                 if level > N3_MAX_LEVEL {
                     return Err(ModelError::new(
                         K,
                         "mesh",
-                        text,
+                        mesh,
                         format!(
                             "N3 accepts levels 1..{N3_MAX_LEVEL} (coarse, medium): level {level} has {} equations, beyond this machine's memory and time (docs/validation/fe.md, N3)",
                             n3_equations(level)
@@ -631,26 +609,13 @@ impl ModelSpec {
                     ));
                 }
                 m.level = level;
-                m.bulk = parse_bulk(K, s.bulk.as_deref())?;
-                m.tool = parse_tool(K, s.tool.as_deref().unwrap_or("needle"))?;
-                match s
+                m.bulk = s.bulk.unwrap_or(Bulk::Exact);
+                m.tool = s.tool.unwrap_or_else(ToolShape::n1_needle);
+                m.element = s
                     .element
-                    .as_deref()
-                    .unwrap_or(defaults::n3_default_element(&m, s.mesh.is_some()))
-                {
-                    "hex8" => {}
-                    "hex27" => {
-                        m.element = N3Element::Hex27;
-                        m.mesh = N3Mesh::OGrid;
-                    }
-                    other => {
-                        return Err(ModelError::new(
-                            K,
-                            "element",
-                            other,
-                            "expected hex8 or hex27",
-                        ))
-                    }
+                    .unwrap_or_else(|| defaults::n3_default_element(&m, s.mesh.is_some()));
+                if m.element == N3Element::Hex27 {
+                    m.mesh = N3Mesh::OGrid;
                 }
                 Model::N3Needle(m)
             }
@@ -669,6 +634,12 @@ fn experiment_model(s: &ExperimentSpec) -> Result<Model, ModelError> {
         spec: s.clone(),
         model,
     }))
+}
+
+/// The level of a spec's mesh (absent: [`DEFAULT_MESH`]) for a kind that
+/// has levels only.
+fn mesh_level(kind: &'static str, mesh: Option<Mesh>) -> Result<usize, ModelError> {
+    mesh.map_or(Ok(DEFAULT_MESH.level), |m| m.level(kind))
 }
 
 /// The R2 model of a spec: every field checked, the geometry (nodules
@@ -690,8 +661,12 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
         ));
     }
     let mut m = R2Rolling::new(law, nodule_law, s.rd);
-    let text = s.nodules.as_deref().unwrap_or(R2_DEFAULT_NODULES);
-    m.nodules = Nodule::parse_list(text).map_err(|e| ModelError::new(K, "nodules", text, e))?;
+    m.nodules = match &s.nodules {
+        Some(n) => n.clone(),
+        None => Nodule::parse_list(R2_DEFAULT_NODULES)
+            .map_err(|e| ModelError::new(K, "nodules", R2_DEFAULT_NODULES, e))?,
+    };
+    let text = fields::nodules_text(&m.nodules);
     let friction = s.friction.unwrap_or(0.0);
     if !(friction >= 0.0 && friction.is_finite()) {
         return Err(ModelError::new(
@@ -702,8 +677,8 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
         ));
     }
     m.friction = friction;
-    let mesh = s.mesh.as_deref().unwrap_or("coarse");
-    let level = parse_mesh(K, Some(mesh))?;
+    let mesh = s.mesh.unwrap_or(Mesh::Level(1));
+    let level = mesh.level(K)?;
     if level > R2_MAX_LEVEL {
         return Err(ModelError::new(
             K,
@@ -715,7 +690,7 @@ fn r2_model(s: &R2Spec, law: Law) -> Result<R2Rolling, ModelError> {
         ));
     }
     m.level = level;
-    m.bulk = parse_bulk(K, s.bulk.as_deref())?;
+    m.bulk = s.bulk.unwrap_or(Bulk::Exact);
     // the scalars and the geometry, named (rd deeper than the wheel allows,
     // a nodule outside the block or overlapping another)
     palpate_fe::r2::check_model(&m).map_err(|(field, reason)| {
@@ -782,11 +757,10 @@ fn homogeneous_model(law: Law, s: &HomogeneousSpec) -> Result<Model, ModelError>
             )
         }
     };
-    let Some(v) = &s.viscoelastic else {
+    let Some(v) = s.viscoelastic else {
         return Ok(elastic);
     };
-    let viscous = Viscous::parse(v).map_err(|e| ModelError::new(K, "viscoelastic", v, e))?;
-    Ok(match (viscous, &elastic) {
+    Ok(match (v, &elastic) {
         (_, Model::GeneralBiaxial(_)) => {
             return Err(ModelError::new(
                 K,
@@ -827,7 +801,7 @@ pub fn record_spec(record: &TestData, law: Law, viscous: Option<Viscous>) -> Mod
         if record.test == TestKind::SimpleShear && record.axial_stretch != 1.0 {
             h.axial_stretch = Some(record.axial_stretch);
         }
-        h.viscoelastic = viscous.map(|v| v.to_string());
+        h.viscoelastic = viscous;
     }
     spec
 }

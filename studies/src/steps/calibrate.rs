@@ -190,14 +190,7 @@ pub(crate) fn run_calibrate(
                         method,
                         fixed: entry.fixed.iter().map(|(k, v)| (k.clone(), *v)).collect(),
                         observer: None,
-                        viscous: entry
-                            .viscoelastic
-                            .as_deref()
-                            .map(crate::model::Viscous::parse)
-                            .transpose()
-                            .map_err(|e| {
-                                anyhow::anyhow!("models.{model_name}.viscoelastic: {e}")
-                            })?,
+                        viscous: entry.viscoelastic,
                     })
                     .with_context(|| {
                         format!(

@@ -104,7 +104,12 @@ impl Manifest {
     /// Parses manifest text (errors name `path`).
     pub fn parse(path: &Path, text: &str) -> anyhow::Result<Manifest> {
         let err = |e: toml::de::Error| {
-            anyhow::anyhow!("{}: {}", path.display(), e.to_string().trim_end())
+            let at = e
+                .span()
+                .and_then(|span| key_path_at(text, span.start))
+                .map(|keys| format!("{keys}: "))
+                .unwrap_or_default();
+            anyhow::anyhow!("{}: {at}{}", path.display(), e.to_string().trim_end())
         };
         let tables = toml::from_str::<Experiments>(text)
             .map_err(err)?
@@ -207,6 +212,37 @@ impl Manifest {
         drop(study);
         Ok(CheckedManifest(self))
     }
+}
+
+/// The dotted path (`models.x.n1_needle.mesh`, `steps[0].calibrate.name`)
+/// of the innermost value of a TOML document at byte `at`, to name the
+/// field of an error the TOML reader places by line only.
+fn key_path_at(text: &str, at: usize) -> Option<String> {
+    use toml::de::{DeTable, DeValue};
+    fn find(v: &DeValue<'_>, at: usize, path: &mut Vec<String>) -> bool {
+        let mut visit = |key: String, child: &toml::Spanned<DeValue<'_>>| {
+            path.push(key);
+            if find(child.get_ref(), at, path) || child.span().contains(&at) {
+                return true;
+            }
+            path.pop();
+            false
+        };
+        match v {
+            DeValue::Table(t) => t.iter().any(|(k, c)| visit(format!(".{}", k.get_ref()), c)),
+            DeValue::Array(a) => a
+                .iter()
+                .enumerate()
+                .any(|(i, c)| visit(format!("[{i}]"), c)),
+            _ => false,
+        }
+    }
+    let doc = DeTable::parse(text).ok()?;
+    let mut path = Vec::new();
+    find(&DeValue::Table(doc.into_inner()), at, &mut path).then(|| {
+        let p = path.concat();
+        p.trim_start_matches('.').to_string()
+    })
 }
 
 /// Checks a name used as a file or folder name inside the run folder: not

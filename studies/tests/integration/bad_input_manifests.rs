@@ -73,8 +73,8 @@ fn manifest_mistakes_name_the_manifest_and_the_field() {
         (format!("{head}[data.uni]\nfile = \"none.csv\"\ntest = \"uniaxial\"\n{}", step("f", "")), vec!["data.uni.file", "none.csv"]),
         (format!("{head}[data.uni]\nfile = \"d.csv\"\ntest = \"shear\"\n{}", step("f", "")), vec!["data.uni.test", "shear"]),
         (format!("{head}{DATA}[models.x]\nlaw = \"ogden:0\"\n{}", step("f", "")), vec!["models.x.law"]),
-        (format!("{head}{DATA}[models.x.n1_needle]\nlaw = \"neo-hookean\"\nmesh = 0\n{}", step("f", "")), vec!["models.x.n1_needle.mesh"]),
-        (format!("{head}{DATA}[models.x.c1_fe]\nlaw = \"neo-hookean\"\nplatens = \"glued\"\n{}", step("f", "")), vec!["models.x.c1_fe.platens", "glued"]),
+        (format!("{head}{DATA}[models.x.n1_needle]\nlaw = \"neo-hookean\"\nmesh = 0\n{}", step("f", "")), vec!["models.x.n1_needle.mesh", "line 14", "mesh = \"0\": expected coarse, medium, fine or a level 1..12"]),
+        (format!("{head}{DATA}[models.x.c1_fe]\nlaw = \"neo-hookean\"\nplatens = \"glued\"\n{}", step("f", "")), vec!["models.x.c1_fe.platens", "line 14", "platens = \"glued\": expected frictionless or bonded"]),
         (format!("{head}{DATA}{}", step("f", "colour = 1")), vec!["colour"]),
         (format!("{head}{DATA}{}", step("f", "residuals = ")), vec!["m.toml"]),
     ];

@@ -3,7 +3,7 @@
 //! to 3 mm, Q1 to 0.1 mm with a 10-sample history.
 
 use palpate_core::{Drive, ForwardModel, Loading};
-use palpate_studies::model::{build, ModelSpec, N1NeedleSpec, Q1Spec};
+use palpate_studies::model::{build, Mesh, ModelSpec, N1NeedleSpec, Q1Spec};
 use serde_json::Value;
 use std::path::Path;
 use std::process::{Command, Output};
@@ -61,7 +61,7 @@ fn n1_posterior_through_a_cached_surrogate() {
     let truth = [6e-4, 3e-4];
     let spec = ModelSpec::N1Needle(N1NeedleSpec {
         law: "mooney-rivlin".into(),
-        mesh: Some("coarse".into()),
+        mesh: Some(Mesh::Level(1)),
         ..Default::default()
     });
     let model = build(&spec).unwrap();
@@ -157,7 +157,7 @@ fn the_box_is_checked_and_its_edge_reported() {
     let dir = tempfile::tempdir().unwrap();
     let spec = ModelSpec::N1Needle(N1NeedleSpec {
         law: "neo-hookean".into(),
-        mesh: Some("coarse".into()),
+        mesh: Some(Mesh::Level(1)),
         ..Default::default()
     });
     let loading = Loading::quasi_static(Drive::DisplacementMm, vec![0.0, 0.5, 1.0, 1.5]);
@@ -240,8 +240,8 @@ fn q1_ramp_and_hold_through_the_surrogate() {
     let dir = tempfile::tempdir().unwrap();
     let spec = ModelSpec::Q1(Q1Spec {
         law: "neo-hookean".into(),
-        mesh: Some("coarse".into()),
-        prony: Some("g1=0.3,tau1=1".into()),
+        mesh: Some(Mesh::Level(1)),
+        prony: Some("g1=0.3,tau1=1".parse().unwrap()),
         ..Default::default()
     });
     let time = vec![0.0, 0.125, 0.25, 0.375, 0.5, 1.0, 1.5, 2.5, 3.5, 5.0];

@@ -305,13 +305,6 @@ impl Posterior {
         ds.model.predict(&x[..self.n_model], &ds.loading)
     }
 
-    /// Log prior + log-likelihood at physical parameters `x` (no Jacobian):
-    /// the posterior density of x, up to the evidence.
-    pub fn log_posterior_physical(&self, x: &[f64]) -> f64 {
-        let mut w = self.make_worker(1.0);
-        w.log_physical(x)
-    }
-
     /// The power posterior prior x likelihood^beta (in the unbounded space,
     /// with the log-Jacobian), used by thermodynamic integration.
     pub fn tempered(&self, beta: f64) -> Tempered<'_> {

@@ -86,32 +86,37 @@ pub(super) fn check_options(o: &SampleOptions) -> anyhow::Result<()> {
 
 /// The model spec of the record: the docs/benchmarks.md set-up with the
 /// options given (mesh coarse unless `mesh`).
-pub fn model_spec(kind: &str, o: &SampleOptions) -> ModelSpec {
-    let mesh = Some(o.mesh.clone().unwrap_or_else(|| "coarse".into()));
-    match kind {
+pub fn model_spec(kind: &str, o: &SampleOptions) -> anyhow::Result<ModelSpec> {
+    // a setting's text parsed, the error naming the option (`--mesh 0: ...`)
+    fn opt<T: crate::model::Setting>(text: &Option<String>) -> anyhow::Result<Option<T>> {
+        crate::model::parse_setting::<T>("sample", text.as_deref())
+            .map_err(|e| anyhow::anyhow!("{}", e.as_option()))
+    }
+    let mesh = Some(opt(&o.mesh)?.unwrap_or(crate::model::Mesh::Level(1)));
+    Ok(match kind {
         "N1" => ModelSpec::N1Needle(N1NeedleSpec {
             law: o.law.clone().unwrap_or_default(),
             friction: o.friction,
             mesh,
-            bulk: o.bulk.clone(),
+            bulk: opt(&o.bulk)?,
             ..Default::default()
         }),
         "N3" => ModelSpec::N3Needle(N3NeedleSpec {
             law: o.law.clone().unwrap_or_default(),
             friction: o.friction,
             mesh,
-            bulk: o.bulk.clone(),
+            bulk: opt(&o.bulk)?,
             ..Default::default()
         }),
         _ => ModelSpec::Q1(Q1Spec {
             law: o.law.clone().unwrap_or_default(),
             mesh,
-            bulk: o.bulk.clone(),
-            prony: o.prony.clone(),
+            bulk: opt(&o.bulk)?,
+            prony: opt(&o.prony)?,
             edge_radius: o.edge_radius,
             ..Default::default()
         }),
-    }
+    })
 }
 
 /// Reads the one record of the FE benchmark `kind` (`FILE` or

@@ -472,7 +472,7 @@ pub fn run(prepared: Prepared, observer: &dyn Observer) -> anyhow::Result<Sample
             (sets, None)
         }
         Records::Fe(kind, data) => {
-            let spec = fe::model_spec(kind, &o);
+            let spec = fe::model_spec(kind, &o)?;
             let fe = fe::surrogate(data, spec, &o, observer)?;
             let set = DataSet {
                 name: kind.to_string(),

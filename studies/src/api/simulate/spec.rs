@@ -4,7 +4,9 @@
 use anyhow::{anyhow, bail};
 
 use super::SimulateOptions;
-use crate::model::{C1FeSpec, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec, R2Spec};
+use crate::model::{
+    parse_setting, C1FeSpec, Mesh, ModelSpec, N1NeedleSpec, N3NeedleSpec, Q1Spec, R2Spec, Setting,
+};
 
 /// The model the options describe: N1 -> `n1_needle`, N3 -> `n3_needle`,
 /// C1 -> `c1_fe`, Q1 -> `q1`; an option of another benchmark is refused by name, since it
@@ -112,6 +114,10 @@ pub fn model_spec(o: &SimulateOptions) -> anyhow::Result<ModelSpec> {
             users.join(" and ")
         );
     }
+    // a setting's text parsed, the error naming the option (`--mesh 0: ...`)
+    fn opt<T: Setting>(text: &Option<String>) -> anyhow::Result<Option<T>> {
+        parse_setting::<T>("simulate", text.as_deref()).map_err(|e| anyhow!("{}", e.as_option()))
+    }
     if kind == "R2" {
         let rd = o.rd.ok_or_else(|| {
             anyhow!("--benchmark R2 needs --rd RD (the rolling depth in mm, e.g. 6)")
@@ -120,10 +126,10 @@ pub fn model_spec(o: &SimulateOptions) -> anyhow::Result<ModelSpec> {
             law: o.law.clone().unwrap_or_else(|| "arruda-boyce".into()),
             nodule_law: o.nodule_law.clone(),
             rd,
-            nodules: o.nodules.clone(),
+            nodules: opt(&o.nodules)?,
             friction: o.friction,
-            mesh: o.mesh.clone(),
-            bulk: o.bulk.clone(),
+            mesh: opt::<Mesh>(&o.mesh)?,
+            bulk: opt(&o.bulk)?,
         }));
     }
     let law = o
@@ -133,39 +139,39 @@ pub fn model_spec(o: &SimulateOptions) -> anyhow::Result<ModelSpec> {
     Ok(if kind == "Q1" {
         ModelSpec::Q1(Q1Spec {
             law: law.clone(),
-            mesh: o.mesh.clone(),
-            bulk: o.bulk.clone(),
-            element: o.element.clone(),
-            prony: o.prony.clone(),
+            mesh: opt::<Mesh>(&o.mesh)?,
+            bulk: opt(&o.bulk)?,
+            element: opt(&o.element)?,
+            prony: opt(&o.prony)?,
             edge_radius: o.edge_radius,
         })
     } else if kind == "N3" {
         ModelSpec::N3Needle(N3NeedleSpec {
             law: law.clone(),
             friction: o.friction,
-            mesh: o.mesh.clone(),
-            bulk: o.bulk.clone(),
-            tool: o.tool.clone(),
-            element: o.element.clone(),
+            mesh: opt::<Mesh>(&o.mesh)?,
+            bulk: opt(&o.bulk)?,
+            tool: opt(&o.tool)?,
+            element: opt(&o.element)?,
         })
     } else if kind == "N1" {
         ModelSpec::N1Needle(N1NeedleSpec {
             law: law.clone(),
             friction: o.friction,
-            mesh: o.mesh.clone(),
-            bulk: o.bulk.clone(),
-            base: o.sliding_base.then(|| "sliding".into()),
-            tool: o.tool.clone(),
-            element: o.element.clone(),
-            prony: o.prony.clone(),
+            mesh: opt::<Mesh>(&o.mesh)?,
+            bulk: opt(&o.bulk)?,
+            base: o.sliding_base.then_some(palpate_fe::Support::Sliding),
+            tool: opt(&o.tool)?,
+            element: opt(&o.element)?,
+            prony: opt(&o.prony)?,
         })
     } else {
         ModelSpec::C1Fe(C1FeSpec {
             law,
-            platens: o.bonded.then(|| "bonded".into()),
-            mesh: o.mesh.clone(),
-            bulk: o.bulk.clone(),
-            prony: o.prony.clone(),
+            platens: o.bonded.then_some(palpate_fe::Platens::Bonded),
+            mesh: opt::<Mesh>(&o.mesh)?,
+            bulk: opt(&o.bulk)?,
+            prony: opt(&o.prony)?,
         })
     })
 }
