@@ -128,7 +128,7 @@ impl ToolComplianceEvaluator<'_> {
             if worst <= tol {
                 return Ok(());
             }
-            let sign = |i: usize| if i % 2 == 0 { 1.0 } else { -1.0 };
+            let sign = |i: usize| if i.is_multiple_of(2) { 1.0 } else { -1.0 };
             let plus: Vec<f64> = u.iter().enumerate().map(|(i, x)| x + sign(i) * h).collect();
             Self::base_at(
                 base,
