@@ -660,14 +660,6 @@ mod n1 {
     use std::fmt::Write;
     use std::sync::Arc;
 
-    /// The effects of the N1 pairs, in the order of the strength scales.
-    const EFFECTS: [&str; 4] = [
-        "friction",
-        "material_form",
-        "zero_offset",
-        "boundary_condition",
-    ];
-
     /// Relative noise of the records (of the peak force).
     const NOISE: f64 = 0.01;
 
@@ -691,11 +683,14 @@ mod n1 {
         seed: u64,
     }
 
-    /// The record's model on the MEDIUM mesh with `spec`'s effects at
-    /// strengths multiplied by `scale` (order of [`EFFECTS`]): the model,
-    /// its parameters, and every planted value by the name the diagnosis
-    /// gives it (`C10`, `C20`, `friction`, `d0_mm`, `thickness_mm`).
-    fn model(spec: &Spec, scale: &[f64]) -> (Arc<dyn ForwardModel>, Vec<f64>, Vec<(String, f64)>) {
+    /// Planted values by the name the diagnosis gives them.
+    type Named = Vec<(String, f64)>;
+
+    /// The record's model on the MEDIUM mesh with `spec`'s effects: the
+    /// model, its parameters, and every planted value by the name the
+    /// diagnosis gives it (`C10`, `C20`, `friction`, `d0_mm`,
+    /// `thickness_mm`).
+    fn model(spec: &Spec) -> (Arc<dyn ForwardModel>, Vec<f64>, Named) {
         let has = |e: &str| spec.effects.contains(&e);
         let mut named = vec![("C10".to_string(), spec.c10)];
         let law = if has("material_form") {
@@ -708,26 +703,25 @@ mod n1 {
         m.friction = 0.0;
         let mut theta = vec![spec.c10];
         if has("material_form") {
-            let c20 = 2.0e-3 * scale[1];
+            let c20 = 2.0e-3;
             theta.push(c20);
             named.push(("C20".into(), c20));
         }
         if has("friction") {
-            // within the plausible range of friction (0..0.8)
-            m.friction = (0.5 * scale[0]).min(0.8);
+            m.friction = 0.5;
             named.push(("friction".into(), m.friction));
         }
         if has("boundary_condition") {
             if spec.sliding {
                 m.base = Support::Sliding;
             } else {
-                m.height = 80.0 / (8.0 / 3.0 * scale[3]);
+                m.height = 30.0;
                 named.push(("thickness_mm".into(), m.height));
             }
         }
         let mut model: Arc<dyn ForwardModel> = Arc::new(m);
         if has("zero_offset") {
-            let d0 = (0.5 * scale[2]).min(1.0);
+            let d0 = 0.5;
             model = Arc::new(ZeroOffset::from_arc(model));
             theta.push(d0);
             named.push(("d0_mm".into(), d0));
@@ -742,7 +736,7 @@ mod n1 {
     /// each planted effect's partner leaves.
     fn make(spec: &Spec) -> (String, String) {
         let loading = loading();
-        let (model, theta, named) = model(spec, &[1.0; EFFECTS.len()]);
+        let (model, theta, named) = model(spec);
         let clean = model.predict(&theta, &loading).expect("N1 record");
         let peak = clean.iter().fold(0.0f64, |m, x| m.max(x.abs()));
         let sd = spec.noise * peak;
