@@ -41,7 +41,9 @@
 //! Noise 1 % of the peak force (nulls 0.5-2 %). Whether each effect shows
 //! beside its partner is not measured by the generator (a fit of an FE
 //! model costs minutes): `bench_gap_sets_n1` prints what each candidate
-//! alone leaves. About two minutes of CPU in the dev profile.
+//! alone leaves. Friction beside a stiffening law is not written (the law
+//! alone fits that record to the noise). About two minutes of CPU in the
+//! dev profile.
 
 use palpate_analytic::{C1Compression, Compressible, Homogeneous, Mode};
 use palpate_core::enrichable::{embed, enrich_forms};
@@ -768,14 +770,10 @@ mod n1 {
 
     pub(super) fn write() {
         let specs = [
-            Spec {
-                name: "n1-00",
-                effects: &["friction", "material_form"],
-                sliding: false,
-                c10: 1.0e-3,
-                noise: NOISE,
-                seed: 5000,
-            },
+            // friction beside a stiffening law (C20 2e-3) is not a two-effect
+            // record: `material_form` alone fits it to 0.9 x noise
+            // (bench_gap_sets_n1), friction hides behind it; not written, so
+            // the others keep their names.
             Spec {
                 name: "n1-01",
                 effects: &["friction", "zero_offset"],
