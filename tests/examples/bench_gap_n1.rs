@@ -75,6 +75,21 @@ impl Enrichable for Counted {
         let rich = palpate_core::enrichable::enrich(self.0.as_ref(), effect)?;
         Ok(Box::new(Counted(Arc::from(rich))))
     }
+    /// Every form, as the CLI's model offers them (`boundary_condition`:
+    /// thickness and sliding base), each counted.
+    fn enrich_forms(
+        &self,
+        effect: Effect,
+    ) -> Result<Vec<palpate_core::enrichable::EffectForm>, ForwardError> {
+        let forms = palpate_core::enrichable::enrich_forms(self.0.as_ref(), effect)?;
+        Ok(forms
+            .into_iter()
+            .map(|f| palpate_core::enrichable::EffectForm {
+                name: f.name,
+                model: Box::new(Counted(Arc::from(f.model))),
+            })
+            .collect())
+    }
     fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
         palpate_core::enrichable::embed(self.0.as_ref(), base_theta)
     }

@@ -27,6 +27,23 @@
 //!
 //! `cargo run -p palpate-tools --bin make_gap_two` (about a minute). The records
 //! are committed; rerun only to change them.
+//!
+//! `cargo run -p palpate-tools --bin make_gap_two -- n1` writes the N1
+//! records instead, to `studies/data/gap-dev2/n1/` with their own
+//! `truth.json` (used by `tests/examples/bench_gap_sets_n1.rs` and
+//! `tests/tests/integration/gap_n1.rs`): the needle of N1 to 8 mm every
+//! 0.25 mm (33 samples), simulated on the MEDIUM mesh while the diagnosis's
+//! base is the coarse one, with two of `friction`, `material_form`
+//! (reduced polynomial N=2), `zero_offset` and `boundary_condition` (a
+//! specimen of 30 mm instead of N1's 80, the effect's `thickness` form)
+//! planted, each pair once (friction 0.5, C20 2e-3 MPa beside C10 1-1.2e-3,
+//! an offset of 0.5 mm), plus three noise-only records (`null-n1-*`).
+//! Noise 1 % of the peak force (nulls 0.5-2 %). Whether each effect shows
+//! beside its partner is not measured by the generator (a fit of an FE
+//! model costs minutes): `bench_gap_sets_n1` prints what each candidate
+//! alone leaves. Friction beside a stiffening law is not written (the law
+//! alone fits that record to the noise). About two minutes of CPU in the
+//! dev profile.
 
 use palpate_analytic::{C1Compression, Compressible, Homogeneous, Mode};
 use palpate_core::enrichable::{embed, enrich_forms};
@@ -577,6 +594,10 @@ fn null_records() -> Vec<Record> {
 }
 
 fn main() {
+    if std::env::args().nth(1).as_deref() == Some("n1") {
+        n1::write();
+        return;
+    }
     let dir = palpate_tools::repo("studies/data/gap-dev2");
     std::fs::create_dir_all(&dir).expect("create studies/data/gap-dev2");
     // records of an earlier suite (a pair no longer written) go
@@ -629,4 +650,210 @@ fn main() {
     }
     truth.push_str("}\n");
     std::fs::write(dir.join("truth.json"), truth).expect("write truth.json");
+}
+
+/// The N1 two-effect records (`-- n1`).
+mod n1 {
+    use palpate_core::{Drive, ForwardModel, Loading};
+    use palpate_enrich::ZeroOffset;
+    use palpate_fe::{MeshDensity, N1Needle, Support};
+    use palpate_material::Law;
+    use rayon::prelude::*;
+    use std::fmt::Write;
+    use std::sync::Arc;
+
+    /// Relative noise of the records (of the peak force).
+    const NOISE: f64 = 0.01;
+
+    /// The depths: 0 to 8 mm every 0.25 mm.
+    fn loading() -> Loading {
+        Loading::quasi_static(
+            Drive::DisplacementMm,
+            (0..=32).map(|i| 0.25 * i as f64).collect(),
+        )
+    }
+
+    /// One N1 record to write: the planted effects (names of GAP.md),
+    /// whether a planted `boundary_condition` is a sliding base (else a
+    /// thinner specimen), C10 and the seed.
+    struct Spec {
+        name: &'static str,
+        effects: &'static [&'static str],
+        sliding: bool,
+        c10: f64,
+        noise: f64,
+        seed: u64,
+    }
+
+    /// Planted values by the name the diagnosis gives them.
+    type Named = Vec<(String, f64)>;
+
+    /// The record's model on the MEDIUM mesh with `spec`'s effects: the
+    /// model, its parameters, and every planted value by the name the
+    /// diagnosis gives it (`C10`, `C20`, `friction`, `d0_mm`,
+    /// `thickness_mm`).
+    fn model(spec: &Spec) -> (Arc<dyn ForwardModel>, Vec<f64>, Named) {
+        let has = |e: &str| spec.effects.contains(&e);
+        let mut named = vec![("C10".to_string(), spec.c10)];
+        let law = if has("material_form") {
+            Law::ReducedPolynomial(2)
+        } else {
+            Law::NeoHookean
+        };
+        let mut m = N1Needle::new(law);
+        m.mesh = MeshDensity::MEDIUM;
+        m.friction = 0.0;
+        let mut theta = vec![spec.c10];
+        if has("material_form") {
+            let c20 = 2.0e-3;
+            theta.push(c20);
+            named.push(("C20".into(), c20));
+        }
+        if has("friction") {
+            m.friction = 0.5;
+            named.push(("friction".into(), m.friction));
+        }
+        if has("boundary_condition") {
+            if spec.sliding {
+                m.base = Support::Sliding;
+            } else {
+                m.height = 30.0;
+                named.push(("thickness_mm".into(), m.height));
+            }
+        }
+        let mut model: Arc<dyn ForwardModel> = Arc::new(m);
+        if has("zero_offset") {
+            let d0 = 0.5;
+            model = Arc::new(ZeroOffset::from_arc(model));
+            theta.push(d0);
+            named.push(("d0_mm".into(), d0));
+        }
+        (model, theta, named)
+    }
+
+    /// One record: its CSV and truth line. Each effect's visibility beside
+    /// its partner is not measured here (a fit of the partner alone on the
+    /// FE model costs minutes per record under load): the diagnosis's first
+    /// step fits every candidate alone, and `bench_gap_sets_n1` prints what
+    /// each planted effect's partner leaves.
+    fn make(spec: &Spec) -> (String, String) {
+        let loading = loading();
+        let (model, theta, named) = model(spec);
+        let clean = model.predict(&theta, &loading).expect("N1 record");
+        let peak = clean.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let sd = spec.noise * peak;
+        let e = super::noise(clean.len(), sd, spec.seed);
+        let mut csv = format!(
+            "# gap diagnosis two-effect development record (tools/src/bin/make_gap_two.rs -- n1): {}, MEDIUM mesh, seed {}, white noise sd {sd:.4e} N ({} of the peak)\ndisplacement_mm,force_N\n",
+            model.name(),
+            spec.seed,
+            spec.noise
+        );
+        for (d, (f, n)) in loading.drive.iter().zip(clean.iter().zip(&e)) {
+            let _ = writeln!(csv, "{d:.2},{:.6e}", f + n);
+        }
+        let params: Vec<String> = named.iter().map(|(n, v)| format!("\"{n}\": {v}")).collect();
+        let expected: Vec<String> = spec.effects.iter().map(|e| format!("\"{e}\"")).collect();
+        let truth = format!(
+            "\"base\": \"N1\", \"law\": \"neo-hookean\", \"model\": \"{}\", \"mesh\": \"medium\", \"base_support\": \"{}\", \"depth_mm\": 8, \
+             \"params\": {{{}}}, \"expected\": [{}], \"noise_sd\": {sd:.6e}, \"seed\": {}, \"samples\": {}",
+            model.name(),
+            if spec.sliding { "sliding" } else { "bonded" },
+            params.join(", "),
+            expected.join(", "),
+            spec.seed,
+            clean.len()
+        );
+        eprintln!("{}: {:?}, noise sd {sd:.3e} N", spec.name, named);
+        (csv, truth)
+    }
+
+    pub(super) fn write() {
+        let specs = [
+            // friction beside a stiffening law (C20 2e-3) is not a two-effect
+            // record: `material_form` alone fits it to 0.9 x noise
+            // (bench_gap_sets_n1), friction hides behind it; not written, so
+            // the others keep their names.
+            Spec {
+                name: "n1-01",
+                effects: &["friction", "zero_offset"],
+                sliding: false,
+                c10: 1.2e-3,
+                noise: NOISE,
+                seed: 5001,
+            },
+            Spec {
+                name: "n1-02",
+                effects: &["friction", "boundary_condition"],
+                sliding: false,
+                c10: 1.0e-3,
+                noise: NOISE,
+                seed: 5002,
+            },
+            Spec {
+                name: "n1-03",
+                effects: &["material_form", "zero_offset"],
+                sliding: false,
+                c10: 1.2e-3,
+                noise: NOISE,
+                seed: 5003,
+            },
+            Spec {
+                name: "n1-04",
+                effects: &["material_form", "boundary_condition"],
+                sliding: false,
+                c10: 1.0e-3,
+                noise: NOISE,
+                seed: 5004,
+            },
+            Spec {
+                name: "n1-05",
+                effects: &["zero_offset", "boundary_condition"],
+                sliding: false,
+                c10: 1.2e-3,
+                noise: NOISE,
+                seed: 5005,
+            },
+            Spec {
+                name: "null-n1-00",
+                effects: &[],
+                sliding: false,
+                c10: 0.9e-3,
+                noise: 0.01,
+                seed: 6000,
+            },
+            Spec {
+                name: "null-n1-01",
+                effects: &[],
+                sliding: false,
+                c10: 1.2e-3,
+                noise: 0.005,
+                seed: 6001,
+            },
+            Spec {
+                name: "null-n1-02",
+                effects: &[],
+                sliding: false,
+                c10: 1.5e-3,
+                noise: 0.02,
+                seed: 6002,
+            },
+        ];
+        let dir = palpate_tools::repo("studies/data/gap-dev2/n1");
+        std::fs::create_dir_all(&dir).expect("create studies/data/gap-dev2/n1");
+        let made: Vec<(String, String)> = specs.par_iter().map(make).collect();
+        let written: Vec<(&Spec, (String, String))> = specs.iter().zip(made).collect();
+        let mut truth = String::from("{\n");
+        for (k, (spec, (csv, line))) in written.iter().enumerate() {
+            std::fs::write(dir.join(format!("{}.csv", spec.name)), csv).expect("write record");
+            let _ = writeln!(
+                truth,
+                "  \"{}\": {{{line}}}{}",
+                spec.name,
+                if k + 1 < written.len() { "," } else { "" }
+            );
+        }
+        truth.push_str("}\n");
+        std::fs::write(dir.join("truth.json"), truth).expect("write truth.json");
+    }
 }
