@@ -15,11 +15,6 @@
 //!   two are reported as confounded (a stiffening law bends one force-depth
 //!   curve as friction does), not one picked.
 //!
-//! * (ignored for its cost) a two-effect record of
-//!   `studies/data/gap-dev2/n1/` (friction and a zero offset planted) ->
-//!   explanation {friction, zero_offset}; the whole suite is
-//!   `bench_gap_sets_n1` (docs/validation/gap-sets-n1.md).
-//!
 //! The candidates are GAP.md's N1 effects (friction, boundary_condition),
 //! the CLI's default for N1. The diagnosis runs the FE model some 60 times
 //! per record (a minute of CPU in the dev profile): the four diagnoses run in
@@ -130,59 +125,4 @@ fn n1_records_get_the_expected_verdicts() {
             );
         }
     }
-}
-
-/// The N1 two-effect records of `studies/data/gap-dev2/n1/` (written by
-/// `make_gap_two -- n1` on the MEDIUM mesh), diagnosed as
-/// `palpate diagnose --benchmark N1 --effects
-/// friction,boundary_condition,material_form,zero_offset` does it.
-fn diagnose_two_effect(name: &str) -> (GapReport, Vec<String>) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../studies/data/gap-dev2/n1");
-    let truth: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("truth.json")).unwrap()).unwrap();
-    let mut planted: Vec<String> = truth[name]["expected"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| e.as_str().unwrap().to_string())
-        .collect();
-    planted.sort();
-    let table = Table::read(dir.join(format!("{name}.csv"))).unwrap();
-    let d = table.column("displacement_mm").unwrap().to_vec();
-    let f = table.column("force_N").unwrap().to_vec();
-    let loading = Loading::quasi_static(Drive::DisplacementMm, d);
-    let mut base = N1Needle::new(Law::NeoHookean);
-    base.friction = 0.0;
-    base.mesh = MeshDensity::COARSE;
-    let options = GapOptions {
-        effects: Some(vec![
-            Effect::Friction,
-            Effect::BoundaryCondition,
-            Effect::MaterialForm,
-            Effect::ZeroOffset,
-        ]),
-        ..GapOptions::default()
-    };
-    (diagnose(&base, &loading, &f, &options).unwrap(), planted)
-}
-
-/// A needle record with friction 0.5 and a 0.5 mm zero offset planted gets
-/// both as its explanation, nothing else, the remainder at the noise.
-#[test]
-#[ignore = "an N1 diagnosis with sets over four candidates costs minutes of CPU in the dev profile (docs/validation/gap-sets-n1.md); run: cargo test -p palpate-tests --test integration gap_n1::an_n1_two_effect_record_gets_its_pair -- --ignored; the whole suite: cargo run -p palpate-tests --example bench_gap_sets_n1"]
-fn an_n1_two_effect_record_gets_its_pair() {
-    let (r, planted) = diagnose_two_effect("n1-01");
-    let mut found: Vec<String> = r
-        .explanation_set
-        .iter()
-        .map(|m| m.effect.name().to_string())
-        .collect();
-    found.sort();
-    assert_eq!(found, planted, "{}", r.explanation);
-    assert!(
-        r.remainder.misfit_over_noise < 1.5,
-        "remainder {} x noise: {}",
-        r.remainder.misfit_over_noise,
-        r.explanation
-    );
 }
