@@ -36,6 +36,7 @@
 
 pub mod boundary_polish;
 pub mod covariance;
+pub(crate) mod curvature;
 pub mod dataset;
 pub mod design;
 pub mod error;
@@ -59,6 +60,7 @@ pub use covariance::{
     covariance, covariance_with_noise, CorrelatedPair, Covariance, Identifiability, MAX_CONDITION,
     MAX_CORRELATION,
 };
+pub use curvature::MAX_RESETS_IN_A_ROW;
 pub use dataset::DataSet;
 pub use error::InverseError;
 pub use fidelity_correction::{CorrectedModel, FidelityCorrection};

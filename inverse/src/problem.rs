@@ -271,6 +271,26 @@ impl Gradient for LeastSquaresProblem<'_> {
     }
 }
 
+/// The adapter lent to a quasi-Newton executor: argmin's L-BFGS drops the
+/// problem it holds when its line search fails (it then ends the run with
+/// the failure as its reason), so the run lends it and keeps its counts and
+/// kept evaluations.
+impl CostFunction for &LeastSquaresProblem<'_> {
+    type Param = Vec<f64>;
+    type Output = f64;
+    fn cost(&self, z: &Vec<f64>) -> Result<f64, Error> {
+        (**self).cost(z)
+    }
+}
+
+impl Gradient for &LeastSquaresProblem<'_> {
+    type Param = Vec<f64>;
+    type Gradient = Vec<f64>;
+    fn gradient(&self, z: &Vec<f64>) -> Result<Vec<f64>, Error> {
+        (**self).gradient(z)
+    }
+}
+
 /// Recovers an [`InverseError`] from an argmin error, or wraps the text.
 pub fn inverse_error(error: Error, solver: &'static str) -> InverseError {
     match error.downcast::<InverseError>() {

@@ -1,7 +1,10 @@
 //! One local optimisation from one starting point, through argmin's
 //! `Executor`: Levenberg-Marquardt, BFGS or L-BFGS (the latter two with the
-//! Moré-Thuente line search on `SSE(z)` and the gradient `2 J^T r`).
+//! Moré-Thuente line search on `SSE(z)` and the gradient `2 J^T r`, and
+//! the reset of [`crate::curvature`] after a step whose curvature is not
+//! positive).
 
+use crate::curvature::{CurvatureGuard, Restart};
 use crate::jacobian::ExactEvaluation;
 use crate::observer::ArgminBridge;
 use crate::problem::{inverse_error, EvaluationCount, LeastSquaresProblem};
@@ -151,7 +154,8 @@ pub(crate) fn run(
                 .with_tolerance_grad(options.relative_tol_grad * sse0)
                 .and_then(|s| s.with_tolerance_cost(options.relative_tol_cost * sse0))
                 .map_err(|e| inverse_error(e, "BFGS"))?;
-            let mut executor = Executor::new(problem, solver).configure(|s| {
+            let solver = CurvatureGuard::new(solver, Restart::InverseHessian(h0.clone()), "BFGS");
+            let mut executor = Executor::new(&problem, solver).configure(|s| {
                 s.param(z0)
                     .inv_hessian(h0)
                     .max_iters(options.max_iterations)
@@ -160,7 +164,7 @@ pub(crate) fn run(
                 executor = executor.add_observer(obs, ObserverMode::Always);
             }
             let result = executor.run().map_err(|e| inverse_error(e, "BFGS"))?;
-            let p = result.problem.problem.as_ref().expect("problem kept");
+            let p = &problem;
             let z = result.state.get_best_param().cloned().unwrap_or_default();
             Ok(RunOutcome {
                 exact: p.take_exact(&z),
@@ -179,13 +183,15 @@ pub(crate) fn run(
                 .with_tolerance_grad(options.relative_tol_grad * sse0)
                 .and_then(|s| s.with_tolerance_cost(options.relative_tol_cost * sse0))
                 .map_err(|e| inverse_error(e, "L-BFGS"))?;
-            let mut executor = Executor::new(problem, solver)
+            let solver =
+                CurvatureGuard::<_, ()>::new(solver.clone(), Restart::Memory(solver), "L-BFGS");
+            let mut executor = Executor::new(&problem, solver)
                 .configure(|s| s.param(z0).max_iters(options.max_iterations));
             if let Some(obs) = observer {
                 executor = executor.add_observer(obs, ObserverMode::Always);
             }
             let result = executor.run().map_err(|e| inverse_error(e, "L-BFGS"))?;
-            let p = result.problem.problem.as_ref().expect("problem kept");
+            let p = &problem;
             let z = result.state.get_best_param().cloned().unwrap_or_default();
             Ok(RunOutcome {
                 exact: p.take_exact(&z),
