@@ -1094,6 +1094,8 @@ fn the_wall_slide_keeps_to_the_run_budget() {
         full.evaluations
     );
     assert!(capped.sse > full.sse, "{} vs {}", capped.sse, full.sse);
+}
+
 /// A deterministic noise in [-1, 1] from the bits of `theta` and `x`, as a
 /// forward model solved to a tolerance gives (repeatable, not smooth).
 fn solver_noise(theta: &[f64], x: f64) -> f64 {
