@@ -9,91 +9,17 @@
 //!
 //! `cargo run --release -p palpate-tests --example bench_gap_n1 [-- --effects friction,material_form]`
 
-use palpate_core::{
-    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
-    ParamSpace, Table,
-};
+use palpate_core::{Drive, Effect, ForwardModel, Loading, Table};
 use palpate_fe::{MeshDensity, N1Needle};
 use palpate_material::Law;
+use palpate_tests::counted::{Counted, RUNS};
 use palpate_uq::gap::{diagnose, GapOptions};
 use rand::SeedableRng;
 use rand_distr::{Distribution, Normal};
 use std::fmt::Write;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::Ordering;
 use std::sync::Arc;
 use std::time::Instant;
-
-/// FE simulations made through [`Counted`].
-static RUNS: AtomicUsize = AtomicUsize::new(0);
-
-/// A model that counts its predictions, and whose enrichments do too.
-struct Counted(Arc<dyn ForwardModel>);
-
-struct CountedEval<'a>(Box<dyn Evaluator + 'a>);
-
-impl Evaluator for CountedEval<'_> {
-    fn predict_into(
-        &mut self,
-        theta: &[f64],
-        loading: &Loading,
-        out: &mut [f64],
-    ) -> Result<(), ForwardError> {
-        let k = RUNS.fetch_add(1, Ordering::Relaxed);
-        if std::env::var_os("GAP_TRACE").is_some() {
-            eprintln!("solve {k}: {theta:?}");
-        }
-        self.0.predict_into(theta, loading, out)
-    }
-}
-
-impl ForwardModel for Counted {
-    fn name(&self) -> String {
-        self.0.name()
-    }
-    fn space(&self) -> &ParamSpace {
-        self.0.space()
-    }
-    fn observable(&self) -> Observable {
-        self.0.observable()
-    }
-    fn expensive(&self) -> bool {
-        self.0.expensive()
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(CountedEval(self.0.evaluator()))
-    }
-    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
-        Some(self)
-    }
-}
-
-impl Enrichable for Counted {
-    fn effects(&self) -> Vec<Effect> {
-        palpate_core::enrichable::effects_of(self.0.as_ref())
-    }
-    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        let rich = palpate_core::enrichable::enrich(self.0.as_ref(), effect)?;
-        Ok(Box::new(Counted(Arc::from(rich))))
-    }
-    /// Every form, as the CLI's model offers them (`boundary_condition`:
-    /// thickness and sliding base), each counted.
-    fn enrich_forms(
-        &self,
-        effect: Effect,
-    ) -> Result<Vec<palpate_core::enrichable::EffectForm>, ForwardError> {
-        let forms = palpate_core::enrichable::enrich_forms(self.0.as_ref(), effect)?;
-        Ok(forms
-            .into_iter()
-            .map(|f| palpate_core::enrichable::EffectForm {
-                name: f.name,
-                model: Box::new(Counted(Arc::from(f.model))),
-            })
-            .collect())
-    }
-    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
-        palpate_core::enrichable::embed(self.0.as_ref(), base_theta)
-    }
-}
 
 /// User + system CPU seconds of this process.
 fn cpu_seconds() -> f64 {

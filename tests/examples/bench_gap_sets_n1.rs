@@ -21,91 +21,15 @@
 //! writes each report's explanation, its candidates and the FE runs by
 //! model to stderr: where the runs go).
 
-use palpate_core::{
-    Drive, Effect, Enrichable, Evaluator, ForwardError, ForwardModel, Loading, Observable,
-    ParamSpace, Table,
-};
+use palpate_core::{Drive, Effect, Loading, Table};
 use palpate_fe::{MeshDensity, N1Needle};
 use palpate_material::Law;
+use palpate_tests::counted::{Counted, BY_MODEL, RUNS};
 use palpate_uq::gap::{diagnose, GapOptions};
-use std::collections::BTreeMap;
 use std::path::Path;
-use std::sync::atomic::{AtomicUsize, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::atomic::Ordering;
+use std::sync::Arc;
 use std::time::Instant;
-
-/// FE simulations made through [`Counted`].
-static RUNS: AtomicUsize = AtomicUsize::new(0);
-
-/// FE simulations by model (`--explain`: where the runs go).
-static BY_MODEL: Mutex<BTreeMap<String, usize>> = Mutex::new(BTreeMap::new());
-
-/// A model that counts its predictions, and whose enrichments do too.
-struct Counted(Arc<dyn ForwardModel>);
-
-struct CountedEval<'a>(Box<dyn Evaluator + 'a>, String);
-
-impl Evaluator for CountedEval<'_> {
-    fn predict_into(
-        &mut self,
-        theta: &[f64],
-        loading: &Loading,
-        out: &mut [f64],
-    ) -> Result<(), ForwardError> {
-        RUNS.fetch_add(1, Ordering::Relaxed);
-        if let Ok(mut m) = BY_MODEL.lock() {
-            *m.entry(self.1.clone()).or_default() += 1;
-        }
-        self.0.predict_into(theta, loading, out)
-    }
-}
-
-impl ForwardModel for Counted {
-    fn name(&self) -> String {
-        self.0.name()
-    }
-    fn space(&self) -> &ParamSpace {
-        self.0.space()
-    }
-    fn observable(&self) -> Observable {
-        self.0.observable()
-    }
-    fn expensive(&self) -> bool {
-        self.0.expensive()
-    }
-    fn evaluator(&self) -> Box<dyn Evaluator + '_> {
-        Box::new(CountedEval(self.0.evaluator(), self.0.name()))
-    }
-    fn as_enrichable(&self) -> Option<&dyn Enrichable> {
-        Some(self)
-    }
-}
-
-impl Enrichable for Counted {
-    fn effects(&self) -> Vec<Effect> {
-        palpate_core::enrichable::effects_of(self.0.as_ref())
-    }
-    fn enrich(&self, effect: Effect) -> Result<Box<dyn ForwardModel>, ForwardError> {
-        let rich = palpate_core::enrichable::enrich(self.0.as_ref(), effect)?;
-        Ok(Box::new(Counted(Arc::from(rich))))
-    }
-    fn enrich_forms(
-        &self,
-        effect: Effect,
-    ) -> Result<Vec<palpate_core::enrichable::EffectForm>, ForwardError> {
-        let forms = palpate_core::enrichable::enrich_forms(self.0.as_ref(), effect)?;
-        Ok(forms
-            .into_iter()
-            .map(|f| palpate_core::enrichable::EffectForm {
-                name: f.name,
-                model: Box::new(Counted(Arc::from(f.model))),
-            })
-            .collect())
-    }
-    fn embed(&self, base_theta: &[f64]) -> Vec<f64> {
-        palpate_core::enrichable::embed(self.0.as_ref(), base_theta)
-    }
-}
 
 /// User + system CPU seconds of this process.
 fn cpu_seconds() -> f64 {

@@ -3,6 +3,7 @@
 //! references, through the same trait objects the estimators use.
 //!
 //! Helpers shared by those tests live here.
+pub mod counted;
 
 /// The R2 development experiment of the gap diagnosis:
 /// a shorter, thinner block than docs/benchmarks.md R2 so that one rolled pass
